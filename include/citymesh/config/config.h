@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// The run configuration: typed params structs whose member initialisers are the defaults,
+// filled from one TOML file (plus command-line overrides).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "citymesh/core/mesh.h"
+#include "citymesh/core/time.h"
+#include "citymesh/geo/crs.h"
+#include "citymesh/io/ply_reader.h"
+
+namespace citymesh {
+
+struct ProjectParams {
+  std::string crs;  ///< required: "EPSG:2154", "EPSG:326xx", "ENU:lat,lon,h"
+  std::string vertical_datum;  ///< required: "ellipsoidal" or "orthometric"
+  double geoid_undulation = 0.0;  ///< metres; orthometric only (h = H + N)
+  std::filesystem::path output = "out";
+  std::filesystem::path work = "work";
+};
+
+/// Property names of the input PLY files; the defaults are the reader's own.
+struct InputParams {
+  std::array<std::string, 3> sensor_origin = PlyReadParams{}.sensor_origin_names;
+  std::vector<std::string> time = PlyReadParams{}.time_names;
+  std::string intensity = PlyReadParams{}.intensity_name;
+};
+
+struct AcquisitionEntry {
+  std::filesystem::path path;  ///< absolute (resolved against the config file's folder)
+  TimePoint time{};
+  std::string name;  ///< defaults to the file stem
+};
+
+struct ChangeParams {
+  double distance_threshold = 0.10;  ///< metres
+  double conflict_margin = 0.10;     ///< metres
+  double normal_angle = 45.0;        ///< degrees
+  Duration sustainability = std::chrono::days(30);
+};
+
+enum class QualityMeasure { constant, area, resolution };
+
+struct MosaicParams {
+  QualityMeasure quality = QualityMeasure::constant;
+  double quality_weight = 1.0;    ///< lambda 1
+  double boundary_weight = 0.5;   ///< lambda 2, per metre of mesh boundary
+  double overlap_weight = 100.0;  ///< lambda 3
+  double seam_weight = 1.0;       ///< lambda 4, per metre of seam
+};
+
+struct TilingParams {
+  double tile_size = 50.0;  ///< metres
+  double halo = 2.0;        ///< metres
+  std::array<double, 2> origin{0.0, 0.0};
+};
+
+struct RunParams {
+  unsigned threads = 0;  ///< 0: all cores
+  std::uint64_t memory = 2ull << 30;
+};
+
+struct OutputParams {
+  bool tiles_3d = true;
+  bool ply = false;
+  double draco_tolerance = 0.001;  ///< metres
+};
+
+struct Config {
+  std::filesystem::path file;      ///< the config file ("" for defaults)
+  std::filesystem::path base_dir;  ///< relative paths resolve against this folder
+  ProjectParams project;
+  InputParams input;
+  std::vector<AcquisitionEntry> acquisitions;
+  ChangeParams change;
+  MosaicParams mosaic;
+  TilingParams tiling;
+  RunParams run;
+  OutputParams output;
+
+  /// The project CRS with its vertical datum.
+  [[nodiscard]] Crs crs() const;
+  /// Acquisitions in config order, indices 0..n-1.
+  [[nodiscard]] std::vector<Acquisition> acquisition_list() const;
+  [[nodiscard]] PlyReadParams ply_read_params() const;
+};
+
+struct ConfigLoadParams {
+  /// "section.key=value" overrides applied on top of the file (value in TOML syntax; a bare
+  /// word is taken as a string).
+  std::vector<std::string> overrides;
+  /// Check that every acquisition file exists.
+  bool check_files = true;
+};
+
+/// Reads and validates a config file. Throws ConfigError "<file>:<line>:<col>: <key>: ..."; an
+/// unknown key names the nearest valid one.
+Config load_config(const std::filesystem::path& file, const ConfigLoadParams& params = {});
+/// Same from text; `source` names the file in errors and gives the base folder.
+Config parse_config(std::string_view text, const std::filesystem::path& source,
+                    const ConfigLoadParams& params = {});
+
+/// Every key with its default and a one-line meaning, as commented TOML (required keys are
+/// shown commented out with an example).
+std::string dump_default_config();
+/// The effective configuration as TOML (what a run used).
+std::string effective_config_toml(const Config& config);
+
+}  // namespace citymesh

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+// Crash-safe file output: write to a temporary name, fsync, then rename over the final name,
+// so that no half-written file is ever taken for finished work.
+#pragma once
+
+#include <cstddef>
+#include <cstdio>
+#include <filesystem>
+#include <string_view>
+
+namespace citymesh {
+
+class AtomicFile {
+ public:
+  /// Opens "<final>.tmp.<pid>" for writing. Throws OutputError naming the file.
+  explicit AtomicFile(std::filesystem::path final_path);
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  /// Removes the temporary file unless commit() succeeded.
+  ~AtomicFile();
+
+  void write(const void* data, std::size_t size);
+  void write(std::string_view text) { write(text.data(), text.size()); }
+  /// Flushes, fsyncs, renames onto the final path and fsyncs the folder.
+  void commit();
+
+  [[nodiscard]] const std::filesystem::path& path() const { return final_path_; }
+
+ private:
+  std::filesystem::path final_path_;
+  std::filesystem::path temp_path_;
+  std::FILE* file_ = nullptr;
+  bool committed_ = false;
+};
+
+/// Writes `content` to `path` atomically.
+void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+
+}  // namespace citymesh

@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: MIT
+// The data model shared by every stage: acquisitions, triangle ids and in-memory meshes.
+#pragma once
+
+#include <array>
+#include <compare>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "citymesh/core/time.h"
+#include "citymesh/core/vec.h"
+
+namespace citymesh {
+
+/// One mobile-mapping pass: its position in the config (the index every output refers to),
+/// its date and the file it was read from.
+struct Acquisition {
+  std::uint32_t index = 0;
+  TimePoint date{};
+  std::filesystem::path path;
+};
+
+/// Global identity of a triangle, kept by every stage and written to every output.
+/// `face` is the face index in the acquisition's file; `fan` numbers the triangles that
+/// fan triangulation made from one polygon (0 for a face that already was a triangle).
+struct TriangleId {
+  std::uint32_t acquisition = 0;
+  std::uint32_t fan = 0;
+  std::uint64_t face = 0;
+
+  friend constexpr auto operator<=>(const TriangleId& a, const TriangleId& b) {
+    if (auto c = a.acquisition <=> b.acquisition; c != 0) return c;
+    if (auto c = a.face <=> b.face; c != 0) return c;
+    return a.fan <=> b.fan;
+  }
+  friend constexpr bool operator==(const TriangleId&, const TriangleId&) = default;
+};
+
+struct Rgb8 {
+  std::uint8_t r = 0, g = 0, b = 0;
+  friend constexpr bool operator==(const Rgb8&, const Rgb8&) = default;
+};
+
+using Triangle = std::array<std::uint32_t, 3>;
+
+/// A triangle mesh in a local frame. Positions are floats relative to `origin` (a point in the
+/// project CRS, in metres): city coordinates are ~10^6 m, far beyond float precision, while
+/// offsets within a tile or street stay well under a millimetre of float error.
+/// Optional attributes are either empty or have one value per vertex.
+struct Mesh {
+  Vec3d origin;
+  std::vector<Vec3f> positions;
+  std::vector<Vec3f> sensor_positions;  ///< where the sensor stood when it measured the vertex
+  std::vector<double> times;            ///< per-vertex time (seconds, the file's time base)
+  std::vector<float> intensities;
+  std::vector<Rgb8> colors;
+  std::vector<Triangle> triangles;
+  std::vector<TriangleId> triangle_ids;  ///< one per triangle
+
+  [[nodiscard]] std::size_t vertex_count() const { return positions.size(); }
+  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
+  [[nodiscard]] bool has_sensor_positions() const { return !sensor_positions.empty(); }
+  /// Absolute position in the project CRS.
+  [[nodiscard]] Vec3d world_position(std::size_t v) const { return origin + Vec3d(positions[v]); }
+  [[nodiscard]] Vec3d world_sensor_position(std::size_t v) const {
+    return origin + Vec3d(sensor_positions[v]);
+  }
+  /// Throws ProcessingError when attribute sizes disagree or an index is out of range.
+  void check_invariants() const;
+};
+
+/// Converts an absolute position to floats relative to `origin`.
+inline Vec3f to_local(const Vec3d& p, const Vec3d& origin) { return Vec3f(p - origin); }
+
+/// Twice the area of the triangle (a, b, c); 0 for degenerate triangles.
+double doubled_area(const Vec3d& a, const Vec3d& b, const Vec3d& c);
+
+}  // namespace citymesh

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: MIT
+// Thread pool control and deterministic parallel loops (TBB behind this header).
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <memory>
+
+namespace citymesh {
+
+/// Limits the worker threads of every parallel loop while alive. 0 means all cores.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(unsigned threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Threads a parallel loop may use now.
+[[nodiscard]] unsigned available_threads();
+
+/// Calls `body(begin, end)` on disjoint blocks covering [0, count). Block boundaries depend only
+/// on `count` and `grain` (never on the thread count), so a body that writes per-block results
+/// that are then combined in block order gives the same bytes on 1 or N threads.
+void parallel_for_blocks(std::size_t count, std::size_t grain,
+                         const std::function<void(std::size_t, std::size_t)>& body);
+
+}  // namespace citymesh

@@ -1,0 +1,62 @@
+// SPDX-License-Identifier: MIT
+// Small 3-vector and axis-aligned box types used at every layer.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace citymesh {
+
+template <class T>
+struct Vec3 {
+  T x{}, y{}, z{};
+
+  constexpr Vec3() = default;
+  constexpr Vec3(T x_, T y_, T z_) : x(x_), y(y_), z(z_) {}
+  template <class U>
+  constexpr explicit Vec3(const Vec3<U>& o)
+      : x(static_cast<T>(o.x)), y(static_cast<T>(o.y)), z(static_cast<T>(o.z)) {}
+
+  constexpr T& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+  constexpr const T& operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+  constexpr Vec3 operator+(const Vec3& o) const { return {x + o.x, y + o.y, z + o.z}; }
+  constexpr Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
+  constexpr Vec3 operator*(T s) const { return {x * s, y * s, z * s}; }
+  constexpr Vec3 operator/(T s) const { return {x / s, y / s, z / s}; }
+  constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
+  constexpr bool operator==(const Vec3&) const = default;
+};
+
+using Vec3d = Vec3<double>;
+using Vec3f = Vec3<float>;
+
+template <class T>
+constexpr T dot(const Vec3<T>& a, const Vec3<T>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class T>
+constexpr Vec3<T> cross(const Vec3<T>& a, const Vec3<T>& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+template <class T>
+T norm(const Vec3<T>& a) { return std::sqrt(dot(a, a)); }
+template <class T>
+bool is_finite(const Vec3<T>& a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
+
+/// Axis-aligned box; empty until the first extend().
+struct Box3d {
+  Vec3d min{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+            std::numeric_limits<double>::infinity()};
+  Vec3d max{-std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity(),
+            -std::numeric_limits<double>::infinity()};
+
+  [[nodiscard]] bool empty() const { return min.x > max.x; }
+  void extend(const Vec3d& p) {
+    min = {std::min(min.x, p.x), std::min(min.y, p.y), std::min(min.z, p.z)};
+    max = {std::max(max.x, p.x), std::max(max.y, p.y), std::max(max.z, p.z)};
+  }
+  void extend(const Box3d& b) {
+    if (!b.empty()) { extend(b.min); extend(b.max); }
+  }
+};
+
+}  // namespace citymesh

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+// Reading a whole PLY acquisition into a Mesh (tests, tiles, small inputs; the tiler streams).
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+
+#include "citymesh/core/mesh.h"
+#include "citymesh/io/ply_reader.h"
+
+namespace citymesh {
+
+struct MeshReadParams {
+  PlyReadParams ply;
+  std::uint32_t acquisition = 0;  ///< written into every TriangleId
+  /// Local frame origin; by default the first vertex rounded down to whole metres.
+  std::optional<Vec3d> origin;
+  /// Triangles with less than this doubled area (m^2) are degenerate: dropped and counted.
+  double min_doubled_area = 1e-12;
+};
+
+struct MeshReadResult {
+  Mesh mesh;
+  PlyReadStats stats;
+  std::uint64_t zero_area_dropped = 0;
+};
+
+/// Reads every vertex and triangle of `path`. Throws InputError naming the file and row.
+MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams& params = {});
+
+}  // namespace citymesh

@@ -1,0 +1,97 @@
+// SPDX-License-Identifier: MIT
+// Streaming PLY reader: bounded chunks of vertices and triangulated faces in file order, so
+// that an acquisition far larger than memory can be read once, front to back.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "citymesh/core/mesh.h"
+#include "citymesh/io/ply.h"
+
+namespace citymesh {
+
+struct PlyReadParams {
+  /// Property names of the per-vertex sensor position.
+  std::array<std::string, 3> sensor_origin_names{"x_origin", "y_origin", "z_origin"};
+  /// Names tried in order for the per-vertex time.
+  std::vector<std::string> time_names{"gps_time", "GPS_time", "time"};
+  std::string intensity_name = "intensity";
+  /// When true, a file without the sensor-origin properties is an input error.
+  bool require_sensor_origin = true;
+  /// Rows per chunk; bounds the reader's memory whatever the file size.
+  std::size_t chunk_rows = 1 << 16;
+};
+
+/// Which optional vertex attributes the file provides.
+struct PlyVertexLayout {
+  bool has_sensor_origin = false;
+  bool has_time = false;
+  bool has_intensity = false;
+  bool has_color = false;
+  std::string time_name;  ///< the property actually used for time
+};
+
+/// Consecutive vertices [first, first + size). Positions are absolute (header offset applied).
+/// Optional attributes are empty when the file lacks them.
+struct PlyVertexChunk {
+  std::uint64_t first = 0;
+  std::vector<Vec3d> positions;
+  std::vector<Vec3d> sensor_positions;
+  std::vector<double> times;
+  std::vector<float> intensities;
+  std::vector<Rgb8> colors;
+  void clear();
+};
+
+/// Triangles from consecutive faces; polygons are fan-triangulated, faces that repeat a vertex
+/// are dropped (and counted). Each triangle keeps its face index and fan number.
+struct PlyFaceChunk {
+  std::uint64_t first_face = 0;
+  std::vector<Triangle> triangles;
+  std::vector<std::uint64_t> faces;
+  std::vector<std::uint32_t> fans;
+  void clear();
+};
+
+struct PlyReadStats {
+  std::uint64_t vertices = 0;
+  std::uint64_t faces = 0;
+  std::uint64_t triangles = 0;
+  std::uint64_t polygons_split = 0;    ///< faces with more than three vertices
+  std::uint64_t degenerate_dropped = 0;  ///< faces or fan triangles with < 3 distinct vertices
+  std::uint64_t bytes = 0;
+};
+
+class PlyReader {
+ public:
+  /// Opens the file and parses its header. Throws InputError naming the file.
+  PlyReader(std::filesystem::path path, PlyReadParams params = {});
+  ~PlyReader();
+  PlyReader(const PlyReader&) = delete;
+  PlyReader& operator=(const PlyReader&) = delete;
+
+  [[nodiscard]] const PlyHeader& header() const;
+  [[nodiscard]] const PlyVertexLayout& vertex_layout() const;
+  [[nodiscard]] const std::filesystem::path& path() const;
+  [[nodiscard]] std::uint64_t vertex_count() const;
+  [[nodiscard]] std::uint64_t face_count() const;
+
+  enum class ChunkKind { vertices, faces, end };
+  /// Reads the next chunk in file order into `vertices` or `faces` (the other is left alone).
+  /// Elements other than vertex and face are skipped. Returns ChunkKind::end after the last
+  /// element. Throws InputError naming the file, element and row on malformed data.
+  ChunkKind next(PlyVertexChunk& vertices, PlyFaceChunk& faces);
+
+  [[nodiscard]] const PlyReadStats& stats() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace citymesh

@@ -1,0 +1,68 @@
+// SPDX-License-Identifier: MIT
+// Temporary name + fsync + rename: readers see either the old file or the complete new one.
+#include "citymesh/core/atomic_file.h"
+
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <system_error>
+
+#include "citymesh/core/error.h"
+
+namespace citymesh {
+
+namespace {
+[[noreturn]] void fail(const std::filesystem::path& path, std::string_view action) {
+  throw OutputError(fmt::format("{}: cannot {}: {}", path.string(), action, std::strerror(errno)));
+}
+
+void fsync_directory(const std::filesystem::path& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd < 0) return;  // best effort: some filesystems refuse directory handles
+  ::fsync(fd);
+  ::close(fd);
+}
+}  // namespace
+
+AtomicFile::AtomicFile(std::filesystem::path final_path) : final_path_(std::move(final_path)) {
+  temp_path_ = final_path_;
+  temp_path_ += fmt::format(".tmp.{}", ::getpid());
+  std::error_code ec;
+  if (final_path_.has_parent_path()) std::filesystem::create_directories(final_path_.parent_path(), ec);
+  file_ = std::fopen(temp_path_.c_str(), "wb");
+  if (file_ == nullptr) fail(temp_path_, "open for writing");
+}
+
+AtomicFile::~AtomicFile() {
+  if (file_ != nullptr) std::fclose(file_);
+  if (!committed_) {
+    std::error_code ec;
+    std::filesystem::remove(temp_path_, ec);
+  }
+}
+
+void AtomicFile::write(const void* data, std::size_t size) {
+  if (size != 0 && std::fwrite(data, 1, size, file_) != size) fail(temp_path_, "write");
+}
+
+void AtomicFile::commit() {
+  if (std::fflush(file_) != 0) fail(temp_path_, "flush");
+  if (::fsync(::fileno(file_)) != 0) fail(temp_path_, "fsync");
+  const int closed = std::fclose(file_);
+  file_ = nullptr;
+  if (closed != 0) fail(temp_path_, "close");
+  if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0) fail(final_path_, "rename into place");
+  committed_ = true;
+  fsync_directory(final_path_.parent_path());
+}
+
+void write_file_atomically(const std::filesystem::path& path, std::string_view content) {
+  AtomicFile file(path);
+  file.write(content);
+  file.commit();
+}
+
+}  // namespace citymesh

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// The only source that includes TBB.
+#include "citymesh/core/parallel.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include <algorithm>
+
+namespace citymesh {
+
+struct ThreadLimit::Impl {
+  explicit Impl(unsigned threads)
+      : control(tbb::global_control::max_allowed_parallelism,
+                threads == 0 ? tbb::this_task_arena::max_concurrency() : threads) {}
+  tbb::global_control control;
+};
+
+ThreadLimit::ThreadLimit(unsigned threads) : impl_(std::make_unique<Impl>(threads)) {}
+ThreadLimit::~ThreadLimit() = default;
+
+unsigned available_threads() {
+  return static_cast<unsigned>(
+      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
+void parallel_for_blocks(std::size_t count, std::size_t grain,
+                         const std::function<void(std::size_t, std::size_t)>& body) {
+  grain = std::max<std::size_t>(grain, 1);
+  const std::size_t blocks = (count + grain - 1) / grain;
+  // simple_partitioner with grain 1 over block numbers: block edges are fixed by `grain` alone.
+  tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, blocks, 1),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+          body(b * grain, std::min(count, (b + 1) * grain));
+        }
+      },
+      tbb::simple_partitioner());
+}
+
+}  // namespace citymesh

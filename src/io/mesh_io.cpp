@@ -1,0 +1,80 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/io/mesh_io.h"
+
+#include <cmath>
+
+#include "citymesh/core/log.h"
+
+namespace citymesh {
+
+namespace {
+
+Vec3d default_origin(const Vec3d& first) {
+  return {std::floor(first.x), std::floor(first.y), std::floor(first.z)};
+}
+
+void append_vertices(Mesh& mesh, const PlyVertexChunk& chunk) {
+  for (const Vec3d& p : chunk.positions) mesh.positions.push_back(to_local(p, mesh.origin));
+  for (const Vec3d& s : chunk.sensor_positions) mesh.sensor_positions.push_back(to_local(s, mesh.origin));
+  mesh.times.insert(mesh.times.end(), chunk.times.begin(), chunk.times.end());
+  mesh.intensities.insert(mesh.intensities.end(), chunk.intensities.begin(), chunk.intensities.end());
+  mesh.colors.insert(mesh.colors.end(), chunk.colors.begin(), chunk.colors.end());
+}
+
+void append_faces(Mesh& mesh, const PlyFaceChunk& chunk, std::uint32_t acquisition) {
+  for (std::size_t t = 0; t < chunk.triangles.size(); ++t) {
+    mesh.triangles.push_back(chunk.triangles[t]);
+    mesh.triangle_ids.push_back({acquisition, chunk.fans[t], chunk.faces[t]});
+  }
+}
+
+/// Removes triangles whose area is (numerically) zero; returns how many.
+std::uint64_t drop_zero_area(Mesh& mesh, double min_doubled_area) {
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    const double area2 = doubled_area(Vec3d(mesh.positions[tri[0]]), Vec3d(mesh.positions[tri[1]]),
+                                      Vec3d(mesh.positions[tri[2]]));
+    if (area2 < min_doubled_area) continue;
+    mesh.triangles[kept] = tri;
+    mesh.triangle_ids[kept] = mesh.triangle_ids[t];
+    ++kept;
+  }
+  const std::uint64_t dropped = mesh.triangles.size() - kept;
+  mesh.triangles.resize(kept);
+  mesh.triangle_ids.resize(kept);
+  return dropped;
+}
+
+}  // namespace
+
+MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams& params) {
+  PlyReader reader(path, params.ply);
+  MeshReadResult result;
+  Mesh& mesh = result.mesh;
+  mesh.positions.reserve(reader.vertex_count());
+  bool origin_set = params.origin.has_value();
+  if (origin_set) mesh.origin = *params.origin;
+  PlyVertexChunk vertices;
+  PlyFaceChunk faces;
+  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;
+       kind = reader.next(vertices, faces)) {
+    if (kind == PlyReader::ChunkKind::vertices) {
+      if (!origin_set && !vertices.positions.empty()) {
+        mesh.origin = default_origin(vertices.positions.front());
+        origin_set = true;
+      }
+      append_vertices(mesh, vertices);
+    } else {
+      append_faces(mesh, faces, params.acquisition);
+    }
+  }
+  result.stats = reader.stats();
+  result.zero_area_dropped = drop_zero_area(mesh, params.min_doubled_area);
+  if (result.zero_area_dropped > 0) {
+    log::info("{}: dropped {} zero-area triangles", path.string(), result.zero_area_dropped);
+  }
+  return result;
+}
+
+}  // namespace citymesh

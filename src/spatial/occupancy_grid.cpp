@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+// The only source that includes OpenVDB (its headers cost ~13 s of compile time per file).
+#include "citymesh/spatial/occupancy_grid.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <mutex>
+#include <openvdb/openvdb.h>
+
+#include "citymesh/core/error.h"
+
+namespace citymesh {
+
+namespace {
+
+void initialise_openvdb() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+openvdb::Coord voxel_of(const Vec3f& p, double size) {
+  return {static_cast<openvdb::Int32>(std::floor(p.x / size)), static_cast<openvdb::Int32>(std::floor(p.y / size)),
+          static_cast<openvdb::Int32>(std::floor(p.z / size))};
+}
+
+/// Above this many voxels a box query walks the active voxels instead of the box.
+constexpr std::int64_t kDenseQueryLimit = 4096;
+
+}  // namespace
+
+struct OccupancyGrid::Impl {
+  double size = 1.0;
+  openvdb::BoolGrid::Ptr grid;
+};
+
+OccupancyGrid::OccupancyGrid(double voxel_size) : impl_(std::make_unique<Impl>()) {
+  if (!(voxel_size > 0) || !std::isfinite(voxel_size)) {
+    throw ProcessingError(fmt::format("occupancy grid: voxel size {} must be positive", voxel_size));
+  }
+  initialise_openvdb();
+  impl_->size = voxel_size;
+  impl_->grid = openvdb::BoolGrid::create(false);
+}
+
+OccupancyGrid::~OccupancyGrid() = default;
+OccupancyGrid::OccupancyGrid(OccupancyGrid&&) noexcept = default;
+OccupancyGrid& OccupancyGrid::operator=(OccupancyGrid&&) noexcept = default;
+
+double OccupancyGrid::voxel_size() const { return impl_->size; }
+
+void OccupancyGrid::mark_point(const Vec3f& p) { impl_->grid->tree().setValueOn(voxel_of(p, impl_->size), true); }
+
+void OccupancyGrid::mark_box(const Vec3f& lo, const Vec3f& hi) {
+  const openvdb::CoordBBox box(voxel_of(lo, impl_->size), voxel_of(hi, impl_->size));
+  impl_->grid->tree().sparseFill(box, true, true);
+}
+
+bool OccupancyGrid::occupied(const Vec3f& p) const {
+  return impl_->grid->tree().isValueOn(voxel_of(p, impl_->size));
+}
+
+bool OccupancyGrid::any_in_box(const Vec3f& lo, const Vec3f& hi) const {
+  const openvdb::CoordBBox box(voxel_of(lo, impl_->size), voxel_of(hi, impl_->size));
+  const auto& tree = impl_->grid->tree();
+  if (static_cast<std::int64_t>(box.volume()) <= kDenseQueryLimit) {
+    openvdb::BoolGrid::ConstAccessor access = impl_->grid->getConstAccessor();
+    for (auto it = box.begin(); it; ++it) {
+      if (access.isValueOn(*it)) return true;
+    }
+    return false;
+  }
+  for (auto it = tree.cbeginValueOn(); it; ++it) {
+    openvdb::CoordBBox active;
+    it.getBoundingBox(active);  // a voxel or a whole active tile
+    if (box.hasOverlap(active)) return true;
+  }
+  return false;
+}
+
+std::size_t OccupancyGrid::marked_voxels() const {
+  return static_cast<std::size_t>(impl_->grid->tree().activeVoxelCount());
+}
+
+}  // namespace citymesh

@@ -1,0 +1,188 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include "citymesh/core/error.h"
+#include "citymesh/io/mesh_io.h"
+#include "citymesh/io/ply_inspect.h"
+#include "citymesh/io/ply_reader.h"
+#include "ply_builder.h"
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+using test::ElementSpec;
+using test::PropSpec;
+
+constexpr PlyFormat kFormats[] = {PlyFormat::ascii, PlyFormat::binary_little_endian, PlyFormat::binary_big_endian};
+
+/// A strip of `n` quads (2n + 2 vertices) with sensor positions 2 m above, as one element set
+/// using the given coordinate and index types.
+std::vector<ElementSpec> quad_strip(int n, PlyScalar coord, PlyScalar index, PlyScalar count = PlyScalar::uint8) {
+  ElementSpec v{"vertex", {{"x", coord}, {"y", coord}, {"z", coord}, {"x_origin", coord}, {"y_origin", coord},
+                           {"z_origin", coord}, {"gps_time", PlyScalar::float64}}, {}};
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      v.rows.push_back({{double(i)}, {double(j)}, {0.5}, {double(i)}, {0.5}, {2.5}, {1000.0 + i}});
+    }
+  }
+  ElementSpec f{"face", {{"vertex_indices", index, true, count}}, {}};
+  for (int i = 0; i < n; ++i) {
+    f.rows.push_back({{double(2 * i), double(2 * i + 2), double(2 * i + 3), double(2 * i + 1)}});
+  }
+  return {v, f};
+}
+
+MeshReadResult read_text(const std::string& ply, MeshReadParams params = {}) {
+  test::TempDir dir;
+  test::write_text(dir / "m.ply", ply);
+  return read_mesh(dir / "m.ply", params);
+}
+
+TEST(PlyReader, AllFormatsAndTypesGiveTheSameMesh) {
+  const Mesh reference = read_text(test::build_ply(PlyFormat::ascii, quad_strip(5, PlyScalar::float64, PlyScalar::int32))).mesh;
+  ASSERT_EQ(reference.vertex_count(), 12u);
+  ASSERT_EQ(reference.triangle_count(), 10u);
+  for (PlyFormat format : kFormats) {
+    for (PlyScalar coord : {PlyScalar::float32, PlyScalar::float64, PlyScalar::int16, PlyScalar::uint8}) {
+      for (PlyScalar index : {PlyScalar::uint8, PlyScalar::int16, PlyScalar::uint32}) {
+        SCOPED_TRACE(fmt::format("{} {} {}", ply_format_name(format), ply_scalar_name(coord), ply_scalar_name(index)));
+        auto strip = quad_strip(5, coord, index, PlyScalar::uint16);
+        if (coord == PlyScalar::int16 || coord == PlyScalar::uint8) {
+          for (auto& row : strip[0].rows) row[2] = row[5] = {1.0};  // integers only
+        }
+        const Mesh m = read_text(test::build_ply(format, strip)).mesh;
+        EXPECT_EQ(m.triangles, reference.triangles);
+        EXPECT_EQ(m.triangle_ids, reference.triangle_ids);
+        EXPECT_EQ(m.times, reference.times);
+        for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+          EXPECT_EQ(m.world_position(v).x, reference.world_position(v).x);
+          EXPECT_EQ(m.world_position(v).y, reference.world_position(v).y);
+        }
+      }
+    }
+  }
+}
+
+TEST(PlyReader, PolygonsAreFanTriangulatedKeepingTheirFaceIndex) {
+  auto elements = quad_strip(1, PlyScalar::float32, PlyScalar::int32);
+  elements[1].rows.push_back({{0, 1, 3, 2, 0}});  // a pentagon repeating a vertex
+  MeshReadParams params;
+  params.acquisition = 4;
+  const MeshReadResult r = read_text(test::build_ply(PlyFormat::binary_little_endian, elements), params);
+  // quad 0,2,3,1 -> (0,2,3) (0,3,1); pentagon 0,1,3,2,0 -> (0,1,3) (0,3,2) and (0,2,0) dropped
+  const std::vector<Triangle> expected{{0, 2, 3}, {0, 3, 1}, {0, 1, 3}, {0, 3, 2}};
+  EXPECT_EQ(r.mesh.triangles, expected);
+  const std::vector<TriangleId> ids{{4, 0, 0}, {4, 1, 0}, {4, 0, 1}, {4, 1, 1}};
+  EXPECT_EQ(r.mesh.triangle_ids, ids);
+  EXPECT_EQ(r.stats.polygons_split, 2u);
+  EXPECT_EQ(r.stats.degenerate_dropped, 1u);
+}
+
+TEST(PlyReader, DegenerateFacesAreDroppedAndCounted) {
+  auto elements = quad_strip(2, PlyScalar::float32, PlyScalar::int32);
+  elements[1].rows = {{{0, 0, 1}}, {{0, 1}}, {{0, 2, 4}}, {{0, 2, 3}}};  // repeat, 2-gon, collinear, good
+  const MeshReadResult r = read_text(test::build_ply(PlyFormat::ascii, elements));
+  EXPECT_EQ(r.stats.degenerate_dropped, 2u);
+  EXPECT_EQ(r.zero_area_dropped, 1u);
+  ASSERT_EQ(r.mesh.triangle_count(), 1u);
+  EXPECT_EQ(r.mesh.triangle_ids[0].face, 3u);
+}
+
+TEST(PlyReader, ChunkSizeDoesNotChangeTheResult) {
+  const std::string ply = test::build_ply(PlyFormat::binary_big_endian, quad_strip(40, PlyScalar::float32, PlyScalar::int32));
+  const Mesh whole = read_text(ply).mesh;
+  for (std::size_t rows : {1u, 3u, 64u}) {
+    MeshReadParams params;
+    params.ply.chunk_rows = rows;
+    const Mesh chunked = read_text(ply, params).mesh;
+    EXPECT_EQ(chunked.positions, whole.positions);
+    EXPECT_EQ(chunked.triangles, whole.triangles);
+    EXPECT_EQ(chunked.triangle_ids, whole.triangle_ids);
+  }
+}
+
+TEST(PlyReader, ChunksAreBoundedAndInFileOrder) {
+  test::TempDir dir;
+  test::write_text(dir / "m.ply", test::build_ply(PlyFormat::binary_little_endian, quad_strip(50, PlyScalar::float32, PlyScalar::int32)));
+  PlyReadParams params;
+  params.chunk_rows = 16;
+  PlyReader reader(dir / "m.ply", params);
+  PlyVertexChunk v;
+  PlyFaceChunk f;
+  std::uint64_t next_vertex = 0, next_face = 0;
+  bool faces_started = false;
+  for (auto kind = reader.next(v, f); kind != PlyReader::ChunkKind::end; kind = reader.next(v, f)) {
+    if (kind == PlyReader::ChunkKind::vertices) {
+      EXPECT_FALSE(faces_started);
+      EXPECT_EQ(v.first, next_vertex);
+      EXPECT_LE(v.positions.size(), 16u);
+      next_vertex += v.positions.size();
+    } else {
+      faces_started = true;
+      EXPECT_EQ(f.first_face, next_face);
+      EXPECT_LE(f.triangles.size(), 32u);  // 16 quads at most
+      next_face += 16;
+    }
+  }
+  EXPECT_EQ(next_vertex, 102u);
+  EXPECT_EQ(reader.stats().faces, 50u);
+  EXPECT_EQ(reader.stats().triangles, 100u);
+}
+
+TEST(PlyReader, IgnOffsetCommentsMakeCoordinatesAbsolute) {
+  for (const char* comment : {"offset Pos 649000.5 6840000 10", "IGN offset Pos 649000.5 6840000 10"}) {
+    const Mesh m = read_text(test::build_ply(PlyFormat::ascii, quad_strip(1, PlyScalar::float32, PlyScalar::int32), {comment})).mesh;
+    EXPECT_EQ(m.world_position(3), (Vec3d{649001.5, 6840001.0, 10.5}));
+    EXPECT_EQ(m.world_sensor_position(3), (Vec3d{649001.5, 6840000.5, 12.5}));
+  }
+}
+
+TEST(PlyReader, SkipsUnknownElementsAndPropertiesInAnyOrder) {
+  auto elements = quad_strip(2, PlyScalar::float32, PlyScalar::int32);
+  elements[1].props.insert(elements[1].props.begin(), PropSpec{"flags", PlyScalar::uint16});
+  elements[1].props.push_back(PropSpec{"texcoord", PlyScalar::float32, true, PlyScalar::uint8});
+  for (auto& row : elements[1].rows) {
+    row.insert(row.begin(), std::vector<double>{7});
+    row.push_back({0.1, 0.2, 0.3});
+  }
+  elements[0].props.push_back(PropSpec{"normals", PlyScalar::float32, true, PlyScalar::int32});
+  for (auto& row : elements[0].rows) row.push_back({0, 0, 1});
+  ElementSpec camera{"camera", {{"k", PlyScalar::float64}, {"ids", PlyScalar::int32, true, PlyScalar::uint8}}, {{{1.0}, {1, 2}}, {{2.0}, {}}}};
+  const std::vector<ElementSpec> reordered{elements[1], camera, elements[0]};  // faces first
+  const Mesh reference = read_text(test::build_ply(PlyFormat::ascii, quad_strip(2, PlyScalar::float32, PlyScalar::int32))).mesh;
+  for (PlyFormat format : kFormats) {
+    const Mesh m = read_text(test::build_ply(format, reordered)).mesh;
+    EXPECT_EQ(m.triangles, reference.triangles) << ply_format_name(format);
+    EXPECT_EQ(m.positions, reference.positions) << ply_format_name(format);
+  }
+}
+
+TEST(PlyReader, OptionalAttributesAndConfigurableNames) {
+  ElementSpec v{"vertex", {{"x", PlyScalar::float32}, {"y", PlyScalar::float32}, {"z", PlyScalar::float32},
+                           {"sx", PlyScalar::float64}, {"sy", PlyScalar::float64}, {"sz", PlyScalar::float64},
+                           {"GPS_time", PlyScalar::float64}, {"intensity", PlyScalar::uint16},
+                           {"red", PlyScalar::uint8}, {"green", PlyScalar::uint8}, {"blue", PlyScalar::uint8}},
+                {{{1}, {2}, {3}, {4}, {5}, {6}, {7.25}, {300}, {10}, {20}, {30}}}};
+  MeshReadParams params;
+  params.ply.sensor_origin_names = {"sx", "sy", "sz"};
+  const Mesh m = read_text(test::build_ply(PlyFormat::binary_big_endian, {v}), params).mesh;
+  EXPECT_EQ(m.world_sensor_position(0), (Vec3d{4, 5, 6}));
+  EXPECT_EQ(m.times, std::vector<double>{7.25});
+  EXPECT_EQ(m.intensities, std::vector<float>{300});
+  EXPECT_EQ(m.colors, (std::vector<Rgb8>{{10, 20, 30}}));
+  EXPECT_EQ(m.triangle_count(), 0u);
+}
+
+TEST(PlyReader, MissingSensorOriginIsAnErrorOnlyWhenRequired) {
+  ElementSpec v{"vertex", {{"x", PlyScalar::float32}, {"y", PlyScalar::float32}, {"z", PlyScalar::float32}}, {{{1}, {2}, {3}}}};
+  test::TempDir dir;
+  test::write_text(dir / "m.ply", test::build_ply(PlyFormat::ascii, {v}));
+  EXPECT_THROW(read_mesh(dir / "m.ply"), InputError);
+  const PlyInspection info = inspect_ply(dir / "m.ply");
+  EXPECT_FALSE(info.layout.has_sensor_origin);
+  EXPECT_EQ(info.bounds.min, (Vec3d{1, 2, 3}));
+}
+
+}  // namespace
+}  // namespace citymesh

@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <set>
+#include <tuple>
+
+#include "citymesh/spatial/occupancy_grid.h"
+
+namespace citymesh {
+namespace {
+
+using Voxel = std::tuple<int, int, int>;
+
+Voxel voxel(const Vec3f& p, double s) {
+  return {int(std::floor(p.x / s)), int(std::floor(p.y / s)), int(std::floor(p.z / s))};
+}
+
+TEST(OccupancyGrid, MarksAndQueriesLikeAVoxelSet) {
+  const double s = 0.25;
+  OccupancyGrid grid(s);
+  std::set<Voxel> reference;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-20.f, 20.f);
+  for (int i = 0; i < 300; ++i) {
+    const Vec3f p{u(rng), u(rng), u(rng)};
+    grid.mark_point(p);
+    reference.insert(voxel(p, s));
+  }
+  for (int i = 0; i < 20; ++i) {
+    const Vec3f lo{u(rng), u(rng), u(rng)};
+    const Vec3f hi = lo + Vec3f{0.6f, 0.3f, 1.1f};
+    grid.mark_box(lo, hi);
+    const auto [i0, j0, k0] = voxel(lo, s);
+    const auto [i1, j1, k1] = voxel(hi, s);
+    for (int a = i0; a <= i1; ++a)
+      for (int b = j0; b <= j1; ++b)
+        for (int c = k0; c <= k1; ++c) reference.insert({a, b, c});
+  }
+  EXPECT_EQ(grid.marked_voxels(), reference.size());
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3f p{u(rng), u(rng), u(rng)};
+    ASSERT_EQ(grid.occupied(p), reference.count(voxel(p, s)) == 1);
+  }
+  for (int i = 0; i < 500; ++i) {
+    const Vec3f lo{u(rng), u(rng), u(rng)};
+    const float e = i % 10 == 0 ? 8.f : 0.7f;  // some boxes take the sparse query path
+    const Vec3f hi = lo + Vec3f{e, e, e};
+    bool expected = false;
+    for (const auto& [a, b, c] : reference) {
+      const auto [i0, j0, k0] = voxel(lo, s);
+      const auto [i1, j1, k1] = voxel(hi, s);
+      expected |= a >= i0 && a <= i1 && b >= j0 && b <= j1 && c >= k0 && c <= k1;
+    }
+    ASSERT_EQ(grid.any_in_box(lo, hi), expected) << i;
+  }
+}
+
+TEST(OccupancyGrid, RefusesNonPositiveVoxelSize) {
+  EXPECT_ANY_THROW(OccupancyGrid(0.0));
+  EXPECT_ANY_THROW(OccupancyGrid(-1.0));
+}
+
+}  // namespace
+}  // namespace citymesh

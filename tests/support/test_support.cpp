@@ -1,0 +1,66 @@
+// SPDX-License-Identifier: MIT
+#include "test_support.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+
+namespace citymesh::test {
+
+TempDir::TempDir() {
+  std::random_device rd;
+  const auto base = std::filesystem::temp_directory_path();
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    path_ = base / ("citymesh_test_" + std::to_string(::getpid()) + "_" + std::to_string(rd()));
+    if (std::filesystem::create_directory(path_)) return;
+  }
+  throw std::runtime_error("cannot create a temporary folder");
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  std::filesystem::remove_all(path_, ec);
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+CommandResult run_citymesh(const std::string& args) {
+  TempDir dir;
+  const auto err_file = dir / "stderr.txt";
+  const std::string command = std::string(CITYMESH_BINARY) + " " + args + " 2>" + err_file.string();
+  CommandResult result;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) throw std::runtime_error("popen failed");
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.out.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  result.err = read_text(err_file);
+  return result;
+}
+
+std::filesystem::path source_dir() { return CITYMESH_SOURCE_DIR; }
+
+std::filesystem::path real_data_dir() {
+  const auto dir = source_dir().parent_path() / "shared" / "data" / "real";
+  return std::filesystem::is_directory(dir) ? dir : std::filesystem::path();
+}
+
+}  // namespace citymesh::test

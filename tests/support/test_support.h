@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// Helpers shared by the tests: temporary folders, running the citymesh binary, real data.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace citymesh::test {
+
+/// A fresh folder under the system temp dir, removed when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  [[nodiscard]] std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string out;  ///< stdout
+  std::string err;  ///< stderr
+};
+
+/// Runs the built citymesh binary with `args` (shell words, already quoted as needed).
+CommandResult run_citymesh(const std::string& args);
+
+/// The project's source folder (for tests/data, configs, docs).
+std::filesystem::path source_dir();
+/// ../shared/data/real beside the checkout, or "" when it is absent.
+std::filesystem::path real_data_dir();
+
+std::string read_text(const std::filesystem::path& path);
+void write_text(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace citymesh::test
