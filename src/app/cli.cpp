@@ -34,7 +34,8 @@ int run_cli(int argc, char** argv) {
   app.set_version_flag("--version", std::string(CITYMESH_VERSION));
   app.require_subcommand(1);
   app.footer("Exit codes: 0 ok, 1 usage or config, 2 input, 3 processing, 4 output, 75 interrupted.\n"
-             "Run 'citymesh <command> --help' for the options of a command.");
+             "Run 'citymesh <command> --help' for the options of a command.\n"
+             "Example: citymesh info --config configs/demo.toml");
   app.option_defaults()->always_capture_default();
   std::string level = "info";
   bool json = false;
