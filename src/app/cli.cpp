@@ -15,6 +15,8 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   std::vector<std::unique_ptr<Command>> commands;
   commands.push_back(make_info_command());
   commands.push_back(make_config_command());
+  commands.push_back(make_simulate_command());
+  commands.push_back(make_render_command());
   return commands;
 }
 

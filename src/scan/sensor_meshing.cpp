@@ -1,0 +1,148 @@
+// SPDX-License-Identifier: MIT
+// Sensor-topology meshing (as in mobile-LiDAR "sensor meshing": triangles between successive
+// pulses of a line and the same pulse of successive lines).
+#include <fmt/format.h>
+
+#include <cmath>
+
+#include "citymesh/core/error.h"
+#include "citymesh/scan/sensor_grid.h"
+
+namespace citymesh {
+
+void SensorGrid::resize(std::size_t r, std::size_t c, bool with_labels) {
+  rows = r;
+  cols = c;
+  points.assign(r * c, {});
+  sensors.assign(r * c, {});
+  times.assign(r * c, 0.0);
+  valid.assign(r * c, 0);
+  labels.assign(with_labels ? r * c : 0, 0);
+}
+
+namespace {
+
+class Mesher {
+ public:
+  Mesher(const SensorGrid& g, const SensorMeshingParams& p, std::uint32_t acquisition)
+      : g_(g), p_(p), acquisition_(acquisition), cos_limit_(std::cos(p.max_incidence_deg * float(M_PI) / 180.0f)) {}
+
+  SensorMeshResult run() {
+    check();
+    vertex_of_.assign(g_.points.size(), kNone);
+    result_.mesh.origin = g_.origin;
+    const std::size_t col_end = g_.wrap_columns ? g_.cols : g_.cols - 1;
+    for (std::size_t r = 0; r + 1 < g_.rows; ++r) {
+      for (std::size_t c = 0; c < col_end; ++c) quad(r, c, (c + 1) % g_.cols);
+    }
+    return std::move(result_);
+  }
+
+ private:
+  static constexpr std::uint32_t kNone = UINT32_MAX;
+
+  void check() const {
+    const std::size_t n = g_.rows * g_.cols;
+    if (g_.points.size() != n || g_.sensors.size() != n || g_.valid.size() != n || g_.times.size() != n ||
+        (!g_.labels.empty() && g_.labels.size() != n) || g_.cols < 2) {
+      throw ProcessingError(fmt::format("sensor meshing: grid of {} x {} has inconsistent arrays", g_.rows, g_.cols));
+    }
+  }
+
+  [[nodiscard]] float range(std::size_t i) const { return norm(g_.points[i] - g_.sensors[i]); }
+
+  /// The length / depth-jump / grazing tests; counts the reason of a rejection.
+  bool acceptable(std::size_t a, std::size_t b, std::size_t c) {
+    ++result_.stats.candidates;
+    const float ra = range(a), rb = range(b), rc = range(c);
+    const std::size_t v[3] = {a, b, c};
+    const float r[3] = {ra, rb, rc};
+    for (int e = 0; e < 3; ++e) {
+      const std::size_t i = v[e], j = v[(e + 1) % 3];
+      const float limit = p_.max_edge_base + p_.max_edge_per_metre * std::max(r[e], r[(e + 1) % 3]);
+      if (norm(g_.points[i] - g_.points[j]) > limit) return reject(result_.stats.rejected_long_edge);
+    }
+    const float rmin = std::min({ra, rb, rc}), rmax = std::max({ra, rb, rc});
+    if (rmax - rmin > p_.max_depth_jump * rmin) return reject(result_.stats.rejected_depth_jump);
+    const Vec3f n = cross(g_.points[b] - g_.points[a], g_.points[c] - g_.points[a]);
+    const Vec3f view = (g_.sensors[a] + g_.sensors[b] + g_.sensors[c]) / 3.0f -
+                       (g_.points[a] + g_.points[b] + g_.points[c]) / 3.0f;
+    const float nn = norm(n), vn = norm(view);
+    if (nn == 0.0f || vn == 0.0f || std::abs(dot(n, view)) < cos_limit_ * nn * vn) {
+      return reject(result_.stats.rejected_grazing);
+    }
+    return true;
+  }
+  static bool reject(std::uint64_t& counter) {
+    ++counter;
+    return false;
+  }
+
+  std::uint32_t vertex(std::size_t cell) {
+    if (vertex_of_[cell] == kNone) {
+      Mesh& m = result_.mesh;
+      vertex_of_[cell] = static_cast<std::uint32_t>(m.positions.size());
+      m.positions.push_back(g_.points[cell]);
+      m.sensor_positions.push_back(g_.sensors[cell]);
+      m.times.push_back(g_.times[cell]);
+    }
+    return vertex_of_[cell];
+  }
+
+  std::uint32_t face_label(std::size_t a, std::size_t b, std::size_t c) const {
+    const auto& l = g_.labels;
+    if (l[a] == l[b] || l[a] == l[c]) return l[a];
+    if (l[b] == l[c]) return l[b];
+    const float ra = range(a), rb = range(b), rc = range(c);
+    return ra <= rb && ra <= rc ? l[a] : (rb <= rc ? l[b] : l[c]);
+  }
+
+  /// Emits triangle a-b-c oriented to face its sensor.
+  void emit(std::size_t a, std::size_t b, std::size_t c, std::size_t quad_cell, std::uint32_t which) {
+    if (!acceptable(a, b, c)) return;
+    const Vec3f n = cross(g_.points[b] - g_.points[a], g_.points[c] - g_.points[a]);
+    if (dot(n, g_.sensors[a] - g_.points[a]) < 0) std::swap(b, c);
+    Mesh& m = result_.mesh;
+    m.triangles.push_back({vertex(a), vertex(b), vertex(c)});
+    m.triangle_ids.push_back({acquisition_, which, quad_cell});
+    if (!g_.labels.empty()) result_.face_labels.push_back(face_label(a, b, c));
+  }
+
+  void quad(std::size_t r, std::size_t c0, std::size_t c1) {
+    const std::size_t a = g_.index(r, c0), b = g_.index(r, c1), c = g_.index(r + 1, c0), d = g_.index(r + 1, c1);
+    const bool va = g_.valid[a], vb = g_.valid[b], vc = g_.valid[c], vd = g_.valid[d];
+    const int count = va + vb + vc + vd;
+    if (count < 3) return;
+    if (count == 3) {
+      if (!va) emit(b, d, c, a, 0);
+      else if (!vb) emit(a, d, c, a, 0);
+      else if (!vc) emit(a, b, d, a, 0);
+      else emit(a, b, c, a, 0);
+      return;
+    }
+    // Split along the shorter diagonal: it follows the surface better.
+    if (norm(g_.points[a] - g_.points[d]) <= norm(g_.points[b] - g_.points[c])) {
+      emit(a, b, d, a, 0);
+      emit(a, d, c, a, 1);
+    } else {
+      emit(a, b, c, a, 0);
+      emit(b, d, c, a, 1);
+    }
+  }
+
+  const SensorGrid& g_;
+  const SensorMeshingParams& p_;
+  std::uint32_t acquisition_;
+  float cos_limit_;
+  std::vector<std::uint32_t> vertex_of_;
+  SensorMeshResult result_;
+};
+
+}  // namespace
+
+SensorMeshResult mesh_sensor_grid(const SensorGrid& grid, const SensorMeshingParams& params,
+                                  std::uint32_t acquisition) {
+  return Mesher(grid, params, acquisition).run();
+}
+
+}  // namespace citymesh

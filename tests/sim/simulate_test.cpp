@@ -1,0 +1,126 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/io/mesh_io.h"
+#include "citymesh/sim/simulate.h"
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+SimulateParams small_street(const std::filesystem::path& out) {
+  SimulateParams p;
+  p.street.length = 40.0f;
+  p.out = out;
+  return p;
+}
+
+TEST(StreetScene, ScriptedChangesHaveTheExpectedFates) {
+  const Scene scene = make_street_scene({});
+  const Duration ts = std::chrono::days(30);
+  std::map<ObjectClass, std::set<Fate>> fates;
+  for (const SceneObject& o : scene.objects) fates[o.type].insert(fate_of(o, scene.epochs, ts));
+  EXPECT_EQ(fates[ObjectClass::ground], std::set<Fate>{Fate::keep});
+  EXPECT_EQ(fates[ObjectClass::building], std::set<Fate>{Fate::keep});
+  EXPECT_EQ(fates[ObjectClass::kiosk], std::set<Fate>{Fate::keep});
+  EXPECT_EQ(fates[ObjectClass::wall], std::set<Fate>{Fate::remove});
+  EXPECT_EQ(fates[ObjectClass::market_stall], std::set<Fate>{Fate::remove});
+  EXPECT_EQ(fates[ObjectClass::moving_car], std::set<Fate>{Fate::remove});
+  EXPECT_EQ(fates[ObjectClass::planter], std::set<Fate>{Fate::unconfirmed});
+  EXPECT_TRUE(fates[ObjectClass::parked_car].count(Fate::remove));
+  // The car seen twice, four days apart, is not sustainable: every parked car but those of
+  // the last epoch must go.
+  for (const SceneObject& o : scene.objects) {
+    if (o.type != ObjectClass::parked_car) continue;
+    int seen = 0;
+    for (const EpochDrive& e : scene.epochs) seen += o.present_at(e.date);
+    EXPECT_GE(seen, 1);
+    EXPECT_LE(seen, 2);
+  }
+  EXPECT_EQ(scene.epochs.size(), 6u);
+  EXPECT_EQ(scene.epochs[2].date - scene.epochs[1].date, std::chrono::days(4));
+}
+
+TEST(StreetScene, RefusesTooFewEpochs) {
+  StreetParams p;
+  p.epochs = 5;
+  EXPECT_THROW(make_street_scene(p), ConfigError);
+}
+
+TEST(Simulate, GroundTruthIsConsistentWithTheScene) {
+  test::TempDir dir;
+  const SimulateParams p = small_street(dir.path());
+  const SimulationReport report = simulate(p);
+  const Scene scene = make_street_scene(p.street);
+  std::map<std::uint32_t, const SceneObject*> by_id;
+  for (const SceneObject& o : scene.objects) by_id[o.id] = &o;
+  ASSERT_EQ(report.epochs.size(), 6u);
+  std::set<ObjectClass> seen_classes;
+  for (std::size_t k = 0; k < report.epochs.size(); ++k) {
+    const MeshReadResult m = read_mesh(report.epochs[k].ply);
+    const std::vector<std::uint32_t> truth = read_truth(report.epochs[k].truth);
+    ASSERT_EQ(truth.size(), m.mesh.triangle_count()) << "every face has an object";
+    EXPECT_TRUE(m.mesh.has_sensor_positions());
+    for (std::uint32_t id : truth) {
+      ASSERT_TRUE(by_id.count(id)) << id;
+      const SceneObject& o = *by_id[id];
+      ASSERT_TRUE(o.present_at(scene.epochs[k].date)) << "object " << id << " seen in epoch " << k << " outside its lifespan";
+      seen_classes.insert(o.type);
+    }
+  }
+  for (ObjectClass c : {ObjectClass::ground, ObjectClass::building, ObjectClass::parked_car, ObjectClass::pedestrian,
+                        ObjectClass::kiosk, ObjectClass::wall, ObjectClass::planter, ObjectClass::pole}) {
+    EXPECT_TRUE(seen_classes.count(c)) << object_class_name(c) << " never scanned";
+  }
+  const auto objects = nlohmann::json::parse(test::read_text(dir / "objects.json"));
+  EXPECT_EQ(objects["objects"].size(), scene.objects.size());
+}
+
+TEST(Simulate, SameSeedSameBytesWhateverTheThreadCount) {
+  test::TempDir a, b, c;
+  {
+    ThreadLimit one(1);
+    simulate(small_street(a.path()));
+  }
+  {
+    ThreadLimit two(2);
+    simulate(small_street(b.path()));
+  }
+  for (const char* f : {"acq_0.ply", "acq_3.ply", "acq_5.truth", "objects.json", "config.toml"}) {
+    EXPECT_EQ(test::read_text(a / f), test::read_text(b / f)) << f;
+  }
+  SimulateParams other = small_street(c.path());
+  other.street.seed = 2;
+  other.scanner.seed = 2;
+  simulate(other);
+  EXPECT_NE(test::read_text(a / "acq_0.ply"), test::read_text(c / "acq_0.ply"));
+}
+
+TEST(Simulate, WrittenConfigIsValid) {
+  test::TempDir dir;
+  simulate(small_street(dir.path()));
+  const auto r = test::run_citymesh("config --check " + (dir / "config.toml").string());
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+}
+
+TEST(Truth, RoundTripsAndDetectsCorruption) {
+  test::TempDir dir;
+  const std::vector<std::uint32_t> ids{5, 1, 9, 9, 2};
+  write_truth(dir / "t.truth", ids);
+  EXPECT_EQ(read_truth(dir / "t.truth"), ids);
+  std::string bytes = test::read_text(dir / "t.truth");
+  bytes[20] ^= 1;
+  test::write_text(dir / "bad.truth", bytes);
+  EXPECT_THROW(read_truth(dir / "bad.truth"), InputError);
+  test::write_text(dir / "short.truth", bytes.substr(0, 20));
+  EXPECT_THROW(read_truth(dir / "short.truth"), InputError);
+}
+
+}  // namespace
+}  // namespace citymesh
