@@ -17,6 +17,7 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   commands.push_back(make_config_command());
   commands.push_back(make_simulate_command());
   commands.push_back(make_render_command());
+  commands.push_back(make_mesh_command());
   return commands;
 }
 

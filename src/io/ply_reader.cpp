@@ -19,7 +19,9 @@ using namespace ply_detail;
 
 namespace {
 
-enum Slot : std::uint8_t { kSkip, kX, kY, kZ, kSX, kSY, kSZ, kTime, kIntensity, kRed, kGreen, kBlue, kSlots };
+// Where a vertex property's value goes: a fixed attribute, or kSlots + e for extra property e.
+using Slot = std::uint16_t;
+enum : Slot { kSkip, kX, kY, kZ, kSX, kSY, kSZ, kTime, kIntensity, kRed, kGreen, kBlue, kSlots };
 
 /// Longest polygon accepted; a longer list is malformed input, not a face.
 constexpr std::int64_t kMaxPolygon = 65535;
@@ -54,6 +56,7 @@ void PlyVertexChunk::clear() {
   times.clear();
   intensities.clear();
   colors.clear();
+  for (auto& column : extras) column.clear();
 }
 
 void PlyFaceChunk::clear() {
@@ -136,6 +139,10 @@ struct PlyReader::Impl {
       }
     }
     layout.has_intensity = assign(params.intensity_name, kIntensity);
+    for (std::size_t e = 0; e < params.extra_vertex_properties.size(); ++e) {
+      const std::string& name = params.extra_vertex_properties[e];
+      if (!assign(name, static_cast<Slot>(kSlots + e))) fail(fmt::format("vertex property '{}' not found", name));
+    }
     layout.has_color = assign("red", kRed) & assign("green", kGreen) & assign("blue", kBlue);
     if (!layout.has_color) {
       std::replace_if(vertex_slots.begin(), vertex_slots.end(),
@@ -168,7 +175,8 @@ struct PlyReader::Impl {
 
   // ---- vertices -------------------------------------------------------------------------
 
-  void emit_vertex(PlyVertexChunk& out, const std::array<double, kSlots>& v, std::uint64_t index) const {
+  void emit_vertex(PlyVertexChunk& out, const std::vector<double>& v, std::uint64_t index) const {
+    for (std::size_t e = 0; e < params.extra_vertex_properties.size(); ++e) out.extras[e].push_back(v[kSlots + e]);
     const Vec3d p{v[kX], v[kY], v[kZ]};
     if (!is_finite(p)) {
       fail_row("vertex", index, fmt::format("position is not finite ({}, {}, {})", p.x, p.y, p.z));
@@ -192,7 +200,7 @@ struct PlyReader::Impl {
     }
   }
 
-  void read_vertex_binary_fixed(std::array<double, kSlots>& v, std::uint64_t index) {
+  void read_vertex_binary_fixed(std::vector<double>& v, std::uint64_t index) {
     const std::size_t size = *vertex_row_size;
     const char* p = src->peek(size);
     if (p == nullptr) fail_row("vertex", index, "unexpected end of file");
@@ -200,7 +208,7 @@ struct PlyReader::Impl {
     src->skip(size);
   }
 
-  void read_vertex_binary_walk(const PlyElement& e, std::array<double, kSlots>& v, std::uint64_t index) {
+  void read_vertex_binary_walk(const PlyElement& e, std::vector<double>& v, std::uint64_t index) {
     for (std::size_t i = 0; i < e.properties.size(); ++i) {
       const PlyProperty& p = e.properties[i];
       if (p.is_list) {
@@ -214,7 +222,7 @@ struct PlyReader::Impl {
     }
   }
 
-  void read_vertex_ascii(const PlyElement& e, std::array<double, kSlots>& v, std::uint64_t index) {
+  void read_vertex_ascii(const PlyElement& e, std::vector<double>& v, std::uint64_t index) {
     std::string_view line;
     if (!src->next_line(line)) fail_row("vertex", index, "unexpected end of file");
     AsciiTokens tokens(line);
@@ -234,8 +242,9 @@ struct PlyReader::Impl {
   }
 
   void read_vertices(PlyVertexChunk& out, const PlyElement& e, std::uint64_t n) {
-    std::array<double, kSlots> v{};
+    std::vector<double> v(kSlots + params.extra_vertex_properties.size(), 0.0);
     out.positions.reserve(n);
+    out.extras.resize(params.extra_vertex_properties.size());
     for (std::uint64_t i = 0; i < n; ++i) {
       const std::uint64_t index = row + i;
       if (ascii) {

@@ -21,6 +21,9 @@ struct PlyReadParams {
   /// Names tried in order for the per-vertex time.
   std::vector<std::string> time_names{"gps_time", "GPS_time", "time"};
   std::string intensity_name = "intensity";
+  /// Further vertex properties to return, as doubles, in PlyVertexChunk::extras (in this
+  /// order); a missing one is an input error.
+  std::vector<std::string> extra_vertex_properties;
   /// When true, a file without the sensor-origin properties is an input error.
   bool require_sensor_origin = true;
   /// Rows per chunk; bounds the reader's memory whatever the file size.
@@ -45,6 +48,7 @@ struct PlyVertexChunk {
   std::vector<double> times;
   std::vector<float> intensities;
   std::vector<Rgb8> colors;
+  std::vector<std::vector<double>> extras;  ///< one column per PlyReadParams::extra_vertex_properties
   void clear();
 };
 

@@ -1,0 +1,85 @@
+// SPDX-License-Identifier: MIT
+// `citymesh mesh`: real scan-ordered points -> a mesh by sensor topology.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "citymesh/core/error.h"
+#include "citymesh/io/ply_reader.h"
+#include "citymesh/io/ply_writer.h"
+#include "citymesh/scan/real_scans.h"
+#include "command.h"
+
+namespace citymesh::app {
+
+namespace {
+
+class MeshCommand final : public Command {
+ public:
+  std::string_view name() const override { return "mesh"; }
+  std::string_view summary() const override { return "mesh real scan-ordered points (profiler lines or spinning frames)"; }
+
+  void declare(CLI::App& app) override {
+    app.add_option("files", files_, "PLY point files in acquisition order (profiler: consecutive chunks of one drive)")
+        ->required()->check(CLI::ExistingFile);
+    app.add_option("--out", out_, "mesh PLY to write")->required();
+    app.add_option("--layout", layout_, "auto (from the properties), profiler (angle wraps per line), spinning (ring x column)")
+        ->check(CLI::IsMember({"auto", "profiler", "spinning"}));
+    app.add_option("--echo", echo_, "profiler: which echo of a multi-echo pulse to mesh")->check(CLI::IsMember({"first", "last"}));
+    app.add_option("--max-edge-base", meshing_.max_edge_base, "metres")->check(CLI::Range(0.0, 100.0));
+    app.add_option("--max-edge-per-metre", meshing_.max_edge_per_metre, "extra edge length per metre of range")
+        ->check(CLI::Range(0.0, 10.0));
+    app.add_option("--max-depth-jump", meshing_.max_depth_jump, "largest relative range difference in a triangle")
+        ->check(CLI::Range(0.0, 10.0));
+    app.add_option("--max-incidence", meshing_.max_incidence_deg, "degrees between normal and line of sight")
+        ->check(CLI::Range(1.0, 90.0));
+    app.footer("Examples:\n  citymesh mesh sample_riegl_18_0{1,2,3,4,5}.ply --out riegl_mesh.ply\n"
+               "  citymesh mesh ouster_os1_128_frame1795.ply --out frame1795_mesh.ply");
+  }
+
+  void run() override {
+    std::vector<std::filesystem::path> paths(files_.begin(), files_.end());
+    const std::string layout = layout_ == "auto" ? detect(paths.front()) : layout_;
+    SensorGrid grid;
+    if (layout == "profiler") {
+      ProfilerGridParams p;
+      p.echo = echo_ == "last" ? ProfilerGridParams::Echo::last : ProfilerGridParams::Echo::first;
+      grid = profiler_grid(paths, p);
+    } else {
+      if (paths.size() != 1) throw UsageError("spinning layout: mesh one frame at a time");
+      grid = spinning_grid(paths.front());
+    }
+    const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
+    write_mesh_ply(out_, r.mesh);
+    const auto cells = std::count(grid.valid.begin(), grid.valid.end(), 1);
+    std::cout << fmt::format("{}: {} layout, grid {} x {}, {} points, {} triangles\n", out_, layout, grid.rows, grid.cols,
+                             cells, r.mesh.triangle_count());
+    std::cout << fmt::format("  rejected: {} long edges, {} depth jumps, {} grazing (of {} candidates)\n",
+                             r.stats.rejected_long_edge, r.stats.rejected_depth_jump, r.stats.rejected_grazing,
+                             r.stats.candidates);
+  }
+
+ private:
+  static std::string detect(const std::filesystem::path& file) {
+    PlyReadParams read;
+    read.require_sensor_origin = false;
+    const PlyElement* v = PlyReader(file, read).header().find("vertex");
+    if (v->find("ring") != nullptr && v->find("column") != nullptr) return "spinning";
+    if (v->find("theta") != nullptr) return "profiler";
+    throw InputError(fmt::format("{}: cannot tell the scan layout (no theta, nor ring and column); use --layout",
+                                 file.string()));
+  }
+
+  std::vector<std::string> files_;
+  std::string out_;
+  std::string layout_ = "auto";
+  std::string echo_ = "first";
+  SensorMeshingParams meshing_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> make_mesh_command() { return std::make_unique<MeshCommand>(); }
+
+}  // namespace citymesh::app
