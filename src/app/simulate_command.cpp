@@ -33,8 +33,12 @@ class SimulateCommand final : public Command {
     app.add_option("--noise", p_.scanner.range_noise, "range noise, metres (1 sigma)")->check(CLI::Range(0.0, 0.5));
     app.add_option("--tilt", p_.scanner.tilt_deg, "scan plane tilt about the vertical, degrees")
         ->check(CLI::Range(-45.0, 45.0));
+    app.add_option("--streets", p_.streets, "city mode: number of parallel streets")->check(CLI::Range(1, 1000));
+    app.add_option("--street-spacing", p_.street_spacing, "city mode: metres between street centre lines")
+        ->check(CLI::Range(24.0, 1000.0));
     app.add_option("--threads", threads_, "worker threads (0: all cores)");
-    app.footer("Example:\n  citymesh simulate --out sim --seed 7 --epochs 7\n"
+    app.footer("Examples:\n  citymesh simulate --out sim --seed 7 --epochs 7\n"
+               "  citymesh simulate --out city --streets 8 --length 500   # ~30 M triangles over 6 epochs\n"
                "Writes acq_<k>.ply, acq_<k>.truth, objects.json and config.toml under --out.");
   }
 

@@ -21,28 +21,55 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-std::string objects_json(const Scene& scene, const SimulateParams& p) {
+/// Object ids of street s are offset by s * kIdsPerStreet, so they stay unique in a city.
+constexpr std::uint32_t kIdsPerStreet = 1'000'000;
+
+/// One street, or `streets` parallel streets street_spacing metres apart (city mode), each
+/// with its own seed and its own van (lane, speed) but the same epoch dates.
+std::vector<Scene> make_scenes(const SimulateParams& p) {
+  if (p.streets < 1 || p.streets > 1000) throw ConfigError(fmt::format("simulate: {} streets (1..1000)", p.streets));
+  if (p.streets > 1 && !(p.street_spacing >= p.street.width + 10)) {
+    throw ConfigError(fmt::format("simulate: street spacing {} m must exceed the street width + 10 m", p.street_spacing));
+  }
+  std::vector<Scene> scenes;
+  for (int s = 0; s < p.streets; ++s) {
+    StreetParams street = p.street;
+    street.seed = p.street.seed + 7919ull * static_cast<std::uint64_t>(s);
+    street.origin.y += static_cast<double>(p.street_spacing) * s;
+    scenes.push_back(make_street_scene(street));
+    if (s > 0) {
+      for (SceneObject& o : scenes.back().objects) o.id += kIdsPerStreet * static_cast<std::uint32_t>(s);
+    }
+  }
+  return scenes;
+}
+
+std::string objects_json(const std::vector<Scene>& scenes, const SimulateParams& p) {
   nlohmann::json j;
   j["seed"] = p.street.seed;
-  j["origin"] = {scene.origin.x, scene.origin.y, scene.origin.z};
   j["crs"] = "EPSG:2154";
   j["sustainability"] = format_duration(p.sustainability);
-  for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
-    const EpochDrive& e = scene.epochs[k];
-    j["epochs"].push_back({{"index", k}, {"date", format_iso8601(e.date)}, {"lane_offset", e.lane_offset},
-                           {"speed", e.speed}});
+  for (std::size_t k = 0; k < scenes.front().epochs.size(); ++k) {
+    j["epochs"].push_back({{"index", k}, {"date", format_iso8601(scenes.front().epochs[k].date)}});
   }
-  for (const SceneObject& o : scene.objects) {
-    nlohmann::json seen = nlohmann::json::array();
-    for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
-      if (o.present_at(scene.epochs[k].date)) seen.push_back(k);
+  for (std::size_t s = 0; s < scenes.size(); ++s) {
+    const Scene& scene = scenes[s];
+    nlohmann::json drives = nlohmann::json::array();
+    for (const EpochDrive& e : scene.epochs) drives.push_back({{"lane_offset", e.lane_offset}, {"speed", e.speed}});
+    j["streets"].push_back({{"index", s}, {"origin", {scene.origin.x, scene.origin.y, scene.origin.z}},
+                            {"length", scene.length}, {"width", scene.width}, {"drives", drives}});
+    for (const SceneObject& o : scene.objects) {
+      nlohmann::json seen = nlohmann::json::array();
+      for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
+        if (o.present_at(scene.epochs[k].date)) seen.push_back(k);
+      }
+      nlohmann::json entry{{"id", o.id}, {"street", s}, {"class", object_class_name(o.type)}, {"epochs", seen},
+                           {"fate", fate_name(fate_of(o, scene.epochs, p.sustainability))}};
+      entry["appear"] = o.appear == TimePoint::min() ? nlohmann::json() : nlohmann::json(format_iso8601(o.appear));
+      entry["disappear"] =
+          o.disappear == TimePoint::max() ? nlohmann::json() : nlohmann::json(format_iso8601(o.disappear));
+      j["objects"].push_back(entry);
     }
-    nlohmann::json entry{{"id", o.id}, {"class", object_class_name(o.type)}, {"epochs", seen},
-                         {"fate", fate_name(fate_of(o, scene.epochs, p.sustainability))}};
-    entry["appear"] = o.appear == TimePoint::min() ? nlohmann::json() : nlohmann::json(format_iso8601(o.appear));
-    entry["disappear"] =
-        o.disappear == TimePoint::max() ? nlohmann::json() : nlohmann::json(format_iso8601(o.disappear));
-    j["objects"].push_back(entry);
   }
   return j.dump(1) + "\n";
 }
@@ -69,6 +96,23 @@ SensorMeshingParams meshing_for(const SimulateParams& p) {
   return m;
 }
 
+/// Appends one street's meshed scan to the epoch's mesh (whose origin may differ).
+void append_street(Mesh& epoch, std::vector<std::uint32_t>& truth, const SensorMeshResult& street) {
+  const Vec3f shift(street.mesh.origin - epoch.origin);
+  const auto base = static_cast<std::uint32_t>(epoch.positions.size());
+  for (std::size_t v = 0; v < street.mesh.vertex_count(); ++v) {
+    epoch.positions.push_back(street.mesh.positions[v] + shift);
+    epoch.sensor_positions.push_back(street.mesh.sensor_positions[v] + shift);
+    epoch.times.push_back(street.mesh.times[v]);
+  }
+  for (std::size_t t = 0; t < street.mesh.triangle_count(); ++t) {
+    const Triangle& tri = street.mesh.triangles[t];
+    epoch.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+    epoch.triangle_ids.push_back({street.mesh.triangle_ids[t].acquisition, 0, epoch.triangle_ids.size()});
+  }
+  truth.insert(truth.end(), street.face_labels.begin(), street.face_labels.end());
+}
+
 }  // namespace
 
 std::uint64_t SimulationReport::triangles() const {
@@ -85,33 +129,39 @@ std::uint64_t SimulationReport::rays() const {
 
 SimulationReport simulate(const SimulateParams& p) {
   if (p.out.empty()) throw UsageError("simulate: no output folder given (--out DIR)");
-  const Scene scene = make_street_scene(p.street);
+  const std::vector<Scene> scenes = make_scenes(p);
   SimulationReport report;
-  report.objects = scene.objects.size();
-  for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
-    throw_if_interrupted("simulate");
-    auto t = std::chrono::steady_clock::now();
-    const SensorGrid grid = scan_epoch(scene, k, p.scanner);
-    report.scan_seconds += seconds_since(t);
-    t = std::chrono::steady_clock::now();
-    const SensorMeshResult meshed = mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k));
-    report.mesh_seconds += seconds_since(t);
-    t = std::chrono::steady_clock::now();
+  for (const Scene& scene : scenes) report.objects += scene.objects.size();
+  const std::size_t epochs = scenes.front().epochs.size();
+  for (std::size_t k = 0; k < epochs; ++k) {
+    Mesh epoch;
+    epoch.origin = scenes.front().origin;
+    std::vector<std::uint32_t> truth;
     SimulatedEpoch e;
+    for (const Scene& scene : scenes) {
+      throw_if_interrupted("simulate");
+      auto t = std::chrono::steady_clock::now();
+      const SensorGrid grid = scan_epoch(scene, k, p.scanner);
+      report.scan_seconds += seconds_since(t);
+      t = std::chrono::steady_clock::now();
+      append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
+      report.mesh_seconds += seconds_since(t);
+      e.rays += rays_per_epoch(scene, k, p.scanner);
+      e.hits += static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
+    }
+    const auto t = std::chrono::steady_clock::now();
     e.ply = p.out / fmt::format("acq_{}.ply", k);
     e.truth = p.out / fmt::format("acq_{}.truth", k);
-    e.rays = rays_per_epoch(scene, k, p.scanner);
-    e.hits = static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
-    e.triangles = meshed.mesh.triangle_count();
-    write_mesh_ply(e.ply, meshed.mesh);
-    write_truth(e.truth, meshed.face_labels);
+    e.triangles = epoch.triangle_count();
+    write_mesh_ply(e.ply, epoch);
+    write_truth(e.truth, truth);
     report.write_seconds += seconds_since(t);
-    log::info("simulate: epoch {} ({}): {} rays, {} triangles", k, format_iso8601(scene.epochs[k].date), e.rays,
-              e.triangles);
+    log::info("simulate: epoch {} ({}): {} rays, {} triangles", k, format_iso8601(scenes.front().epochs[k].date),
+              e.rays, e.triangles);
     report.epochs.push_back(e);
   }
-  write_file_atomically(p.out / "objects.json", objects_json(scene, p));
-  write_file_atomically(p.out / "config.toml", config_toml(scene, p));
+  write_file_atomically(p.out / "objects.json", objects_json(scenes, p));
+  write_file_atomically(p.out / "config.toml", config_toml(scenes.front(), p));
   return report;
 }
 

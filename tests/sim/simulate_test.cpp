@@ -109,6 +109,31 @@ TEST(Simulate, WrittenConfigIsValid) {
   EXPECT_EQ(r.exit_code, 0) << r.err;
 }
 
+TEST(Simulate, CityModeKeepsObjectIdsUniqueAndStreetsApart) {
+  test::TempDir dir;
+  SimulateParams p = small_street(dir.path());
+  p.streets = 3;
+  p.street.length = 30.0f;
+  const SimulationReport r = simulate(p);
+  const auto objects = nlohmann::json::parse(test::read_text(dir / "objects.json"));
+  std::set<std::uint32_t> ids;
+  for (const auto& o : objects["objects"]) EXPECT_TRUE(ids.insert(o["id"].get<std::uint32_t>()).second);
+  EXPECT_EQ(objects["streets"].size(), 3u);
+  const std::vector<std::uint32_t> truth = read_truth(r.epochs[0].truth);
+  std::set<std::uint32_t> streets_seen;
+  for (std::uint32_t id : truth) {
+    ASSERT_TRUE(ids.count(id)) << id;
+    streets_seen.insert(id / 1'000'000);
+  }
+  EXPECT_EQ(streets_seen, (std::set<std::uint32_t>{0, 1, 2}));
+  // The third street lies two spacings north of the first.
+  const MeshReadResult m = read_mesh(r.epochs[0].ply);
+  Box3d box;
+  for (std::size_t v = 0; v < m.mesh.vertex_count(); ++v) box.extend(m.mesh.world_position(v));
+  EXPECT_GT(box.max.y - box.min.y, 2 * p.street_spacing);
+  EXPECT_LT(box.max.y - box.min.y, 2 * p.street_spacing + 2 * p.street.width + 10);
+}
+
 TEST(Truth, RoundTripsAndDetectsCorruption) {
   test::TempDir dir;
   const std::vector<std::uint32_t> ids{5, 1, 9, 9, 2};

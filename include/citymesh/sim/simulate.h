@@ -28,6 +28,10 @@ struct SimulateParams {
   ScannerParams scanner;
   SensorMeshingParams meshing;
   Duration sustainability = std::chrono::days(30);
+  /// City mode: this many parallel streets, street_spacing metres apart (north of the first),
+  /// all scanned at every epoch into the same acquisition files.
+  int streets = 1;
+  float street_spacing = 80.0f;
   std::filesystem::path out;  ///< created if missing
 };
 
