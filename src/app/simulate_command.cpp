@@ -33,6 +33,11 @@ class SimulateCommand final : public Command {
     app.add_option("--noise", p_.scanner.range_noise, "range noise, metres (1 sigma)")->check(CLI::Range(0.0, 0.5));
     app.add_option("--tilt", p_.scanner.tilt_deg, "scan plane tilt about the vertical, degrees")
         ->check(CLI::Range(-45.0, 45.0));
+    app.add_option("--scanner", scanner_, "profiler (2D scan plane) or spinning (multi-beam, one grid per turn)")
+        ->check(CLI::IsMember({"profiler", "spinning"}));
+    app.add_option("--rings", p_.scanner.rings, "spinning: beams")->check(CLI::Range(2, 256));
+    app.add_option("--columns", p_.scanner.columns, "spinning: azimuth steps per turn")->check(CLI::Range(16, 8192));
+    app.add_option("--rotation-rate", p_.scanner.rotation_rate, "spinning: turns per second")->check(CLI::Range(0.02, 50.0));
     app.add_option("--streets", p_.streets, "city mode: number of parallel streets")->check(CLI::Range(1, 1000));
     app.add_option("--street-spacing", p_.street_spacing, "city mode: metres between street centre lines")
         ->check(CLI::Range(24.0, 1000.0));
@@ -45,6 +50,7 @@ class SimulateCommand final : public Command {
   void run() override {
     const ThreadLimit limit(threads_);
     p_.scanner.seed = p_.street.seed;
+    p_.scanner.mode = scanner_ == "spinning" ? ScannerParams::Mode::spinning : ScannerParams::Mode::profiler;
     const auto start = std::chrono::steady_clock::now();
     const SimulationReport r = simulate(p_);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -60,6 +66,7 @@ class SimulateCommand final : public Command {
  private:
   SimulateParams p_;
   unsigned threads_ = 0;
+  std::string scanner_ = "profiler";
 };
 
 }  // namespace

@@ -91,7 +91,10 @@ std::string config_toml(const Scene& scene, const SimulateParams& p) {
 /// pulses land about 6 x (angular step in radians) x range apart.
 SensorMeshingParams meshing_for(const SimulateParams& p) {
   SensorMeshingParams m = p.meshing;
-  const float step = p.scanner.angular_step_deg * float(M_PI) / 180.0f;
+  const bool spinning = p.scanner.mode == ScannerParams::Mode::spinning;
+  const float step = spinning ? std::max(2.0f * float(M_PI) / static_cast<float>(p.scanner.columns),
+                                         p.scanner.vertical_fov_deg * float(M_PI) / 180.0f / static_cast<float>(std::max(1, p.scanner.rings - 1)))
+                              : p.scanner.angular_step_deg * float(M_PI) / 180.0f;
   m.max_edge_per_metre = std::max(m.max_edge_per_metre, 6.0f * step);
   return m;
 }
@@ -141,13 +144,15 @@ SimulationReport simulate(const SimulateParams& p) {
     for (const Scene& scene : scenes) {
       throw_if_interrupted("simulate");
       auto t = std::chrono::steady_clock::now();
-      const SensorGrid grid = scan_epoch(scene, k, p.scanner);
+      const std::vector<SensorGrid> grids = scan_epoch(scene, k, p.scanner);
       report.scan_seconds += seconds_since(t);
       t = std::chrono::steady_clock::now();
-      append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
+      for (const SensorGrid& grid : grids) {
+        append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
+        e.hits += static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
+      }
       report.mesh_seconds += seconds_since(t);
       e.rays += rays_per_epoch(scene, k, p.scanner);
-      e.hits += static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
     }
     const auto t = std::chrono::steady_clock::now();
     e.ply = p.out / fmt::format("acq_{}.ply", k);

@@ -134,6 +134,30 @@ TEST(Simulate, CityModeKeepsObjectIdsUniqueAndStreetsApart) {
   EXPECT_LT(box.max.y - box.min.y, 2 * p.street_spacing + 2 * p.street.width + 10);
 }
 
+TEST(Simulate, SpinningScannerMeshesEachTurnConsistently) {
+  test::TempDir a, b;
+  SimulateParams p = small_street(a.path());
+  p.scanner.mode = ScannerParams::Mode::spinning;
+  p.scanner.rings = 16;
+  p.scanner.columns = 256;
+  p.scanner.rotation_rate = 1.0f;
+  const SimulationReport r = simulate(p);
+  const Scene scene = make_street_scene(p.street);
+  for (std::size_t k = 0; k < r.epochs.size(); ++k) {
+    EXPECT_EQ(r.epochs[k].rays % (16u * 256u), 0u);  // whole turns
+    const MeshReadResult m = read_mesh(r.epochs[k].ply);
+    const std::vector<std::uint32_t> truth = read_truth(r.epochs[k].truth);
+    ASSERT_EQ(truth.size(), m.mesh.triangle_count());
+    EXPECT_GT(m.mesh.triangle_count(), 1000u);
+  }
+  {
+    ThreadLimit one(1);
+    p.out = b.path();
+    simulate(p);
+  }
+  EXPECT_EQ(test::read_text(a / "acq_2.ply"), test::read_text(b / "acq_2.ply"));
+}
+
 TEST(Truth, RoundTripsAndDetectsCorruption) {
   test::TempDir dir;
   const std::vector<std::uint32_t> ids{5, 1, 9, 9, 2};

@@ -11,6 +11,10 @@
 namespace citymesh {
 
 struct ScannerParams {
+  /// profiler: a 2D scan plane swept along the track (Riegl-like); spinning: a multi-beam
+  /// sensor turning about the vertical (Ouster/Velodyne-like), one grid per turn.
+  enum class Mode { profiler, spinning };
+  Mode mode = Mode::profiler;
   float line_rate = 25.0f;        ///< scan lines per second
   float angular_step_deg = 1.5f;  ///< between successive pulses of a line
   float max_range = 60.0f;        ///< metres
@@ -18,14 +22,21 @@ struct ScannerParams {
   float sensor_height = 2.5f;     ///< metres above the road
   float tilt_deg = 0.0f;          ///< rotation of the scan plane about the vertical
   std::uint64_t seed = 1;         ///< noise seed (combined with the epoch and line)
+  // spinning mode
+  int rings = 32;                   ///< beams, spread evenly over the vertical field of view
+  float vertical_fov_deg = 40.0f;   ///< from -fov/2 to +fov/2 around the horizontal
+  int columns = 1024;               ///< azimuth steps per turn
+  float rotation_rate = 2.0f;       ///< turns per second
 };
 
 /// Scans epoch `epoch` of `scene`: the objects present at its date, driven as its EpochDrive
-/// says, from x = 0 to x = scene.length. Rows are scan lines, columns pulses (a full turn
-/// starting straight down). Labels are object ids; times are seconds since the epoch's start.
+/// says, from x = 0 to x = scene.length. Profiler rows are scan lines, columns pulses (a full
+/// turn starting straight down). Labels are object ids; times are seconds since the epoch's start.
 /// The epoch's registration error is applied to points and sensor positions. Deterministic
 /// whatever the thread count. Throws ConfigError on out-of-range parameters.
-SensorGrid scan_epoch(const Scene& scene, std::size_t epoch, const ScannerParams& params);
+/// Profiler mode gives one grid (lines x pulses); spinning mode one grid per turn (rings x
+/// columns, columns wrapping), the sensor moving during the turn.
+std::vector<SensorGrid> scan_epoch(const Scene& scene, std::size_t epoch, const ScannerParams& params);
 
 /// Rays cast by scan_epoch for these parameters (for throughput figures).
 std::uint64_t rays_per_epoch(const Scene& scene, std::size_t epoch, const ScannerParams& params);
