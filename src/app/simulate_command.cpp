@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/stopwatch.h"
 #include "citymesh/sim/simulate.h"
 #include "command.h"
 
@@ -51,9 +52,9 @@ class SimulateCommand final : public Command {
     const ThreadLimit limit(threads_);
     p_.scanner.seed = p_.street.seed;
     p_.scanner.mode = scanner_ == "spinning" ? ScannerParams::Mode::spinning : ScannerParams::Mode::profiler;
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch clock;
     const SimulationReport r = simulate(p_);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds = clock.seconds();
     std::cout << fmt::format("simulated {} epochs, {} objects, {} triangles in {:.2f} s ({:.2f} M rays/s)\n",
                              r.epochs.size(), r.objects, r.triangles(), seconds,
                              static_cast<double>(r.rays()) / r.scan_seconds / 1e6);

@@ -9,10 +9,6 @@ namespace citymesh {
 
 namespace {
 
-Vec3d default_origin(const Vec3d& first) {
-  return {std::floor(first.x), std::floor(first.y), std::floor(first.z)};
-}
-
 void append_vertices(Mesh& mesh, const PlyVertexChunk& chunk) {
   for (const Vec3d& p : chunk.positions) mesh.positions.push_back(to_local(p, mesh.origin));
   for (const Vec3d& s : chunk.sensor_positions) mesh.sensor_positions.push_back(to_local(s, mesh.origin));
@@ -61,7 +57,7 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
        kind = reader.next(vertices, faces)) {
     if (kind == PlyReader::ChunkKind::vertices) {
       if (!origin_set && !vertices.positions.empty()) {
-        mesh.origin = default_origin(vertices.positions.front());
+        mesh.origin = whole_metre_origin(vertices.positions.front());
         origin_set = true;
       }
       append_vertices(mesh, vertices);

@@ -58,8 +58,6 @@ double median_step(const std::vector<Pulse>& pulses) {
   return steps[steps.size() / 2];
 }
 
-Vec3d floor_origin(const Vec3d& p) { return {std::floor(p.x), std::floor(p.y), std::floor(p.z)}; }
-
 }  // namespace
 
 SensorGrid profiler_grid(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& params,
@@ -71,7 +69,7 @@ SensorGrid profiler_grid(const std::vector<std::filesystem::path>& files, const 
   SensorGrid g;
   g.resize(pulses.back().line + 1, cols, false);
   g.wrap_columns = true;
-  g.origin = floor_origin(pulses.front().point);
+  g.origin = whole_metre_origin(pulses.front().point);
   for (const Pulse& p : pulses) {
     const double turn = std::fmod(p.angle + 4 * M_PI, 2 * M_PI);
     const std::size_t cell = g.index(p.line, static_cast<std::size_t>(turn / step) % cols);
@@ -115,7 +113,7 @@ SensorGrid spinning_grid(const std::filesystem::path& file, PlyReadParams read) 
   SensorGrid g;
   g.resize(rings, columns, false);
   g.wrap_columns = true;
-  g.origin = floor_origin(returns.front().point);
+  g.origin = whole_metre_origin(returns.front().point);
   for (const Return& r : returns) {
     const std::size_t cell = g.index(r.ring, r.column);
     g.points[cell] = to_local(r.point, g.origin);

@@ -11,15 +11,12 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
 
 namespace citymesh {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 /// Object ids of street s are offset by s * kIdsPerStreet, so they stay unique in a city.
 constexpr std::uint32_t kIdsPerStreet = 1'000'000;
@@ -143,24 +140,23 @@ SimulationReport simulate(const SimulateParams& p) {
     SimulatedEpoch e;
     for (const Scene& scene : scenes) {
       throw_if_interrupted("simulate");
-      auto t = std::chrono::steady_clock::now();
+      Stopwatch stage;
       const std::vector<SensorGrid> grids = scan_epoch(scene, k, p.scanner);
-      report.scan_seconds += seconds_since(t);
-      t = std::chrono::steady_clock::now();
+      report.scan_seconds += stage.restart();
       for (const SensorGrid& grid : grids) {
         append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
         e.hits += static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
       }
-      report.mesh_seconds += seconds_since(t);
+      report.mesh_seconds += stage.seconds();
       e.rays += rays_per_epoch(scene, k, p.scanner);
     }
-    const auto t = std::chrono::steady_clock::now();
+    const Stopwatch writing;
     e.ply = p.out / fmt::format("acq_{}.ply", k);
     e.truth = p.out / fmt::format("acq_{}.truth", k);
     e.triangles = epoch.triangle_count();
     write_mesh_ply(e.ply, epoch);
     write_truth(e.truth, truth);
-    report.write_seconds += seconds_since(t);
+    report.write_seconds += writing.seconds();
     log::info("simulate: epoch {} ({}): {} rays, {} triangles", k, format_iso8601(scenes.front().epochs[k].date),
               e.rays, e.triangles);
     report.epochs.push_back(e);

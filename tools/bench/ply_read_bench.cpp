@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_reader.h"
 #include "citymesh/io/ply_writer.h"
 
@@ -43,18 +44,14 @@ Mesh make_grid(std::size_t triangles) {
   return m;
 }
 
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 /// Reading the bytes alone: the ceiling any parser can reach on this machine.
 double raw_read_seconds(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   std::vector<char> buffer(4u << 20);
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
   }
-  return seconds_since(start);
+  return clock.seconds();
 }
 
 /// Drops the file's pages from the page cache so the next read comes from the disk.
@@ -68,14 +65,14 @@ void evict_from_page_cache(const std::filesystem::path& path) {
 
 /// One full streaming pass; returns seconds and fills `stats`.
 double read_all(const std::filesystem::path& path, PlyReadStats& stats) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   PlyReader reader(path);
   PlyVertexChunk vertices;
   PlyFaceChunk faces;
   while (reader.next(vertices, faces) != PlyReader::ChunkKind::end) {
   }
   stats = reader.stats();
-  return seconds_since(start);
+  return clock.seconds();
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include <filesystem>
 
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/stopwatch.h"
 #include "citymesh/sim/simulate.h"
 
 using namespace citymesh;
@@ -17,9 +18,9 @@ namespace {
 
 SimulationReport run(const SimulateParams& p, unsigned threads, double& wall) {
   const ThreadLimit limit(threads);
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch clock;
   SimulationReport r = simulate(p);
-  wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  wall = clock.seconds();
   return r;
 }
 

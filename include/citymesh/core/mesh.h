@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <compare>
 #include <cstdint>
 #include <filesystem>
@@ -73,6 +74,12 @@ struct Mesh {
 
 /// Converts an absolute position to floats relative to `origin`.
 inline Vec3f to_local(const Vec3d& p, const Vec3d& origin) { return Vec3f(p - origin); }
+
+/// The default local origin for data starting at `first`: that point rounded down to whole
+/// metres, so origins are exact and readable in any CRS.
+inline Vec3d whole_metre_origin(const Vec3d& first) {
+  return {std::floor(first.x), std::floor(first.y), std::floor(first.z)};
+}
 
 /// Twice the area of the triangle (a, b, c); 0 for degenerate triangles.
 double doubled_area(const Vec3d& a, const Vec3d& b, const Vec3d& c);
