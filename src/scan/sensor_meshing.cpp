@@ -30,6 +30,9 @@ class Mesher {
   SensorMeshResult run() {
     check();
     vertex_of_.assign(g_.points.size(), kNone);
+    // Every range is needed by up to six triangles' tests: compute each once.
+    range_.resize(g_.points.size());
+    for (std::size_t i = 0; i < range_.size(); ++i) range_[i] = g_.valid[i] ? norm(g_.points[i] - g_.sensors[i]) : 0.0f;
     result_.mesh.origin = g_.origin;
     const std::size_t col_end = g_.wrap_columns ? g_.cols : g_.cols - 1;
     for (std::size_t r = 0; r + 1 < g_.rows; ++r) {
@@ -49,12 +52,11 @@ class Mesher {
     }
   }
 
-  [[nodiscard]] float range(std::size_t i) const { return norm(g_.points[i] - g_.sensors[i]); }
-
-  /// The length / depth-jump / grazing tests; counts the reason of a rejection.
-  bool acceptable(std::size_t a, std::size_t b, std::size_t c) {
+  /// The length / depth-jump / grazing tests; counts the reason of a rejection. On success
+  /// `normal` holds the (unnormalised) normal of a-b-c, reused to orient the triangle.
+  bool acceptable(std::size_t a, std::size_t b, std::size_t c, Vec3f& normal) {
     ++result_.stats.candidates;
-    const float ra = range(a), rb = range(b), rc = range(c);
+    const float ra = range_[a], rb = range_[b], rc = range_[c];
     const std::size_t v[3] = {a, b, c};
     const float r[3] = {ra, rb, rc};
     for (int e = 0; e < 3; ++e) {
@@ -64,11 +66,11 @@ class Mesher {
     }
     const float rmin = std::min({ra, rb, rc}), rmax = std::max({ra, rb, rc});
     if (rmax - rmin > p_.max_depth_jump * rmin) return reject(result_.stats.rejected_depth_jump);
-    const Vec3f n = cross(g_.points[b] - g_.points[a], g_.points[c] - g_.points[a]);
+    normal = cross(g_.points[b] - g_.points[a], g_.points[c] - g_.points[a]);
     const Vec3f view = (g_.sensors[a] + g_.sensors[b] + g_.sensors[c]) / 3.0f -
                        (g_.points[a] + g_.points[b] + g_.points[c]) / 3.0f;
-    const float nn = norm(n), vn = norm(view);
-    if (nn == 0.0f || vn == 0.0f || std::abs(dot(n, view)) < cos_limit_ * nn * vn) {
+    const float nn = norm(normal), vn = norm(view);
+    if (nn == 0.0f || vn == 0.0f || std::abs(dot(normal, view)) < cos_limit_ * nn * vn) {
       return reject(result_.stats.rejected_grazing);
     }
     return true;
@@ -93,14 +95,14 @@ class Mesher {
     const auto& l = g_.labels;
     if (l[a] == l[b] || l[a] == l[c]) return l[a];
     if (l[b] == l[c]) return l[b];
-    const float ra = range(a), rb = range(b), rc = range(c);
+    const float ra = range_[a], rb = range_[b], rc = range_[c];
     return ra <= rb && ra <= rc ? l[a] : (rb <= rc ? l[b] : l[c]);
   }
 
   /// Emits triangle a-b-c oriented to face its sensor.
   void emit(std::size_t a, std::size_t b, std::size_t c, std::size_t quad_cell, std::uint32_t which) {
-    if (!acceptable(a, b, c)) return;
-    const Vec3f n = cross(g_.points[b] - g_.points[a], g_.points[c] - g_.points[a]);
+    Vec3f n;
+    if (!acceptable(a, b, c, n)) return;
     if (dot(n, g_.sensors[a] - g_.points[a]) < 0) std::swap(b, c);
     Mesh& m = result_.mesh;
     m.triangles.push_back({vertex(a), vertex(b), vertex(c)});
@@ -135,6 +137,7 @@ class Mesher {
   std::uint32_t acquisition_;
   float cos_limit_;
   std::vector<std::uint32_t> vertex_of_;
+  std::vector<float> range_;  ///< sensor-to-point distance per cell
   SensorMeshResult result_;
 };
 
