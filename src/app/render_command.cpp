@@ -18,14 +18,27 @@ namespace citymesh::app {
 
 namespace {
 
-/// Object id -> class name, from a simulation's objects.json.
-std::map<std::uint32_t, std::string> object_classes(const std::filesystem::path& sim) {
+/// How an object is drawn: its class and that class's colour.
+struct ObjectStyle {
+  std::string cls;
+  Rgb8 color;
+};
+
+/// Object id -> class and colour, from a simulation's objects.json. Classes take palette
+/// colours in the order they first appear, so colours are stable for a scene.
+std::map<std::uint32_t, ObjectStyle> object_classes(const std::filesystem::path& sim) {
   std::ifstream in(sim / "objects.json");
   if (!in) throw InputError(fmt::format("{}: no objects.json (is this a citymesh simulate folder?)", sim.string()));
-  std::map<std::uint32_t, std::string> classes;
+  std::map<std::uint32_t, ObjectStyle> classes;
+  std::map<std::string, Rgb8> class_colors;
   try {
     const nlohmann::json objects = nlohmann::json::parse(in);  // named: iterating a temporary's member dangles
-    for (const auto& o : objects.at("objects")) classes[o.at("id").get<std::uint32_t>()] = o.at("class");
+    for (const auto& o : objects.at("objects")) {
+      const std::string cls = o.at("class");
+      const auto [it, added] = class_colors.emplace(cls, Rgb8{});
+      if (added) it->second = palette_color(static_cast<std::uint32_t>(class_colors.size() - 1));
+      classes[o.at("id").get<std::uint32_t>()] = {cls, it->second};
+    }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: objects.json: {}", sim.string(), e.what()));
   }
@@ -68,7 +81,7 @@ class RenderCommand final : public Command {
     read.ply.require_sensor_origin = false;
     std::vector<Mesh> meshes;
     for (const auto& path : inputs) meshes.push_back(read_mesh(path, read).mesh);
-    const auto classes = color_ == "class" ? object_classes(sim_) : std::map<std::uint32_t, std::string>{};
+    const auto classes = color_ == "class" ? object_classes(sim_) : std::map<std::uint32_t, ObjectStyle>{};
     std::map<std::string, Rgb8> legend;
     std::vector<RenderLayer> layers;
     for (std::size_t i = 0; i < meshes.size(); ++i) layers.push_back({&meshes[i], colors(meshes[i], inputs[i], i, classes, legend)});
@@ -80,7 +93,7 @@ class RenderCommand final : public Command {
 
  private:
   std::vector<Rgb8> colors(const Mesh& m, const std::filesystem::path& path, std::size_t layer,
-                           const std::map<std::uint32_t, std::string>& classes, std::map<std::string, Rgb8>& legend) {
+                           const std::map<std::uint32_t, ObjectStyle>& classes, std::map<std::string, Rgb8>& legend) {
     std::vector<Rgb8> out(m.triangle_count());
     if (color_ == "input") {
       const Rgb8 c = palette_color(static_cast<std::uint32_t>(layer) + 1);
@@ -96,11 +109,13 @@ class RenderCommand final : public Command {
       auto truth_path = path;
       const std::vector<std::uint32_t> truth = read_truth(truth_path.replace_extension(".truth"));
       if (truth.size() != out.size()) throw InputError(fmt::format("{}: ground truth does not match the mesh", truth_path.string()));
-      std::map<std::string, std::uint32_t> class_index;
-      for (const auto& [id, cls] : classes) class_index.emplace(cls, static_cast<std::uint32_t>(class_index.size()));
       for (std::size_t t = 0; t < out.size(); ++t) {
-        const std::string& cls = classes.at(truth[t]);
-        out[t] = legend[cls] = palette_color(class_index[cls]);
+        const auto style = classes.find(truth[t]);
+        if (style == classes.end()) {
+          throw InputError(fmt::format("{}: face {} names object {}, absent from objects.json", truth_path.string(), t,
+                                       truth[t]));
+        }
+        out[t] = legend[style->second.cls] = style->second.color;
       }
     }
     return out;

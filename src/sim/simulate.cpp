@@ -145,7 +145,6 @@ SimulationReport simulate(const SimulateParams& p) {
       report.scan_seconds += stage.restart();
       for (const SensorGrid& grid : grids) {
         append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
-        e.hits += static_cast<std::uint64_t>(std::count(grid.valid.begin(), grid.valid.end(), 1));
       }
       report.mesh_seconds += stage.seconds();
       e.rays += rays_per_epoch(scene, k, p.scanner);

@@ -62,7 +62,7 @@ std::vector<std::uint32_t> read_truth(const std::filesystem::path& path) {
   in.read(reinterpret_cast<char*>(&count), sizeof count);
   std::error_code ec;
   const auto size = std::filesystem::file_size(path, ec);
-  if (!in || ec || count != (size - 24) / 4 || size < 24 || (size - 24) % 4 != 0) {
+  if (!in || ec || size < 24 || (size - 24) % 4 != 0 || count != (size - 24) / 4) {
     throw InputError(fmt::format("{}: ground truth is truncated or its count is wrong", path.string()));
   }
   std::vector<std::uint32_t> ids(count);

@@ -37,7 +37,7 @@ struct SimulateParams {
 
 struct SimulatedEpoch {
   std::filesystem::path ply, truth;
-  std::uint64_t rays = 0, hits = 0, triangles = 0;
+  std::uint64_t rays = 0, triangles = 0;
 };
 
 struct SimulationReport {
