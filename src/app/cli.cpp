@@ -18,6 +18,7 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   commands.push_back(make_simulate_command());
   commands.push_back(make_render_command());
   commands.push_back(make_mesh_command());
+  commands.push_back(make_detect_command());
   return commands;
 }
 

@@ -63,6 +63,7 @@ void PlyFaceChunk::clear() {
   triangles.clear();
   faces.clear();
   fans.clear();
+  for (auto& column : extras) column.clear();
 }
 
 struct PlyReader::Impl {
@@ -83,6 +84,8 @@ struct PlyReader::Impl {
   std::vector<FixedField> vertex_fixed;
   std::optional<std::size_t> vertex_row_size;
   std::size_t face_list = 0;  // index of vertex_indices among the face properties
+  std::vector<int> face_extra_slot;  // per face property: index into extra_face_properties, or -1
+  std::vector<double> face_values;   // the current face's extra values
   std::vector<std::int64_t> polygon;
 
   Impl(std::filesystem::path p, PlyReadParams rp) : path(std::move(p)), params(std::move(rp)) {
@@ -168,9 +171,22 @@ struct PlyReader::Impl {
         fail(fmt::format("face property '{}' must hold integers, not {}", p.name, ply_scalar_name(p.type)));
       }
       face_list = i;
+      plan_face_extras(*f);
       return;
     }
     fail("face element has no 'vertex_indices' (or 'vertex_index') list");
+  }
+
+  void plan_face_extras(const PlyElement& f) {
+    face_extra_slot.assign(f.properties.size(), -1);
+    face_values.assign(params.extra_face_properties.size(), 0.0);
+    for (std::size_t e = 0; e < params.extra_face_properties.size(); ++e) {
+      const std::string& name = params.extra_face_properties[e];
+      const auto it = std::find_if(f.properties.begin(), f.properties.end(),
+                                   [&](const PlyProperty& p) { return p.name == name && !p.is_list; });
+      if (it == f.properties.end()) fail(fmt::format("face property '{}' not found", name));
+      face_extra_slot[static_cast<std::size_t>(it - f.properties.begin())] = static_cast<int>(e);
+    }
   }
 
   // ---- vertices -------------------------------------------------------------------------
@@ -293,9 +309,10 @@ struct PlyReader::Impl {
       if (i != face_list) {
         if (p.is_list) {
           skip_binary_list(p, "face", index);
-        } else if (src->peek(ply_scalar_size(p.type)) == nullptr) {
+        } else if (const char* b = src->peek(ply_scalar_size(p.type)); b == nullptr) {
           fail_row("face", index, "unexpected end of file");
         } else {
+          if (face_extra_slot[i] >= 0) face_values[static_cast<std::size_t>(face_extra_slot[i])] = load_double(b, p.type, swap);
           src->skip(ply_scalar_size(p.type));
         }
         continue;
@@ -324,6 +341,10 @@ struct PlyReader::Impl {
           skip_ascii_list(tokens, p, "face", index);
         } else if (!tokens.next(token)) {
           fail_row("face", index, fmt::format("missing value for '{}'", p.name));
+        } else if (face_extra_slot[i] >= 0) {
+          const auto value = parse_double(token);
+          if (!value) fail_row("face", index, fmt::format("'{}' is not a number", p.name));
+          face_values[static_cast<std::size_t>(face_extra_slot[i])] = *value;
         }
         continue;
       }
@@ -363,10 +384,12 @@ struct PlyReader::Impl {
       out.triangles.push_back(t);
       out.faces.push_back(index);
       out.fans.push_back(static_cast<std::uint32_t>(k - 1));
+      for (std::size_t e = 0; e < face_values.size(); ++e) out.extras[e].push_back(face_values[e]);
     }
   }
 
   void read_faces(PlyFaceChunk& out, const PlyElement& e, std::uint64_t n) {
+    out.extras.resize(params.extra_face_properties.size());
     for (std::uint64_t i = 0; i < n; ++i) {
       if (ascii) {
         read_polygon_ascii(e, row + i);

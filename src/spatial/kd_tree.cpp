@@ -3,6 +3,7 @@
 #include "citymesh/spatial/kd_tree.h"
 
 #include <algorithm>
+#include <cmath>
 #include <nanoflann.hpp>
 
 namespace citymesh {
@@ -33,17 +34,30 @@ PointKdTree::~PointKdTree() = default;
 
 std::size_t PointKdTree::size() const { return impl_->cloud.points.size(); }
 
+namespace {
+/// Collects indices straight into the caller's vector (no pairs, no per-query allocation).
+struct IndexCollector {
+  float radius_sq;
+  std::vector<std::uint32_t>& out;
+  [[nodiscard]] std::size_t size() const { return out.size(); }
+  [[nodiscard]] bool full() const { return true; }
+  bool addPoint(float dist_sq, std::uint32_t index) {
+    if (dist_sq <= radius_sq) out.push_back(index);
+    return true;
+  }
+  [[nodiscard]] float worstDist() const { return radius_sq; }
+};
+}  // namespace
+
 void PointKdTree::radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& out) const {
   out.clear();
   if (size() == 0) return;
-  std::vector<std::pair<std::uint32_t, float>> matches;
   const float q[3] = {query.x, query.y, query.z};
   nanoflann::SearchParams params;
   params.sorted = false;
-  // nanoflann's L2 metric works on squared distances; the bound is exclusive, so nudge it up.
-  impl_->tree.radiusSearch(q, std::nextafter(radius * radius, INFINITY), matches, params);
-  out.reserve(matches.size());
-  for (const auto& m : matches) out.push_back(m.first);
+  // The search prunes cells farther than worstDist(); nudged up so the bound is inclusive.
+  IndexCollector collect{std::nextafter(radius * radius, INFINITY), out};
+  impl_->tree.radiusSearchCustomCallback(q, collect, params);
   std::sort(out.begin(), out.end());
 }
 

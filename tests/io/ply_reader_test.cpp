@@ -186,3 +186,42 @@ TEST(PlyReader, MissingSensorOriginIsAnErrorOnlyWhenRequired) {
 
 }  // namespace
 }  // namespace citymesh
+
+namespace citymesh {
+namespace {
+
+TEST(PlyReader, ExtraFacePropertiesInEveryFormatFollowTheirTriangles) {
+  for (PlyFormat format : kFormats) {
+    auto elements = quad_strip(2, PlyScalar::float32, PlyScalar::int32);
+    elements[1].props.insert(elements[1].props.begin(), {"flag", PlyScalar::uint8});
+    elements[1].props.push_back({"score", PlyScalar::float64});
+    elements[1].props.push_back({"ignored", PlyScalar::int16});
+    elements[1].rows[0].insert(elements[1].rows[0].begin(), {7.0});
+    elements[1].rows[0].push_back({0.25});
+    elements[1].rows[0].push_back({1});
+    elements[1].rows[1].insert(elements[1].rows[1].begin(), {9.0});
+    elements[1].rows[1].push_back({-1.5});
+    elements[1].rows[1].push_back({2});
+    test::TempDir dir;
+    test::write_text(dir / "m.ply", test::build_ply(format, elements));
+    PlyReadParams params;
+    params.extra_face_properties = {"score", "flag"};
+    PlyReader reader(dir / "m.ply", params);
+    PlyVertexChunk vertices;
+    PlyFaceChunk faces, all;
+    all.extras.resize(2);
+    while (reader.next(vertices, faces) != PlyReader::ChunkKind::end) {
+      for (std::size_t e = 0; e < faces.extras.size(); ++e) {
+        all.extras[e].insert(all.extras[e].end(), faces.extras[e].begin(), faces.extras[e].end());
+      }
+    }
+    // Two quads, each split into two triangles that repeat the quad's values.
+    EXPECT_EQ(all.extras[0], (std::vector<double>{0.25, 0.25, -1.5, -1.5})) << ply_format_name(format);
+    EXPECT_EQ(all.extras[1], (std::vector<double>{7, 7, 9, 9})) << ply_format_name(format);
+    params.extra_face_properties = {"missing"};
+    EXPECT_THROW(PlyReader(dir / "m.ply", params), InputError);
+  }
+}
+
+}  // namespace
+}  // namespace citymesh

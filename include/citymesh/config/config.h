@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "citymesh/change/change_params.h"
 #include "citymesh/core/mesh.h"
 #include "citymesh/core/time.h"
 #include "citymesh/geo/crs.h"
@@ -35,13 +36,6 @@ struct AcquisitionEntry {
   std::filesystem::path path;  ///< absolute (resolved against the config file's folder)
   TimePoint time{};
   std::string name;  ///< defaults to the file stem
-};
-
-struct ChangeParams {
-  double distance_threshold = 0.10;  ///< metres
-  double conflict_margin = 0.10;     ///< metres
-  double normal_angle = 45.0;        ///< degrees
-  Duration sustainability = std::chrono::days(30);
 };
 
 enum class QualityMeasure { constant, area, resolution };

@@ -24,6 +24,9 @@ struct PlyReadParams {
   /// Further vertex properties to return, as doubles, in PlyVertexChunk::extras (in this
   /// order); a missing one is an input error.
   std::vector<std::string> extra_vertex_properties;
+  /// Scalar face properties to return, as doubles, in PlyFaceChunk::extras (one value per
+  /// triangle, repeated for the triangles of a split polygon); a missing one is an input error.
+  std::vector<std::string> extra_face_properties;
   /// When true, a file without the sensor-origin properties is an input error.
   bool require_sensor_origin = true;
   /// Rows per chunk; bounds the reader's memory whatever the file size.
@@ -59,6 +62,7 @@ struct PlyFaceChunk {
   std::vector<Triangle> triangles;
   std::vector<std::uint64_t> faces;
   std::vector<std::uint32_t> fans;
+  std::vector<std::vector<double>> extras;  ///< one column per PlyReadParams::extra_face_properties
   void clear();
 };
 

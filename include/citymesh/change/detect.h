@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+// Change detection and time series (paper section III) on one in-memory set of meshes: which
+// triangles agree between acquisitions (consistent), which belong to surfaces that have
+// disappeared (conflicting), and which are sustainable. A tile with its halo is such a set.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "citymesh/change/change_params.h"
+#include "citymesh/core/mesh.h"
+#include "citymesh/core/time.h"
+
+namespace citymesh {
+
+/// The meshes of every acquisition, index = acquisition index (config order), all in one local
+/// frame (the same origin) and with sensor positions; dates may come in any order.
+struct ChangeInput {
+  std::span<const Mesh> meshes;
+  std::span<const TimePoint> dates;  ///< one per mesh
+};
+
+enum class TriangleState : std::uint8_t { consistent = 0, conflicting = 1, single = 2 };
+[[nodiscard]] std::string_view triangle_state_name(TriangleState s);
+
+/// Triangles are numbered globally: acquisition a's triangle t is offsets[a] + t.
+struct GlobalTriangles {
+  std::vector<std::size_t> offsets;  ///< size meshes + 1
+  [[nodiscard]] std::size_t size() const { return offsets.back(); }
+  [[nodiscard]] std::uint32_t acquisition_of(std::size_t g) const;
+};
+
+/// Consistent pairs (global indices, first < second), sorted: the overlap edges of the mosaic.
+using TrianglePair = std::pair<std::uint32_t, std::uint32_t>;
+
+struct ChangeStats {
+  std::uint64_t triangles = 0;
+  std::uint64_t samples = 0;              ///< kd-tree points
+  std::uint64_t consistent_pairs = 0;
+  std::uint64_t conflict_candidates = 0;  ///< (triangle, newer acquisition) pairs without consistency
+  std::uint64_t prefilter_skipped = 0;    ///< of those, ruled out by the empty-space grids
+  std::uint64_t exact_tests = 0;          ///< triangle-tetrahedron tests run
+  std::uint64_t marked_voxels = 0;
+  double seconds_prepare = 0, seconds_consistency = 0, seconds_grids = 0, seconds_conflicts = 0,
+         seconds_time_series = 0;
+  [[nodiscard]] double prefilter_hit_rate() const {
+    return conflict_candidates == 0 ? 0.0 : double(prefilter_skipped) / double(conflict_candidates);
+  }
+  [[nodiscard]] double seconds_total() const {
+    return seconds_prepare + seconds_consistency + seconds_grids + seconds_conflicts + seconds_time_series;
+  }
+};
+
+struct ChangeResult {
+  GlobalTriangles index;
+  std::vector<TriangleState> state;         ///< per global triangle
+  std::vector<TimePoint> first_seen, last_seen;
+  std::vector<std::uint8_t> sustainable;    ///< last_seen - first_seen >= Ts
+  std::vector<std::uint8_t> kept;           ///< survives the time series (not conflicting; sustainable or
+                                            ///< kept by the unconfirmed policy)
+  std::vector<std::uint8_t> refutes;        ///< its empty space made an older triangle conflict
+  std::vector<TrianglePair> consistent_pairs;
+  ChangeStats stats;
+};
+
+/// Runs consistency, conflicts and the time series. Same input and params give the same
+/// result whatever the thread count. Throws ProcessingError when the meshes lack sensor
+/// positions, have different origins, or dates are missing.
+ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params);
+
+}  // namespace citymesh

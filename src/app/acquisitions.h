@@ -1,0 +1,24 @@
+// SPDX-License-Identifier: MIT
+// Reading a config's acquisitions into meshes sharing one local frame (the pipeline's input).
+#pragma once
+
+#include <vector>
+
+#include "citymesh/config/config.h"
+#include "citymesh/core/mesh.h"
+
+namespace citymesh::app {
+
+struct LoadedAcquisitions {
+  std::vector<Acquisition> acquisitions;  ///< config order
+  std::vector<Mesh> meshes;               ///< one per acquisition, all with the first one's origin
+  std::vector<TimePoint> dates;
+  /// Per acquisition, per triangle: the face index in the file (the provenance id).
+  [[nodiscard]] std::vector<std::int32_t> source_faces(std::size_t acquisition) const;
+};
+
+/// Reads every acquisition of `config` whole. Throws InputError naming the file, and
+/// ProcessingError when a file has no sensor positions.
+LoadedAcquisitions load_acquisitions(const Config& config);
+
+}  // namespace citymesh::app

@@ -1,0 +1,153 @@
+// SPDX-License-Identifier: MIT
+#include "frames.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+
+namespace citymesh {
+
+std::string_view unconfirmed_policy_name(UnconfirmedPolicy p) {
+  switch (p) {
+    case UnconfirmedPolicy::drop: return "drop";
+    case UnconfirmedPolicy::keep: return "keep";
+    default: return "keep-unobserved";
+  }
+}
+
+std::string_view triangle_state_name(TriangleState s) {
+  switch (s) {
+    case TriangleState::consistent: return "consistent";
+    case TriangleState::conflicting: return "conflicting";
+    default: return "single";
+  }
+}
+
+std::uint32_t GlobalTriangles::acquisition_of(std::size_t g) const {
+  const auto it = std::upper_bound(offsets.begin(), offsets.end(), g);
+  return static_cast<std::uint32_t>(it - offsets.begin() - 1);
+}
+
+namespace change_detail {
+
+namespace {
+
+void check_input(const ChangeInput& input) {
+  if (input.meshes.size() != input.dates.size()) {
+    throw ProcessingError(fmt::format("change detection: {} meshes but {} dates", input.meshes.size(), input.dates.size()));
+  }
+  for (std::size_t a = 0; a < input.meshes.size(); ++a) {
+    const Mesh& m = input.meshes[a];
+    m.check_invariants();
+    if (m.triangle_count() > 0 && !m.has_sensor_positions()) {
+      throw ProcessingError(fmt::format("change detection: acquisition {} has no sensor positions", a));
+    }
+    if (!(m.origin == input.meshes.front().origin)) {
+      throw ProcessingError(fmt::format("change detection: acquisition {} has another local origin", a));
+    }
+  }
+  std::size_t total = 0;
+  for (const Mesh& m : input.meshes) total += m.triangle_count();
+  if (total >= (std::size_t{1} << 32)) {
+    throw ProcessingError(fmt::format("change detection: {} triangles in one set (at most 2^32 - 1; use tiles)", total));
+  }
+}
+
+Vec3d corner(const Mesh& m, std::size_t t, int k) { return Vec3d(m.positions[m.triangles[t][static_cast<std::size_t>(k)]]); }
+
+}  // namespace
+
+TriangleCorners TriangleFrames::corners(std::size_t g) const {
+  const std::uint32_t a = index.acquisition_of(g);
+  const std::size_t t = g - index.offsets[a];
+  const Mesh& m = meshes[a];
+  return {corner(m, t, 0), corner(m, t, 1), corner(m, t, 2)};
+}
+
+TetrahedronCorners TriangleFrames::empty_space(std::size_t g) const {
+  const TriangleCorners c = corners(g);
+  const Vec3d v(viewpoint[g]);
+  const double s = empty_scale[g];
+  return {v, v + (c[0] - v) * s, v + (c[1] - v) * s, v + (c[2] - v) * s};
+}
+
+namespace {
+/// Boxes are padded by a hair so that rounding to float never loses a touching pair.
+Box3f padded_box(std::span<const Vec3d> points) {
+  Box3d b;
+  for (const Vec3d& p : points) b.extend(p);
+  const double pad = 1e-5 + 1e-6 * std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z),
+                                             std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+  return {Vec3f(b.min - Vec3d{pad, pad, pad}), Vec3f(b.max + Vec3d{pad, pad, pad})};
+}
+}  // namespace
+
+Box3f TriangleFrames::bounds(std::size_t g) const {
+  const TriangleCorners c = corners(g);
+  return padded_box(c);
+}
+
+Box3f TriangleFrames::empty_space_bounds(std::size_t g) const {
+  const TetrahedronCorners q = empty_space(g);
+  return padded_box(q);
+}
+
+TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params) {
+  check_input(input);
+  TriangleFrames f;
+  f.meshes = input.meshes;
+  f.dates.assign(input.dates.begin(), input.dates.end());
+  f.index.offsets.assign(1, 0);
+  for (const Mesh& m : input.meshes) f.index.offsets.push_back(f.index.offsets.back() + m.triangle_count());
+  const std::size_t n = f.index.size();
+  f.centroid.resize(n);
+  f.normal.resize(n);
+  f.viewpoint.resize(n);
+  f.empty_scale.resize(n);
+  for (std::size_t a = 0; a < input.meshes.size(); ++a) {
+    const Mesh& m = input.meshes[a];
+    const std::size_t base = f.index.offsets[a];
+    parallel_for_blocks(m.triangle_count(), 8192, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const Triangle& tri = m.triangles[t];
+        const Vec3d p0 = corner(m, t, 0), p1 = corner(m, t, 1), p2 = corner(m, t, 2);
+        const Vec3d c = (p0 + p1 + p2) / 3.0;
+        const Vec3d v = (Vec3d(m.sensor_positions[tri[0]]) + Vec3d(m.sensor_positions[tri[1]]) +
+                         Vec3d(m.sensor_positions[tri[2]])) / 3.0;
+        Vec3d normal = cross(p1 - p0, p2 - p0);
+        const double len = norm(normal);
+        normal = len > 0 ? normal / len : Vec3d{0, 0, 0};
+        double h = dot(v - p0, normal);  // viewpoint height above the plane
+        if (h < 0) {
+          normal = normal * -1.0;
+          h = -h;
+        }
+        const std::size_t g = base + t;
+        f.centroid[g] = Vec3f(c);
+        f.normal[g] = Vec3f(normal);
+        f.viewpoint[g] = Vec3f(v);
+        f.empty_scale[g] = h > params.conflict_margin ? static_cast<float>((h - params.conflict_margin) / h) : 0.0f;
+      }
+    });
+  }
+  return f;
+}
+
+PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs) {
+  PartnerBits p;
+  p.words = (frames.meshes.size() + 63) / 64;
+  p.bits.assign(frames.size() * p.words, 0);
+  for (const auto& [a, b] : pairs) {
+    const std::size_t ja = frames.index.acquisition_of(a), jb = frames.index.acquisition_of(b);
+    p.bits[a * p.words + jb / 64] |= std::uint64_t{1} << (jb % 64);
+    p.bits[b * p.words + ja / 64] |= std::uint64_t{1} << (ja % 64);
+  }
+  return p;
+}
+
+}  // namespace change_detail
+}  // namespace citymesh

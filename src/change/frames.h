@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+// Internal to the change module: per-triangle quantities every step needs, computed once, and
+// the steps of detect_changes as free functions.
+#pragma once
+
+#include <vector>
+
+#include "citymesh/change/detect.h"
+#include "citymesh/core/geometry.h"
+#include "citymesh/spatial/box_collide.h"
+#include "citymesh/spatial/occupancy_grid.h"
+
+namespace citymesh::change_detail {
+
+/// Derived per global triangle, in the meshes' shared local frame.
+struct TriangleFrames {
+  std::span<const Mesh> meshes;
+  std::vector<TimePoint> dates;  ///< per acquisition
+  GlobalTriangles index;
+  std::vector<Vec3f> centroid;
+  std::vector<Vec3f> normal;     ///< unit, turned towards the viewpoint
+  std::vector<Vec3f> viewpoint;  ///< barycentre of the corners' sensor positions
+  /// The empty space kept after the conflict margin is the tetrahedron scaled about the
+  /// viewpoint by this factor (exactly the points at least `margin` from the triangle's plane);
+  /// 0 when the viewpoint is within the margin of the plane (no empty space).
+  std::vector<float> empty_scale;
+
+  [[nodiscard]] std::size_t size() const { return centroid.size(); }
+  [[nodiscard]] TriangleCorners corners(std::size_t g) const;
+  [[nodiscard]] TetrahedronCorners empty_space(std::size_t g) const;
+  [[nodiscard]] Box3f bounds(std::size_t g) const;
+  [[nodiscard]] Box3f empty_space_bounds(std::size_t g) const;
+  [[nodiscard]] TimePoint date_of(std::size_t g) const { return dates[index.acquisition_of(g)]; }
+};
+
+/// Checks the input and computes every frame (parallel, deterministic).
+TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params);
+
+/// Consistent pairs: triangles of different acquisitions whose normals are within
+/// normal_angle and where one's centroid lies within distance_threshold of the other
+/// (point-to-triangle distance). Candidates come from a nanoflann kd-tree over samples spread
+/// on every triangle at most `spacing` apart (spacing set by the coarser triangles), so the
+/// search radius is the threshold plus the spacing and no partner is missed.
+std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& frames, const ChangeParams& params,
+                                                ChangeStats& stats);
+
+/// Per acquisition, a sparse voxel grid marking every voxel its (margin-reduced) empty space
+/// crosses; conservative: a voxel not marked holds none of that empty space.
+std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& frames, const ChangeParams& params,
+                                                   ChangeStats& stats);
+
+/// consistent_with[g * words + (j / 64)] bit (j % 64): triangle g has a consistent partner in
+/// acquisition j.
+struct PartnerBits {
+  std::size_t words = 1;
+  std::vector<std::uint64_t> bits;
+  [[nodiscard]] bool has(std::size_t g, std::size_t j) const { return (bits[g * words + j / 64] >> (j % 64)) & 1u; }
+};
+PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs);
+
+struct ConflictFlags {
+  std::vector<std::uint8_t> conflicting;  ///< per global triangle
+  std::vector<std::uint8_t> refutes;
+};
+
+/// A triangle conflicts with a newer acquisition j it is not consistent with when it meets
+/// the margin-reduced empty space of one of j's triangles (exact triangle-tetrahedron test).
+/// Candidates: Embree box collision between the triangles and j's empty spaces; with the
+/// pre-filter, triangles whose box meets no voxel of j's grid are not tested at all.
+ConflictFlags find_conflicts(const TriangleFrames& frames, const PartnerBits& partners,
+                             std::span<const OccupancyGrid> grids, const ChangeParams& params, ChangeStats& stats);
+
+}  // namespace citymesh::change_detail
