@@ -69,6 +69,9 @@ class Parser {
         context(node, name).fail(fmt::format("unknown section; did you mean '{}'?", nearest(name, valid)));
       }
     }
+    // Like the acquisitions' paths: relative to the config file's folder, not to the caller's.
+    config_.project.output = (config_.base_dir / config_.project.output).lexically_normal();
+    config_.project.work = (config_.base_dir / config_.project.work).lexically_normal();
     validate();
     return std::move(config_);
   }

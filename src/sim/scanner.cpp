@@ -156,3 +156,39 @@ std::vector<SensorGrid> scan_epoch(const Scene& scene, std::size_t epoch, const 
 }
 
 }  // namespace citymesh
+
+namespace citymesh {
+
+namespace {
+constexpr float kMinSurfaceCosine = 0.866f;  // 30 degrees
+}  // namespace
+
+std::vector<std::uint32_t> surface_labels(const Scene& scene, std::size_t epoch, const Mesh& mesh, float tolerance) {
+  const Geometry geometry = present_geometry(scene, scene.epochs.at(epoch).date);
+  const RayScene rays(geometry.vertices, geometry.triangles);
+  const Vec3f shift(mesh.origin - scene.origin);  // mesh frame -> scene frame
+  std::vector<std::uint32_t> labels(mesh.triangle_count(), kNoSurface);
+  parallel_for_blocks(labels.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      const Triangle& tri = mesh.triangles[t];
+      const Vec3f a = mesh.positions[tri[0]], b = mesh.positions[tri[1]], c = mesh.positions[tri[2]];
+      Vec3f n = cross(b - a, c - a);
+      const float len = norm(n);
+      if (!(len > 0)) continue;
+      n = n / len;
+      const Vec3f centre = (a + b + c) / 3.0f + shift;
+      const RayHit up = rays.intersect(centre, n, tolerance), down = rays.intersect(centre, n * -1.0f, tolerance);
+      if (!up.hit && !down.hit) continue;
+      const std::uint32_t hit = (up.hit && (!down.hit || up.distance <= down.distance)) ? up.triangle : down.triangle;
+      // On the surface only when also parallel to it: a face bridging a depth jump may pass
+      // close to a surface at a steep angle.
+      const Triangle& s = geometry.triangles[hit];
+      const Vec3f& p = geometry.vertices[s[0]];
+      const Vec3f m = cross(geometry.vertices[s[1]] - p, geometry.vertices[s[2]] - p);
+      if (std::abs(dot(m, n)) >= kMinSurfaceCosine * norm(m)) labels[t] = geometry.object_of[hit];
+    }
+  });
+  return labels;
+}
+
+}  // namespace citymesh

@@ -18,6 +18,10 @@ namespace citymesh {
 
 namespace {
 
+/// A face is labelled with the object whose surface lies this close to its centroid (range
+/// noise, registration error and chords of curved surfaces stay well below it).
+constexpr float kTruthTolerance = 0.03f;
+
 /// Object ids of street s are offset by s * kIdsPerStreet, so they stay unique in a city.
 constexpr std::uint32_t kIdsPerStreet = 1'000'000;
 
@@ -97,20 +101,19 @@ SensorMeshingParams meshing_for(const SimulateParams& p) {
 }
 
 /// Appends one street's meshed scan to the epoch's mesh (whose origin may differ).
-void append_street(Mesh& epoch, std::vector<std::uint32_t>& truth, const SensorMeshResult& street) {
-  const Vec3f shift(street.mesh.origin - epoch.origin);
-  const auto base = static_cast<std::uint32_t>(epoch.positions.size());
-  for (std::size_t v = 0; v < street.mesh.vertex_count(); ++v) {
-    epoch.positions.push_back(street.mesh.positions[v] + shift);
-    epoch.sensor_positions.push_back(street.mesh.sensor_positions[v] + shift);
-    epoch.times.push_back(street.mesh.times[v]);
+void append_mesh(Mesh& to, const Mesh& from) {
+  const Vec3f shift(from.origin - to.origin);
+  const auto base = static_cast<std::uint32_t>(to.positions.size());
+  for (std::size_t v = 0; v < from.vertex_count(); ++v) {
+    to.positions.push_back(from.positions[v] + shift);
+    to.sensor_positions.push_back(from.sensor_positions[v] + shift);
+    to.times.push_back(from.times[v]);
   }
-  for (std::size_t t = 0; t < street.mesh.triangle_count(); ++t) {
-    const Triangle& tri = street.mesh.triangles[t];
-    epoch.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
-    epoch.triangle_ids.push_back({street.mesh.triangle_ids[t].acquisition, 0, epoch.triangle_ids.size()});
+  for (std::size_t t = 0; t < from.triangle_count(); ++t) {
+    const Triangle& tri = from.triangles[t];
+    to.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+    to.triangle_ids.push_back({from.triangle_ids[t].acquisition, 0, to.triangle_ids.size()});
   }
-  truth.insert(truth.end(), street.face_labels.begin(), street.face_labels.end());
 }
 
 }  // namespace
@@ -143,9 +146,14 @@ SimulationReport simulate(const SimulateParams& p) {
       Stopwatch stage;
       const std::vector<SensorGrid> grids = scan_epoch(scene, k, p.scanner);
       report.scan_seconds += stage.restart();
+      Mesh street;
+      street.origin = epoch.origin;
       for (const SensorGrid& grid : grids) {
-        append_street(epoch, truth, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)));
+        append_mesh(street, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)).mesh);
       }
+      const std::vector<std::uint32_t> labels = surface_labels(scene, k, street, kTruthTolerance);
+      truth.insert(truth.end(), labels.begin(), labels.end());
+      append_mesh(epoch, street);
       report.mesh_seconds += stage.seconds();
       e.rays += rays_per_epoch(scene, k, p.scanner);
     }

@@ -156,14 +156,55 @@ class StreetBuilder {
     return {epoch(first) - days(1), epoch(last) + days(1)};
   }
 
+  struct ParkedCar {
+    float x = 0, side = 1;
+  };
+  static constexpr float kCarLength = 4.2f;
+
+  /// 2-3 cars per epoch, alternating sides. A car never takes a space used by a car of the
+  /// previous, the next or the last epoch (nor by the car seen twice): two cars in one space
+  /// with no scan in between showing it empty look like one permanent object to any method,
+  /// which would make the ground truth ambiguous. A car that finds no free space is left out.
+  std::vector<std::vector<ParkedCar>> parking_plan() {
+    const std::size_t last = date_.size() - 1;
+    std::vector<std::vector<ParkedCar>> plan(date_.size());
+    plan[1].push_back({twice_seen_x(), -1.0f});
+    plan[2].push_back({twice_seen_x(), -1.0f});
+    const auto is_free = [&](std::size_t k, const ParkedCar& car) {
+      for (std::size_t other : {k == 0 ? k : k - 1, k, std::min(k + 1, last), last}) {
+        for (const ParkedCar& c : plan[other]) {
+          if (c.side == car.side && std::abs(c.x - car.x) < kCarLength + 1.5f) return false;
+        }
+      }
+      return true;
+    };
+    std::vector<std::size_t> order{last};
+    for (std::size_t k = 0; k < last; ++k) order.push_back(k);
+    std::vector<std::vector<ParkedCar>> chosen(date_.size());
+    for (std::size_t k : order) {
+      for (int c = 0, n = rng_.integer(2, 3); c < n; ++c) {
+        for (int attempt = 0; attempt < 50; ++attempt) {
+          const ParkedCar car{rng_.uniform(5, p_.length - 5), c % 2 == 0 ? 1.0f : -1.0f};
+          if (!is_free(k, car)) continue;
+          plan[k].push_back(car);
+          chosen[k].push_back(car);
+          break;
+        }
+      }
+    }
+    return chosen;
+  }
+
+  float twice_seen_x() const { return p_.length * 0.55f; }
+
   void add_scripted_changes() {
     const std::size_t last = date_.size() - 1;
     const float park = kRoadHalfWidth - 1.0f;  // parking lane, both sides
+    const std::vector<std::vector<ParkedCar>> parked = parking_plan();
     for (std::size_t k = 0; k < date_.size(); ++k) {
-      for (int c = 0, n = rng_.integer(2, 3); c < n; ++c) {  // cars parked in this epoch only
+      for (const ParkedCar& car : parked[k]) {  // cars parked in this epoch only
         auto [a, d] = during(k, k);
-        const float side = c % 2 == 0 ? 1.0f : -1.0f;
-        add_car(object(ObjectClass::parked_car, a, d), rng_.uniform(5, p_.length - 5), side * park, 4.2f, 1.8f);
+        add_car(object(ObjectClass::parked_car, a, d), car.x, car.side * park, kCarLength, 1.8f);
       }
       for (int c = 0; c < 3; ++c) {  // pedestrians on the sidewalks
         auto [a, d] = during(k, k);
@@ -173,7 +214,7 @@ class StreetBuilder {
     }
     {  // a car seen in epochs 1 and 2, four days apart: not sustainable at Ts = 30 d
       auto [a, d] = during(1, 2);
-      add_car(object(ObjectClass::parked_car, a, d), p_.length * 0.55f, -park, 4.5f, 1.9f);
+      add_car(object(ObjectClass::parked_car, a, d), twice_seen_x(), -park, 4.5f, 1.9f);
     }
     {  // a car driving in the far lane during epoch 3
       auto [a, d] = during(3, 3);

@@ -41,4 +41,13 @@ std::vector<SensorGrid> scan_epoch(const Scene& scene, std::size_t epoch, const 
 /// Rays cast by scan_epoch for these parameters (for throughput figures).
 std::uint64_t rays_per_epoch(const Scene& scene, std::size_t epoch, const ScannerParams& params);
 
+/// Ground-truth label of a face that lies on no scene surface (it bridges a depth jump).
+inline constexpr std::uint32_t kNoSurface = 0xFFFFFFFFu;
+
+/// Per triangle of `mesh`: the id of the object whose surface (as present at the epoch) lies
+/// nearest the triangle's centroid along the triangle's normal, within `tolerance` metres;
+/// kNoSurface when none does. Labels faces by where they are rather than by their corners, so
+/// that a sidewalk triangle with one corner on a wall counts as sidewalk.
+std::vector<std::uint32_t> surface_labels(const Scene& scene, std::size_t epoch, const Mesh& mesh, float tolerance);
+
 }  // namespace citymesh
