@@ -27,7 +27,8 @@ LoadedAcquisitions load_acquisitions(const Config& config) {
     if (!out.meshes.empty()) params.origin = out.meshes.front().origin;
     MeshReadResult r = read_mesh(a.path, params);
     if (r.stats.faces > std::uint64_t{INT32_MAX}) {
-      throw InputError(fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", a.path.string(), r.stats.faces));
+      throw InputError(
+          fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", a.path.string(), r.stats.faces));
     }
     log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());
     out.meshes.push_back(std::move(r.mesh));

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // `citymesh detect CONFIG`: change detection and time series over a config's acquisitions.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "acquisitions.h"
@@ -30,9 +30,10 @@ class DetectCommand final : public Command {
     app.add_option("--threads", threads_, "worker threads (default: [run] threads; 0: all cores)");
     app.add_option("--pixel", pixel_size_, "metres per pixel of the pictures")->check(CLI::Range(0.005, 100.0));
     app.add_flag("--no-pictures", no_pictures_, "skip the PNGs");
-    app.footer("Writes <output>/detect/<k>_<name>.ply (per-face state, first_seen, last_seen, sustainable,\n"
-               "kept), <k>_<name>.png and summary.json. Example:\n"
-               "  citymesh simulate --out sim && citymesh detect sim/config.toml");
+    app.footer(
+        "Writes <output>/detect/<k>_<name>.ply (per-face state, first_seen, last_seen, sustainable,\n"
+        "kept), <k>_<name>.png and summary.json. Example:\n"
+        "  citymesh simulate --out sim && citymesh detect sim/config.toml");
   }
 
   void run() override {
@@ -43,8 +44,9 @@ class DetectCommand final : public Command {
     const double read_seconds = clock.restart();
     const ChangeResult result = detect_changes({input.meshes, input.dates}, config.change);
     const std::filesystem::path dir = config.project.output / "detect";
-    write_detect_outputs(config, input, result,
-                         {.dir = dir, .pixel_size = pixel_size_, .pictures = !no_pictures_, .read_seconds = read_seconds});
+    write_detect_outputs(
+        config, input, result,
+        {.dir = dir, .pixel_size = pixel_size_, .pictures = !no_pictures_, .read_seconds = read_seconds});
     report(result, dir);
   }
 
@@ -59,9 +61,9 @@ class DetectCommand final : public Command {
     const ChangeStats& s = r.stats;
     std::cout << fmt::format("{}: {} triangles: {} consistent, {} conflicting, {} single; {} kept\n", dir.string(),
                              s.triangles, states[0], states[1], states[2], kept);
-    std::cout << fmt::format("  {} consistent pairs; pre-filter skipped {} of {} candidates ({:.1f} %), {} exact tests\n",
-                             s.consistent_pairs, s.prefilter_skipped, s.conflict_candidates,
-                             100 * s.prefilter_hit_rate(), s.exact_tests);
+    std::cout << fmt::format(
+        "  {} consistent pairs; pre-filter skipped {} of {} candidates ({:.1f} %), {} exact tests\n",
+        s.consistent_pairs, s.prefilter_skipped, s.conflict_candidates, 100 * s.prefilter_hit_rate(), s.exact_tests);
     std::cout << fmt::format("  {:.3f} s: consistency {:.3f}, grids {:.3f}, conflicts {:.3f}, time series {:.3f}\n",
                              s.seconds_total(), s.seconds_consistency, s.seconds_grids, s.seconds_conflicts,
                              s.seconds_time_series);

@@ -16,9 +16,9 @@ namespace citymesh::app {
 
 Rgb8 detect_color(TriangleState state, bool kept, bool refutes) {
   if (state == TriangleState::conflicting) return {220, 30, 30};  // red: a surface that disappeared
-  if (refutes) return {255, 150, 0};                               // orange: newer surface proving it
+  if (refutes) return {255, 150, 0};                              // orange: newer surface proving it
   if (state == TriangleState::single) return kept ? Rgb8{230, 0, 230} : Rgb8{110, 40, 160};  // magenta / purple
-  return kept ? Rgb8{175, 175, 175} : Rgb8{110, 110, 110};         // grey: consistent (darker: unconfirmed)
+  return kept ? Rgb8{175, 175, 175} : Rgb8{110, 110, 110};  // grey: consistent (darker: unconfirmed)
 }
 
 namespace {
@@ -55,7 +55,9 @@ void write_labelled_ply(const std::filesystem::path& path, const Mesh& mesh, std
     first[t] = unix_seconds(r.first_seen[begin + t]);
     last[t] = unix_seconds(r.last_seen[begin + t]);
   }
-  const auto slice = [&](const std::vector<std::uint8_t>& v) { return std::span<const std::uint8_t>(v.data() + begin, n); };
+  const auto slice = [&](const std::vector<std::uint8_t>& v) {
+    return std::span<const std::uint8_t>(v.data() + begin, n);
+  };
   write_mesh_ply(path, mesh,
                  {{kSourceFaceProperty, source_face},
                   {kStateProperty, std::span<const std::uint8_t>(state)},
@@ -80,8 +82,8 @@ void write_picture(const std::filesystem::path& path, const Mesh& mesh, const Ch
 }
 
 nlohmann::json counts_json(const Counts& c) {
-  return {{"consistent", c.state[0]}, {"conflicting", c.state[1]}, {"single", c.state[2]},
-          {"kept", c.kept}, {"sustainable", c.sustainable}, {"refutes", c.refutes}};
+  return {{"consistent", c.state[0]}, {"conflicting", c.state[1]},    {"single", c.state[2]},
+          {"kept", c.kept},           {"sustainable", c.sustainable}, {"refutes", c.refutes}};
 }
 
 }  // namespace
@@ -100,10 +102,12 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
     const std::vector<std::int32_t> faces = input.source_faces(k);
     write_labelled_ply(params.dir / (stem + ".ply"), input.meshes[k], faces, r, begin);
     if (params.pictures) write_picture(params.dir / (stem + ".png"), input.meshes[k], r, begin, params.pixel_size);
-    summary["acquisitions"].push_back({{"index", k}, {"name", config.acquisitions[k].name},
+    summary["acquisitions"].push_back({{"index", k},
+                                       {"name", config.acquisitions[k].name},
                                        {"date", format_iso8601(input.dates[k])},
                                        {"input", input.acquisitions[k].path.string()},
-                                       {"ply", stem + ".ply"}, {"png", params.pictures ? stem + ".png" : ""},
+                                       {"ply", stem + ".ply"},
+                                       {"png", params.pictures ? stem + ".png" : ""},
                                        {"triangles", input.meshes[k].triangle_count()},
                                        {"counts", counts_json(count(r, begin, r.index.offsets[k + 1]))}});
   }
@@ -112,13 +116,13 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
   summary["totals"]["triangles"] = s.triangles;
   summary["consistent_pairs"] = s.consistent_pairs;
   summary["prefilter"] = {{"enabled", config.change.prefilter}, {"voxel_size", config.change.voxel_size},
-                          {"marked_voxels", s.marked_voxels}, {"candidates", s.conflict_candidates},
-                          {"skipped", s.prefilter_skipped}, {"hit_rate", s.prefilter_hit_rate()},
+                          {"marked_voxels", s.marked_voxels},   {"candidates", s.conflict_candidates},
+                          {"skipped", s.prefilter_skipped},     {"hit_rate", s.prefilter_hit_rate()},
                           {"exact_tests", s.exact_tests}};
-  summary["seconds"] = {{"read", params.read_seconds}, {"prepare", s.seconds_prepare},
+  summary["seconds"] = {{"read", params.read_seconds},          {"prepare", s.seconds_prepare},
                         {"consistency", s.seconds_consistency}, {"grids", s.seconds_grids},
-                        {"conflicts", s.seconds_conflicts}, {"time_series", s.seconds_time_series},
-                        {"detect_total", s.seconds_total()}, {"write", clock.seconds()}};
+                        {"conflicts", s.seconds_conflicts},     {"time_series", s.seconds_time_series},
+                        {"detect_total", s.seconds_total()},    {"write", clock.seconds()}};
   write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
 }
 

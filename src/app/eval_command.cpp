@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: MIT
 // `citymesh eval OUTPUT --truth SIMDIR`: scores a run's output against the simulator's ground
 // truth, object by object.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <CLI/CLI.hpp>
 #include <fstream>
 #include <iostream>
 #include <map>
@@ -63,7 +63,8 @@ void score_acquisition(const std::filesystem::path& ply, const std::filesystem::
   PlyVertexChunk vertices;
   PlyFaceChunk faces;
   std::vector<Vec3d> positions;
-  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end; kind = reader.next(vertices, faces)) {
+  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;
+       kind = reader.next(vertices, faces)) {
     if (kind == PlyReader::ChunkKind::vertices) {
       positions.insert(positions.end(), vertices.positions.begin(), vertices.positions.end());
       continue;
@@ -107,8 +108,12 @@ nlohmann::json evaluate(const std::map<std::uint32_t, ObjectInfo>& objects) {
     by_class[{o.cls, o.fate}].kept += o.kept_area;
     all_kept += o.kept_area;
     const double kept_fraction = o.area > 0 ? o.kept_area / o.area : 1.0;
-    per_object.push_back({{"id", id}, {"class", o.cls}, {"fate", o.fate}, {"triangles", o.triangles},
-                          {"area", o.area}, {"kept_fraction", kept_fraction}});
+    per_object.push_back({{"id", id},
+                          {"class", o.cls},
+                          {"fate", o.fate},
+                          {"triangles", o.triangles},
+                          {"area", o.area},
+                          {"kept_fraction", kept_fraction}});
     if (o.fate == "remove" && 1.0 - kept_fraction < worst_removed) {  // ties: the lowest id
       worst_removed = 1.0 - kept_fraction;
       worst_id = id;
@@ -118,7 +123,9 @@ nlohmann::json evaluate(const std::map<std::uint32_t, ObjectInfo>& objects) {
   for (const auto& [fate, t] : by_fate) total_area += t.area;
   nlohmann::json classes = nlohmann::json::array();
   for (const auto& [key, t] : by_class) {
-    classes.push_back({{"class", key.first}, {"fate", key.second}, {"area", t.area},
+    classes.push_back({{"class", key.first},
+                       {"fate", key.second},
+                       {"area", t.area},
                        {"kept_fraction", t.area > 0 ? t.kept / t.area : 1.0}});
   }
   const auto fraction = [&](const std::string& fate) {
@@ -142,8 +149,8 @@ nlohmann::json evaluate(const std::map<std::uint32_t, ObjectInfo>& objects) {
 void print_summary(const nlohmann::json& e, std::ostream& out) {
   out << fmt::format("{:<14} {:<12} {:>10} {:>8}\n", "class", "fate", "area m2", "kept %");
   for (const auto& c : e["classes"]) {
-    out << fmt::format("{:<14} {:<12} {:>10.1f} {:>8.2f}\n", c["class"].get<std::string>(), c["fate"].get<std::string>(),
-                       c["area"].get<double>(), 100 * c["kept_fraction"].get<double>());
+    out << fmt::format("{:<14} {:<12} {:>10.1f} {:>8.2f}\n", c["class"].get<std::string>(),
+                       c["fate"].get<std::string>(), c["area"].get<double>(), 100 * c["kept_fraction"].get<double>());
   }
   out << fmt::format("static completeness     {:.2f} % of the area of objects that must stay is kept\n",
                      100 * e["static_completeness"].get<double>());
@@ -154,8 +161,9 @@ void print_summary(const nlohmann::json& e, std::ostream& out) {
                      100 * e["dynamic_residue"].get<double>());
   out << fmt::format("unconfirmed kept        {:.2f} % (objects first seen less than Ts before the last scan)\n",
                      100 * e["unconfirmed_kept"].get<double>());
-  out << fmt::format("on no surface           {:.2f} % of the area (faces bridging depth jumps; {:.2f} % of them kept)\n",
-                     100 * e["no_surface_fraction"].get<double>(), 100 * e["no_surface_kept"].get<double>());
+  out << fmt::format(
+      "on no surface           {:.2f} % of the area (faces bridging depth jumps; {:.2f} % of them kept)\n",
+      100 * e["no_surface_fraction"].get<double>(), 100 * e["no_surface_kept"].get<double>());
 }
 
 class EvalCommand final : public Command {
@@ -164,11 +172,15 @@ class EvalCommand final : public Command {
   std::string_view summary() const override { return "score a run's output against a simulation's ground truth"; }
 
   void declare(CLI::App& app) override {
-    app.add_option("output", output_, "the run's output folder (holds detect/summary.json)")->required()
+    app.add_option("output", output_, "the run's output folder (holds detect/summary.json)")
+        ->required()
         ->check(CLI::ExistingDirectory);
-    app.add_option("--truth", truth_, "the citymesh simulate folder the run read")->required()->check(CLI::ExistingDirectory);
-    app.footer("Writes <output>/eval.json and prints a summary. Example:\n"
-               "  citymesh simulate --out sim && citymesh detect sim/config.toml && citymesh eval sim/out --truth sim");
+    app.add_option("--truth", truth_, "the citymesh simulate folder the run read")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    app.footer(
+        "Writes <output>/eval.json and prints a summary. Example:\n"
+        "  citymesh simulate --out sim && citymesh detect sim/config.toml && citymesh eval sim/out --truth sim");
   }
 
   void run() override {
@@ -178,7 +190,8 @@ class EvalCommand final : public Command {
     try {
       for (const auto& a : summary.at("acquisitions")) {
         const std::filesystem::path input = a.at("input").get<std::string>();
-        const std::filesystem::path truth = std::filesystem::path(truth_) / input.filename().replace_extension(".truth");
+        const std::filesystem::path truth =
+            std::filesystem::path(truth_) / input.filename().replace_extension(".truth");
         score_acquisition(detect / a.at("ply").get<std::string>(), truth, objects);
       }
     } catch (const nlohmann::json::exception& e) {

@@ -21,7 +21,8 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& gri
   const double length = std::max({norm(q[1] - q[0]), norm(q[2] - q[0]), norm(q[3] - q[0])});
   const auto steps = static_cast<int>(std::clamp(std::ceil(length / grid.voxel_size()), 1.0, 100000.0));
   const auto corner_box = [&](float t0, float t1, Vec3f& lo, Vec3f& hi) {
-    const Vec3f pts[6] = {lerp(v, a, t0), lerp(v, b, t0), lerp(v, c, t0), lerp(v, a, t1), lerp(v, b, t1), lerp(v, c, t1)};
+    const Vec3f pts[6] = {lerp(v, a, t0), lerp(v, b, t0), lerp(v, c, t0),
+                          lerp(v, a, t1), lerp(v, b, t1), lerp(v, c, t1)};
     lo = hi = pts[0];
     for (const Vec3f& p : pts) {
       lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
@@ -30,7 +31,8 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& gri
   };
   for (int k = 0; k < steps; ++k) {
     Vec3f lo, hi;
-    corner_box(static_cast<float>(k) / static_cast<float>(steps), static_cast<float>(k + 1) / static_cast<float>(steps), lo, hi);
+    corner_box(static_cast<float>(k) / static_cast<float>(steps), static_cast<float>(k + 1) / static_cast<float>(steps),
+               lo, hi);
     grid.mark_box(lo, hi);
   }
 }

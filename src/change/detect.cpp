@@ -58,9 +58,14 @@ void compute_time_series(const TriangleFrames& f, const ConflictFlags& conflicts
       bool keep = r.sustainable[g] != 0;
       if (!keep) {
         switch (params.unconfirmed) {
-          case UnconfirmedPolicy::drop: break;
-          case UnconfirmedPolicy::keep: keep = true; break;
-          case UnconfirmedPolicy::keep_unobserved: keep = !observed_later(f, g, grids); break;
+          case UnconfirmedPolicy::drop:
+            break;
+          case UnconfirmedPolicy::keep:
+            keep = true;
+            break;
+          case UnconfirmedPolicy::keep_unobserved:
+            keep = !observed_later(f, g, grids);
+            break;
         }
       }
       r.kept[g] = keep ? 1 : 0;

@@ -13,17 +13,23 @@ namespace citymesh {
 
 std::string_view unconfirmed_policy_name(UnconfirmedPolicy p) {
   switch (p) {
-    case UnconfirmedPolicy::drop: return "drop";
-    case UnconfirmedPolicy::keep: return "keep";
-    default: return "keep-unobserved";
+    case UnconfirmedPolicy::drop:
+      return "drop";
+    case UnconfirmedPolicy::keep:
+      return "keep";
+    default:
+      return "keep-unobserved";
   }
 }
 
 std::string_view triangle_state_name(TriangleState s) {
   switch (s) {
-    case TriangleState::consistent: return "consistent";
-    case TriangleState::conflicting: return "conflicting";
-    default: return "single";
+    case TriangleState::consistent:
+      return "consistent";
+    case TriangleState::conflicting:
+      return "conflicting";
+    default:
+      return "single";
   }
 }
 
@@ -38,7 +44,8 @@ namespace {
 
 void check_input(const ChangeInput& input) {
   if (input.meshes.size() != input.dates.size()) {
-    throw ProcessingError(fmt::format("change detection: {} meshes but {} dates", input.meshes.size(), input.dates.size()));
+    throw ProcessingError(
+        fmt::format("change detection: {} meshes but {} dates", input.meshes.size(), input.dates.size()));
   }
   for (std::size_t a = 0; a < input.meshes.size(); ++a) {
     const Mesh& m = input.meshes[a];
@@ -53,19 +60,20 @@ void check_input(const ChangeInput& input) {
   std::size_t total = 0;
   for (const Mesh& m : input.meshes) total += m.triangle_count();
   if (total >= (std::size_t{1} << 32)) {
-    throw ProcessingError(fmt::format("change detection: {} triangles in one set (at most 2^32 - 1; use tiles)", total));
+    throw ProcessingError(
+        fmt::format("change detection: {} triangles in one set (at most 2^32 - 1; use tiles)", total));
   }
 }
 
-Vec3d corner(const Mesh& m, std::size_t t, int k) { return Vec3d(m.positions[m.triangles[t][static_cast<std::size_t>(k)]]); }
+Vec3d corner(const Mesh& m, std::size_t t, int k) {
+  return Vec3d(m.positions[m.triangles[t][static_cast<std::size_t>(k)]]);
+}
 
 }  // namespace
 
 TriangleCorners TriangleFrames::corners(std::size_t g) const {
-  const std::uint32_t a = index.acquisition_of(g);
-  const std::size_t t = g - index.offsets[a];
-  const Mesh& m = meshes[a];
-  return {corner(m, t, 0), corner(m, t, 1), corner(m, t, 2)};
+  const std::array<Vec3f, 3>& c = corner[g];
+  return {Vec3d(c[0]), Vec3d(c[1]), Vec3d(c[2])};
 }
 
 TetrahedronCorners TriangleFrames::empty_space(std::size_t g) const {
@@ -80,8 +88,8 @@ namespace {
 Box3f padded_box(std::span<const Vec3d> points) {
   Box3d b;
   for (const Vec3d& p : points) b.extend(p);
-  const double pad = 1e-5 + 1e-6 * std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z),
-                                             std::abs(b.max.x), std::abs(b.max.y), std::abs(b.max.z)});
+  const double pad = 1e-5 + 1e-6 * std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x),
+                                             std::abs(b.max.y), std::abs(b.max.z)});
   return {Vec3f(b.min - Vec3d{pad, pad, pad}), Vec3f(b.max + Vec3d{pad, pad, pad})};
 }
 }  // namespace
@@ -104,6 +112,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
   f.index.offsets.assign(1, 0);
   for (const Mesh& m : input.meshes) f.index.offsets.push_back(f.index.offsets.back() + m.triangle_count());
   const std::size_t n = f.index.size();
+  f.corner.resize(n);
   f.centroid.resize(n);
   f.normal.resize(n);
   f.viewpoint.resize(n);
@@ -117,7 +126,8 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
         const Vec3d p0 = corner(m, t, 0), p1 = corner(m, t, 1), p2 = corner(m, t, 2);
         const Vec3d c = (p0 + p1 + p2) / 3.0;
         const Vec3d v = (Vec3d(m.sensor_positions[tri[0]]) + Vec3d(m.sensor_positions[tri[1]]) +
-                         Vec3d(m.sensor_positions[tri[2]])) / 3.0;
+                         Vec3d(m.sensor_positions[tri[2]])) /
+                        3.0;
         Vec3d normal = cross(p1 - p0, p2 - p0);
         const double len = norm(normal);
         normal = len > 0 ? normal / len : Vec3d{0, 0, 0};
@@ -127,6 +137,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
           h = -h;
         }
         const std::size_t g = base + t;
+        f.corner[g] = {m.positions[tri[0]], m.positions[tri[1]], m.positions[tri[2]]};
         f.centroid[g] = Vec3f(c);
         f.normal[g] = Vec3f(normal);
         f.viewpoint[g] = Vec3f(v);

@@ -3,6 +3,7 @@
 // the steps of detect_changes as free functions.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "citymesh/change/detect.h"
@@ -17,6 +18,7 @@ struct TriangleFrames {
   std::span<const Mesh> meshes;
   std::vector<TimePoint> dates;  ///< per acquisition
   GlobalTriangles index;
+  std::vector<std::array<Vec3f, 3>> corner;  ///< copied out of the meshes for locality
   std::vector<Vec3f> centroid;
   std::vector<Vec3f> normal;     ///< unit, turned towards the viewpoint
   std::vector<Vec3f> viewpoint;  ///< barycentre of the corners' sensor positions

@@ -116,6 +116,31 @@ KeyDef duration_key(std::string_view section, std::string_view name, std::string
           [=](const Config& c) { return toml_string(format_duration(get(c))); }};
 }
 
+/// A string key naming one of `values` (name, enum value); the help lists the names.
+template <class Get, class E>
+KeyDef enum_key(std::string_view section, std::string_view name, std::string_view help, Get get,
+                std::vector<std::pair<std::string, E>> values) {
+  std::vector<std::string> quoted;
+  for (const auto& v : values) quoted.push_back(toml_string(v.first));
+  return {section, name, fmt::format("{}: {}", help, fmt::join(quoted, ", ")), "",
+          [=](Config& c, const toml::node& n, const KeyContext& k) {
+            const std::string s = read_string(n, k);
+            for (const auto& v : values) {
+              if (v.first == s) {
+                get(c) = v.second;
+                return;
+              }
+            }
+            k.fail(fmt::format("'{}': expected one of {}", s, fmt::join(quoted, ", ")));
+          },
+          [=](const Config& c) {
+            for (const auto& v : values) {
+              if (v.second == get(c)) return toml_string(v.first);
+            }
+            return std::string();
+          }};
+}
+
 std::vector<KeyDef> make_keys() {
   using P = std::string_view;
   std::vector<KeyDef> keys;
@@ -160,23 +185,25 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(duration_key(change, "sustainability",
       "Ts: a surface seen over at least this span is sustainable (e.g. \"30d\", \"12h\")",
       [](auto& c) -> auto& { return c.change.sustainability; }));
+  keys.push_back(enum_key(change, "unconfirmed",
+      "triangles neither conflicting nor sustainable: drop them (the paper), keep them unless a newer scan "
+      "saw their place (keep-unobserved), or keep them",
+      [](auto& c) -> auto& { return c.change.unconfirmed; },
+      std::vector<std::pair<std::string, UnconfirmedPolicy>>{{"drop", UnconfirmedPolicy::drop},
+                                                             {"keep-unobserved", UnconfirmedPolicy::keep_unobserved},
+                                                             {"keep", UnconfirmedPolicy::keep}}));
+  keys.push_back(real_key(change, "voxel_size",
+      "voxel edge of the empty-space grids used by the pre-filter and keep-unobserved (metres)",
+      [](auto& c) -> auto& { return c.change.voxel_size; }, 0.05, 10));
+  keys.push_back(bool_key(change, "prefilter",
+      "skip exact conflict tests where the empty-space grids show no newer empty space (never changes results)",
+      [](auto& c) -> auto& { return c.change.prefilter; }));
 
-  keys.push_back({mosaic, "quality",
-      "per-triangle quality Q: \"constant\" (favours the finer mesh), \"area\" or \"resolution\"", "",
-      [](Config& c, const toml::node& n, const KeyContext& k) {
-        const std::string s = read_string(n, k);
-        if (s == "constant") c.mosaic.quality = QualityMeasure::constant;
-        else if (s == "area") c.mosaic.quality = QualityMeasure::area;
-        else if (s == "resolution") c.mosaic.quality = QualityMeasure::resolution;
-        else k.fail(fmt::format("'{}': expected \"constant\", \"area\" or \"resolution\"", s));
-      },
-      [](const Config& c) {
-        switch (c.mosaic.quality) {
-          case QualityMeasure::area: return toml_string("area");
-          case QualityMeasure::resolution: return toml_string("resolution");
-          default: return toml_string("constant");
-        }
-      }});
+  keys.push_back(enum_key(mosaic, "quality", "per-triangle quality Q (constant favours the finer mesh)",
+      [](auto& c) -> auto& { return c.mosaic.quality; },
+      std::vector<std::pair<std::string, QualityMeasure>>{{"constant", QualityMeasure::constant},
+                                                          {"area", QualityMeasure::area},
+                                                          {"resolution", QualityMeasure::resolution}}));
   keys.push_back(real_key(mosaic, "quality_weight", "lambda 1: reward for keeping quality",
       [](auto& c) -> auto& { return c.mosaic.quality_weight; }, 0, 1e6));
   keys.push_back(real_key(mosaic, "boundary_weight", "lambda 2: cost per metre of mesh boundary kept",

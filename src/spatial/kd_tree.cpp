@@ -49,7 +49,7 @@ struct IndexCollector {
 };
 }  // namespace
 
-void PointKdTree::radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& out) const {
+void PointKdTree::radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& out, bool sorted) const {
   out.clear();
   if (size() == 0) return;
   const float q[3] = {query.x, query.y, query.z};
@@ -58,7 +58,7 @@ void PointKdTree::radius_search(const Vec3f& query, float radius, std::vector<st
   // The search prunes cells farther than worstDist(); nudged up so the bound is inclusive.
   IndexCollector collect{std::nextafter(radius * radius, INFINITY), out};
   impl_->tree.radiusSearchCustomCallback(q, collect, params);
-  std::sort(out.begin(), out.end());
+  if (sorted) std::sort(out.begin(), out.end());
 }
 
 std::vector<std::uint32_t> PointKdTree::nearest(const Vec3f& query, std::size_t k) const {

@@ -24,9 +24,9 @@ enum class UnconfirmedPolicy {
 };
 
 struct ChangeParams {
-  double distance_threshold = 0.10;  ///< metres: closer surfaces are the same surface
-  double conflict_margin = 0.10;     ///< metres: depth into a newer empty space needed to conflict
-  double normal_angle = 45.0;        ///< degrees between normals of consistent triangles
+  double distance_threshold = 0.10;                 ///< metres: closer surfaces are the same surface
+  double conflict_margin = 0.10;                    ///< metres: depth into a newer empty space needed to conflict
+  double normal_angle = 45.0;                       ///< degrees between normals of consistent triangles
   Duration sustainability = std::chrono::days(30);  ///< Ts
   UnconfirmedPolicy unconfirmed = UnconfirmedPolicy::keep_unobserved;
   double voxel_size = 0.5;  ///< metres: the empty-space grids of the pre-filter and the policy

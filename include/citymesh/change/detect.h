@@ -38,7 +38,7 @@ using TrianglePair = std::pair<std::uint32_t, std::uint32_t>;
 
 struct ChangeStats {
   std::uint64_t triangles = 0;
-  std::uint64_t samples = 0;              ///< kd-tree points
+  std::uint64_t samples = 0;  ///< kd-tree points
   std::uint64_t consistent_pairs = 0;
   std::uint64_t conflict_candidates = 0;  ///< (triangle, newer acquisition) pairs without consistency
   std::uint64_t prefilter_skipped = 0;    ///< of those, ruled out by the empty-space grids
@@ -56,12 +56,12 @@ struct ChangeStats {
 
 struct ChangeResult {
   GlobalTriangles index;
-  std::vector<TriangleState> state;         ///< per global triangle
+  std::vector<TriangleState> state;  ///< per global triangle
   std::vector<TimePoint> first_seen, last_seen;
-  std::vector<std::uint8_t> sustainable;    ///< last_seen - first_seen >= Ts
-  std::vector<std::uint8_t> kept;           ///< survives the time series (not conflicting; sustainable or
-                                            ///< kept by the unconfirmed policy)
-  std::vector<std::uint8_t> refutes;        ///< its empty space made an older triangle conflict
+  std::vector<std::uint8_t> sustainable;  ///< last_seen - first_seen >= Ts
+  std::vector<std::uint8_t> kept;         ///< survives the time series (not conflicting; sustainable or
+                                          ///< kept by the unconfirmed policy)
+  std::vector<std::uint8_t> refutes;      ///< its empty space made an older triangle conflict
   std::vector<TrianglePair> consistent_pairs;
   ChangeStats stats;
 };

@@ -21,8 +21,9 @@ class PointKdTree {
 
   [[nodiscard]] std::size_t size() const;
   /// Indices of the points within `radius` (metres, inclusive) of `query`, in increasing index
-  /// order so that results never depend on the tree's internal order.
-  void radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& out) const;
+  /// order so that results never depend on the tree's internal order; `sorted = false` skips
+  /// the sort for callers that only use the set.
+  void radius_search(const Vec3f& query, float radius, std::vector<std::uint32_t>& out, bool sorted = true) const;
   /// The `k` nearest points, nearest first; equal distances by increasing index.
   [[nodiscard]] std::vector<std::uint32_t> nearest(const Vec3f& query, std::size_t k) const;
 
