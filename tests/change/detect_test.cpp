@@ -1,0 +1,282 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/change/detect.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <set>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/geometry.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/scan/sensor_grid.h"
+#include "citymesh/sim/scanner.h"
+#include "citymesh/sim/scene.h"
+
+namespace citymesh {
+namespace {
+
+using namespace std::chrono_literals;
+
+const TimePoint kDay0 = parse_iso8601("2026-01-05T10:00:00Z", "test");
+TimePoint day(int d) { return kDay0 + std::chrono::days(d); }
+
+/// A grid of square cells (two triangles each) in the plane z = height over [x0, x1] x [y0, y1],
+/// seen from a sensor at `sensor`, with optional per-vertex jitter of the height.
+void add_patch(Mesh& m, double x0, double x1, double y0, double y1, double height, double cell, const Vec3f& sensor,
+               std::mt19937* jitter = nullptr) {
+  const auto nx = static_cast<std::uint32_t>(std::lround((x1 - x0) / cell));
+  const auto ny = static_cast<std::uint32_t>(std::lround((y1 - y0) / cell));
+  const auto base = static_cast<std::uint32_t>(m.positions.size());
+  std::normal_distribution<float> noise(0.0f, 0.004f);
+  for (std::uint32_t j = 0; j <= ny; ++j) {
+    for (std::uint32_t i = 0; i <= nx; ++i) {
+      const float z = static_cast<float>(height) + (jitter != nullptr ? noise(*jitter) : 0.0f);
+      m.positions.push_back({static_cast<float>(x0 + i * cell), static_cast<float>(y0 + j * cell), z});
+      m.sensor_positions.push_back(sensor);
+    }
+  }
+  for (std::uint32_t j = 0; j < ny; ++j) {
+    for (std::uint32_t i = 0; i < nx; ++i) {
+      const std::uint32_t a = base + j * (nx + 1) + i, b = a + 1, c = a + nx + 1, d = c + 1;
+      m.triangles.push_back({a, b, d});
+      m.triangles.push_back({a, d, c});
+    }
+  }
+}
+
+void finish(Mesh& m, std::uint32_t acquisition) {
+  m.triangle_ids.clear();
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) m.triangle_ids.push_back({acquisition, 0, t});
+}
+
+/// A wall (plane x = x_wall, facing -x) from y0 to y1, z0 to z1.
+void add_wall(Mesh& m, double x_wall, double y0, double y1, double z0, double z1, double cell, const Vec3f& sensor) {
+  const std::size_t first = m.positions.size();
+  add_patch(m, y0, y1, z0, z1, x_wall, cell, sensor);
+  for (std::size_t v = first; v < m.positions.size(); ++v) {
+    const Vec3f p = m.positions[v];
+    m.positions[v] = {p.z, p.x, p.y};  // (y, z, x) -> (x, y, z)
+  }
+}
+
+ChangeResult detect(const std::vector<Mesh>& meshes, const std::vector<TimePoint>& dates, ChangeParams params = {}) {
+  return detect_changes({meshes, dates}, params);
+}
+
+// ---- consistency against brute force --------------------------------------------------
+
+bool projects_inside(const Vec3d& c, const TriangleCorners& q, double threshold) {
+  Vec3d n = cross(q[1] - q[0], q[2] - q[0]);
+  n = n / norm(n);
+  const double h = dot(c - q[0], n);
+  if (std::abs(h) > threshold) return false;
+  const Vec3d p = c - n * h;
+  // Barycentric coordinates of p.
+  const Vec3d v0 = q[1] - q[0], v1 = q[2] - q[0], v2 = p - q[0];
+  const double d00 = dot(v0, v0), d01 = dot(v0, v1), d11 = dot(v1, v1), d20 = dot(v2, v0), d21 = dot(v2, v1);
+  const double den = d00 * d11 - d01 * d01;
+  const double b = (d11 * d20 - d01 * d21) / den, g = (d00 * d21 - d01 * d20) / den;
+  return b >= -1e-9 && g >= -1e-9 && b + g <= 1 + 1e-9;
+}
+
+TEST(Consistency, PairsEqualBruteForceOnNoisyOverlappingPatches) {
+  std::mt19937 rng(11);
+  std::vector<Mesh> meshes(3);
+  // Three passes over the same ground at different resolutions and offsets, one with a
+  // tilted patch (normals too far apart) and one with a patch 30 cm up (too far).
+  add_patch(meshes[0], 0, 3, 0, 2, 0.0, 0.1, {1.5f, -3, 2.5f}, &rng);
+  add_patch(meshes[1], 0.05, 3.05, 0.02, 2.02, 0.0, 0.15, {1.5f, -3, 2.5f}, &rng);
+  add_patch(meshes[1], 0, 1, 3, 4, 0.3, 0.1, {0.5f, 1, 2.5f});
+  add_patch(meshes[2], 0.5, 2.5, 0.5, 1.5, 0.05, 0.25, {1.5f, -3, 2.5f}, &rng);
+  add_patch(meshes[0], 0, 1, 3, 4, 0.0, 0.1, {0.5f, 1, 2.5f});
+  for (std::uint32_t a = 0; a < 3; ++a) finish(meshes[a], a);
+  const ChangeResult r = detect(meshes, {day(0), day(10), day(40)});
+
+  std::vector<TrianglePair> expected;
+  std::vector<std::pair<std::uint32_t, std::size_t>> all;  // (acquisition, triangle)
+  for (std::uint32_t a = 0; a < 3; ++a) {
+    for (std::size_t t = 0; t < meshes[a].triangle_count(); ++t) all.emplace_back(a, t);
+  }
+  const auto corners = [&](std::uint32_t a, std::size_t t) {
+    const Mesh& m = meshes[a];
+    return TriangleCorners{Vec3d(m.positions[m.triangles[t][0]]), Vec3d(m.positions[m.triangles[t][1]]),
+                           Vec3d(m.positions[m.triangles[t][2]])};
+  };
+  const auto up_normal = [&](const TriangleCorners& q) {
+    Vec3d n = cross(q[1] - q[0], q[2] - q[0]);
+    n = n / norm(n);
+    return n.z < 0 ? n * -1.0 : n;  // every sensor is above: normals face up
+  };
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    for (std::size_t j = i + 1; j < all.size(); ++j) {
+      if (all[i].first == all[j].first) continue;
+      const TriangleCorners p = corners(all[i].first, all[i].second), q = corners(all[j].first, all[j].second);
+      if (dot(up_normal(p), up_normal(q)) < std::cos(45.0 * M_PI / 180)) continue;
+      const Vec3d cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
+      if (projects_inside(cp, q, 0.1) || projects_inside(cq, p, 0.1)) {
+        expected.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+      }
+    }
+  }
+  ASSERT_GT(expected.size(), 500u);
+  EXPECT_EQ(r.consistent_pairs, expected);
+}
+
+// ---- conflicts ---------------------------------------------------------------------------
+
+/// Ground seen from x = -5 in both passes; the older pass also saw a wall at x = 2 which the
+/// newer pass sees through (the ground behind it is seen).
+std::vector<Mesh> wall_then_gone() {
+  std::vector<Mesh> m(2);
+  const Vec3f sensor{-5, 1, 2.5f};
+  add_patch(m[0], -4, 1.8, 0, 2, 0.0, 0.2, sensor);  // 29 x 10 cells
+  add_wall(m[0], 2.0, 0, 2, 0.2, 1.8, 0.2, sensor);
+  add_patch(m[1], -4, 30, -8, 10, 0.0, 0.2, sensor);  // far and wide enough to see through all the wall
+  finish(m[0], 0);
+  finish(m[1], 1);
+  return m;
+}
+
+TEST(Conflicts, ASurfaceSeenThroughLaterConflictsAndTheGroundStays) {
+  const std::vector<Mesh> m = wall_then_gone();
+  const ChangeResult r = detect(m, {day(0), day(40)});
+  const std::size_t ground0 = 2 * 29 * 10;  // triangles of the first patch
+  for (std::size_t t = 0; t < m[0].triangle_count(); ++t) {
+    const bool wall = t >= ground0;
+    EXPECT_EQ(r.state[t], wall ? TriangleState::conflicting : TriangleState::consistent) << t;
+    EXPECT_EQ(r.kept[t], wall ? 0 : 1) << t;
+  }
+  // Newer ground behind the old wall proves it gone: some of it refutes.
+  EXPECT_GT(std::count(r.refutes.begin() + r.index.offsets[1], r.refutes.end(), 1), 10);
+}
+
+TEST(Conflicts, ANewSurfaceInOlderEmptySpaceIsNotAConflict) {
+  std::vector<Mesh> m = wall_then_gone();
+  std::swap(m[0], m[1]);  // the wall is now the newer pass
+  finish(m[0], 0);
+  finish(m[1], 1);
+  const ChangeResult r = detect(m, {day(0), day(40)});
+  EXPECT_EQ(std::count(r.state.begin(), r.state.end(), TriangleState::conflicting), 0);
+}
+
+TEST(Conflicts, NoiseWithinTheMarginIsNotAConflict) {
+  std::mt19937 rng(2);
+  std::vector<Mesh> m(2);
+  // Same ground, the older one 6 cm higher and coarser in places: consistent or within the margin.
+  add_patch(m[0], 0, 4, 0, 2, 0.06, 0.3, {2, -4, 2.5f}, &rng);
+  add_patch(m[1], 0, 4, 0, 2, 0.0, 0.1, {2, -4, 2.5f}, &rng);
+  finish(m[0], 0);
+  finish(m[1], 1);
+  ChangeParams p;
+  p.normal_angle = 0.001;  // nothing is consistent: only the margin protects the older ground
+  const ChangeResult r = detect(m, {day(0), day(40)}, p);
+  EXPECT_EQ(std::count(r.state.begin(), r.state.end(), TriangleState::conflicting), 0);
+}
+
+// ---- time series and policies ----------------------------------------------------------
+
+TEST(TimeSeries, FirstAndLastSeenSpanPartnersAndDecideSustainability) {
+  std::vector<Mesh> m(3);
+  const Vec3f s{1, -3, 2.5f};
+  add_patch(m[0], 0, 2, 0, 2, 0, 0.2, s);  // ground, three times
+  add_patch(m[1], 0, 2, 0, 2, 0, 0.2, s);
+  add_patch(m[2], 0, 2, 0, 2, 0, 0.2, s);
+  add_patch(m[1], 5, 6, 0, 1, 0, 0.2, s);  // a patch seen only in the middle pass, not looked at later
+  add_patch(m[2], 8, 9, 0, 1, 0, 0.2, s);  // a patch seen only in the last pass
+  for (std::uint32_t a = 0; a < 3; ++a) finish(m[a], a);
+  const std::vector<TimePoint> dates{day(0), day(20), day(45)};
+  const std::size_t ground = 200;
+  for (UnconfirmedPolicy policy : {UnconfirmedPolicy::drop, UnconfirmedPolicy::keep_unobserved, UnconfirmedPolicy::keep}) {
+    ChangeParams p;
+    p.unconfirmed = policy;
+    const ChangeResult r = detect(m, dates, p);
+    for (std::size_t t = 0; t < ground; ++t) {
+      EXPECT_EQ(r.first_seen[t], day(0));
+      EXPECT_EQ(r.last_seen[t], day(45));
+      EXPECT_EQ(r.sustainable[t], 1);
+      EXPECT_EQ(r.kept[t], 1);
+    }
+    const std::size_t lone = r.index.offsets[1] + ground, last_only = r.index.offsets[2] + ground;
+    EXPECT_EQ(r.state[lone], TriangleState::single);
+    EXPECT_EQ(r.first_seen[lone], day(20));
+    EXPECT_EQ(r.sustainable[lone], 0);
+    EXPECT_EQ(r.sustainable[last_only], 0);
+    const std::uint8_t expected = policy == UnconfirmedPolicy::drop ? 0 : 1;
+    EXPECT_EQ(r.kept[lone], expected) << unconfirmed_policy_name(policy);
+    EXPECT_EQ(r.kept[last_only], expected) << unconfirmed_policy_name(policy);
+  }
+}
+
+TEST(TimeSeries, KeepUnobservedDropsWhatANewerPassLookedAtWithoutConfirming) {
+  std::vector<Mesh> m(2);
+  const Vec3f s{1, -3, 2.5f};
+  add_patch(m[0], 0, 2, 0, 2, 0.05, 0.2, s);  // 5 cm above the newer ground:
+  add_patch(m[1], 0, 2, 0, 2, 0.0, 0.2, s);
+  finish(m[0], 0);
+  finish(m[1], 1);
+  ChangeParams p;
+  p.distance_threshold = 0.02;  // too far to be the same surface, within the conflict margin
+  const ChangeResult r = detect(m, {day(0), day(10)}, p);
+  for (std::size_t t = 0; t < m[0].triangle_count(); ++t) {
+    EXPECT_EQ(r.state[t], TriangleState::single);
+    EXPECT_EQ(r.kept[t], 0) << t;  // the newer pass's empty space reaches its voxels
+  }
+  p.unconfirmed = UnconfirmedPolicy::keep;
+  EXPECT_EQ(detect(m, {day(0), day(10)}, p).kept[0], 1);
+}
+
+// ---- on a simulated street: pre-filter and threads change nothing ------------------------
+
+std::vector<Mesh> simulated_street(std::vector<TimePoint>& dates) {
+  StreetParams street;
+  street.length = 30.0f;
+  const Scene scene = make_street_scene(street);
+  ScannerParams scanner;
+  std::vector<Mesh> meshes;
+  for (std::size_t k = 0; k < 4; ++k) {
+    const std::vector<SensorGrid> grids = scan_epoch(scene, k, scanner);
+    Mesh m = mesh_sensor_grid(grids.front(), {}, static_cast<std::uint32_t>(k)).mesh;
+    meshes.push_back(std::move(m));
+    dates.push_back(scene.epochs[k].date);
+  }
+  return meshes;
+}
+
+void expect_same(const ChangeResult& a, const ChangeResult& b) {
+  EXPECT_EQ(a.consistent_pairs, b.consistent_pairs);
+  EXPECT_EQ(a.state, b.state);
+  EXPECT_EQ(a.kept, b.kept);
+  EXPECT_EQ(a.refutes, b.refutes);
+  EXPECT_EQ(a.first_seen, b.first_seen);
+  EXPECT_EQ(a.last_seen, b.last_seen);
+}
+
+TEST(DetectChanges, PrefilterAndThreadCountNeverChangeTheResult) {
+  std::vector<TimePoint> dates;
+  const std::vector<Mesh> meshes = simulated_street(dates);
+  ChangeParams with, without;
+  without.prefilter = false;
+  const ChangeResult a = detect(meshes, dates, with), b = detect(meshes, dates, without);
+  expect_same(a, b);
+  EXPECT_GT(a.stats.prefilter_skipped, 0u);
+  EXPECT_LT(a.stats.exact_tests, b.stats.exact_tests);
+  EXPECT_GT(std::count(a.state.begin(), a.state.end(), TriangleState::conflicting), 100);
+  const ThreadLimit one(1);
+  expect_same(a, detect(meshes, dates, with));
+}
+
+TEST(DetectChanges, RejectsMeshesInDifferentFramesOrWithoutSensors) {
+  std::vector<Mesh> m = wall_then_gone();
+  m[1].origin = {1, 0, 0};
+  EXPECT_THROW(detect(m, {day(0), day(1)}), ProcessingError);
+  m = wall_then_gone();
+  m[1].sensor_positions.clear();
+  EXPECT_THROW(detect(m, {day(0), day(1)}), ProcessingError);
+  EXPECT_THROW(detect(wall_then_gone(), {day(0)}), ProcessingError);
+}
+
+}  // namespace
+}  // namespace citymesh
