@@ -153,7 +153,7 @@ toml("bad_duration.toml", cfg(extra='[change]\nsustainability = "30 days"\n'), "
 toml("bad_size.toml", cfg(extra='[run]\nmemory = "2 gigs"\n'), "expected a size")
 toml("small_memory.toml", cfg(extra='[run]\nmemory = "1MiB"\n'), "at least 64MiB")
 toml("fractional_threads.toml", cfg(extra="[run]\nthreads = 1.5\n"), "expected a whole number")
-toml("bad_quality.toml", cfg(extra='[mosaic]\nquality = "best"\n'), "expected \"constant\", \"area\"")
+toml("bad_quality.toml", cfg(extra='[mosaic]\nquality = "best"\n'), "expected one of \"constant\", \"area\"")
 toml("sensor_origin_two_names.toml", cfg(extra='[input]\nsensor_origin = ["ox", "oy"]\n'),
      "expected an array of 3 strings")
 toml("halo_too_big.toml", cfg(extra="[tiling]\ntile_size = 10\nhalo = 6\n"), "less than half")
