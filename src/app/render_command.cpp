@@ -11,6 +11,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/render/render.h"
+#include "citymesh/sim/scanner.h"
 #include "citymesh/sim/simulate.h"
 #include "command.h"
 
@@ -110,6 +111,10 @@ class RenderCommand final : public Command {
       const std::vector<std::uint32_t> truth = read_truth(truth_path.replace_extension(".truth"));
       if (truth.size() != out.size()) throw InputError(fmt::format("{}: ground truth does not match the mesh", truth_path.string()));
       for (std::size_t t = 0; t < out.size(); ++t) {
+        if (truth[t] == kNoSurface) {  // a facet bridging a depth jump
+          out[t] = {200, 200, 200};
+          continue;
+        }
         const auto style = classes.find(truth[t]);
         if (style == classes.end()) {
           throw InputError(fmt::format("{}: face {} names object {}, absent from objects.json", truth_path.string(), t,

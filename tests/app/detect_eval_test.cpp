@@ -18,6 +18,8 @@ TEST(DetectEval, DefaultStreetMeetsTheRemovalAndCompletenessTargets) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {}", sim)).exit_code, 0);
+  // Faces on no surface (bridging depth jumps) are drawn too, not rejected.
+  EXPECT_EQ(test::run_citymesh(fmt::format("render --sim {} --epoch 3 --color class --out {}/e3.png", sim, sim)).exit_code, 0);
   const auto detect = test::run_citymesh(fmt::format("detect {}/config.toml", sim));
   ASSERT_EQ(detect.exit_code, 0) << detect.err;
   const auto eval = test::run_citymesh(fmt::format("eval {}/out --truth {}", sim, sim));
