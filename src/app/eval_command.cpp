@@ -12,7 +12,6 @@
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/io/ply_reader.h"
-#include "citymesh/sim/scanner.h"
 #include "citymesh/sim/simulate.h"
 #include "command.h"
 #include "detect_output.h"
@@ -37,18 +36,9 @@ struct ObjectInfo {
   std::uint64_t triangles = 0;
 };
 
-std::map<std::uint32_t, ObjectInfo> read_objects(const std::filesystem::path& sim) {
-  const nlohmann::json j = read_json(sim / "objects.json", "the simulator's objects");
+std::map<std::uint32_t, ObjectInfo> objects_by_id(const std::filesystem::path& sim) {
   std::map<std::uint32_t, ObjectInfo> objects;
-  try {
-    for (const auto& o : j.at("objects")) {
-      objects[o.at("id").get<std::uint32_t>()] = {o.at("class").get<std::string>(), o.at("fate").get<std::string>()};
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: {}", (sim / "objects.json").string(), e.what()));
-  }
-  // Faces lying on no scene surface (bridging a depth jump) are scored apart from every target.
-  objects[kNoSurface] = {"no_surface", "none"};
+  for (ObjectRecord& o : read_objects(sim)) objects[o.id] = {std::move(o.cls), std::move(o.fate)};
   return objects;
 }
 
@@ -186,7 +176,7 @@ class EvalCommand final : public Command {
   void run() override {
     const std::filesystem::path detect = std::filesystem::path(output_) / "detect";
     const nlohmann::json summary = read_json(detect / "summary.json", "run citymesh detect first");
-    std::map<std::uint32_t, ObjectInfo> objects = read_objects(truth_);
+    std::map<std::uint32_t, ObjectInfo> objects = objects_by_id(truth_);
     try {
       for (const auto& a : summary.at("acquisitions")) {
         const std::filesystem::path input = a.at("input").get<std::string>();

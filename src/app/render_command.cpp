@@ -3,15 +3,12 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include <fstream>
 #include <iostream>
 #include <map>
-#include <nlohmann/json.hpp>
 
 #include "citymesh/core/error.h"
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/render/render.h"
-#include "citymesh/sim/scanner.h"
 #include "citymesh/sim/simulate.h"
 #include "command.h"
 
@@ -28,20 +25,12 @@ struct ObjectStyle {
 /// Object id -> class and colour, from a simulation's objects.json. Classes take palette
 /// colours in the order they first appear, so colours are stable for a scene.
 std::map<std::uint32_t, ObjectStyle> object_classes(const std::filesystem::path& sim) {
-  std::ifstream in(sim / "objects.json");
-  if (!in) throw InputError(fmt::format("{}: no objects.json (is this a citymesh simulate folder?)", sim.string()));
   std::map<std::uint32_t, ObjectStyle> classes;
   std::map<std::string, Rgb8> class_colors;
-  try {
-    const nlohmann::json objects = nlohmann::json::parse(in);  // named: iterating a temporary's member dangles
-    for (const auto& o : objects.at("objects")) {
-      const std::string cls = o.at("class");
-      const auto [it, added] = class_colors.emplace(cls, Rgb8{});
-      if (added) it->second = palette_color(static_cast<std::uint32_t>(class_colors.size() - 1));
-      classes[o.at("id").get<std::uint32_t>()] = {cls, it->second};
-    }
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: objects.json: {}", sim.string(), e.what()));
+  for (const ObjectRecord& o : read_objects(sim)) {
+    const auto [it, added] = class_colors.emplace(o.cls, Rgb8{});
+    if (added) it->second = palette_color(static_cast<std::uint32_t>(class_colors.size() - 1));
+    classes[o.id] = {o.cls, it->second};
   }
   return classes;
 }
@@ -111,10 +100,6 @@ class RenderCommand final : public Command {
       const std::vector<std::uint32_t> truth = read_truth(truth_path.replace_extension(".truth"));
       if (truth.size() != out.size()) throw InputError(fmt::format("{}: ground truth does not match the mesh", truth_path.string()));
       for (std::size_t t = 0; t < out.size(); ++t) {
-        if (truth[t] == kNoSurface) {  // a facet bridging a depth jump
-          out[t] = {200, 200, 200};
-          continue;
-        }
         const auto style = classes.find(truth[t]);
         if (style == classes.end()) {
           throw InputError(fmt::format("{}: face {} names object {}, absent from objects.json", truth_path.string(), t,

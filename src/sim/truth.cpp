@@ -7,6 +7,9 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include <nlohmann/json.hpp>
+
+#include "citymesh/sim/scanner.h"
 #include "citymesh/sim/simulate.h"
 
 namespace citymesh {
@@ -72,6 +75,24 @@ std::vector<std::uint32_t> read_truth(const std::filesystem::path& path) {
     throw InputError(fmt::format("{}: ground truth checksum mismatch", path.string()));
   }
   return ids;
+}
+
+std::vector<ObjectRecord> read_objects(const std::filesystem::path& sim) {
+  const std::filesystem::path file = sim / "objects.json";
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot open (is {} a citymesh simulate folder?)", file.string(), sim.string()));
+  std::vector<ObjectRecord> records;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);  // named: iterating a temporary's member dangles
+    for (const auto& o : j.at("objects")) {
+      records.push_back({o.at("id").get<std::uint32_t>(), o.at("class").get<std::string>(), o.at("fate").get<std::string>()});
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: {}", file.string(), e.what()));
+  }
+  // Faces lying on no scene surface (bridging a depth jump) are labelled kNoSurface.
+  records.push_back({kNoSurface, "no_surface", "none"});
+  return records;
 }
 
 }  // namespace citymesh

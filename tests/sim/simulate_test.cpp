@@ -88,6 +88,17 @@ TEST(Simulate, GroundTruthIsConsistentWithTheScene) {
   }
   const auto objects = nlohmann::json::parse(test::read_text(dir / "objects.json"));
   EXPECT_EQ(objects["objects"].size(), scene.objects.size());
+  // The shared reader gives every object in file order, then the no-surface record.
+  const std::vector<ObjectRecord> records = read_objects(dir.path());
+  ASSERT_EQ(records.size(), scene.objects.size() + 1);
+  for (std::size_t i = 0; i < scene.objects.size(); ++i) {
+    EXPECT_EQ(records[i].id, scene.objects[i].id);
+    EXPECT_EQ(records[i].cls, object_class_name(scene.objects[i].type));
+  }
+  EXPECT_EQ(records.back().id, kNoSurface);
+  EXPECT_EQ(records.back().fate, "none");
+  test::write_text(dir / "objects.json", "{\"objects\": [{\"id\": 1}]}");
+  EXPECT_THROW(read_objects(dir.path()), InputError);
 }
 
 TEST(Simulate, SameSeedSameBytesWhateverTheThreadCount) {

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -52,6 +53,18 @@ struct SimulationReport {
 /// position and time per vertex), acq_<k>.truth (object id per face), objects.json and
 /// config.toml. Same params give the same bytes. Throws ConfigError, OutputError.
 SimulationReport simulate(const SimulateParams& params);
+
+/// One entry of a simulation's objects.json.
+struct ObjectRecord {
+  std::uint32_t id = 0;
+  std::string cls;   ///< object class name
+  std::string fate;  ///< keep, remove, unconfirmed; "none" for the no-surface record
+};
+
+/// Reads <sim>/objects.json, in file order, and appends a record for kNoSurface (class
+/// "no_surface", fate "none") so that every id of a truth file has a record. Throws
+/// InputError naming the file when it is missing or malformed.
+std::vector<ObjectRecord> read_objects(const std::filesystem::path& sim);
 
 /// The ground-truth sidecar: "CMTRUTH1", uint64 face count, uint32 object id per face (file
 /// order), uint64 FNV-1a of the ids; little endian.
