@@ -52,12 +52,9 @@ class DetectCommand final : public Command {
 
  private:
   static void report(const ChangeResult& r, const std::filesystem::path& dir) {
-    std::array<std::uint64_t, 3> states{};
-    std::uint64_t kept = 0;
-    for (std::size_t g = 0; g < r.index.size(); ++g) {
-      ++states[static_cast<std::size_t>(r.state[g])];
-      kept += r.kept[g];
-    }
+    const StateCounts c = count_states(r, 0, r.index.size());
+    const auto& states = c.state;
+    const std::uint64_t kept = c.kept;
     const ChangeStats& s = r.stats;
     std::cout << fmt::format("{}: {} triangles: {} consistent, {} conflicting, {} single; {} kept\n", dir.string(),
                              s.triangles, states[0], states[1], states[2], kept);

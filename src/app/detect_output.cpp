@@ -29,22 +29,6 @@ std::string file_stem(const Config& config, std::size_t k) {
   return fmt::format("{}_{}", k, config.acquisitions[k].name);
 }
 
-struct Counts {
-  std::array<std::uint64_t, 3> state{};
-  std::uint64_t kept = 0, sustainable = 0, refutes = 0;
-};
-
-Counts count(const ChangeResult& r, std::size_t begin, std::size_t end) {
-  Counts c;
-  for (std::size_t g = begin; g < end; ++g) {
-    ++c.state[static_cast<std::size_t>(r.state[g])];
-    c.kept += r.kept[g];
-    c.sustainable += r.sustainable[g];
-    c.refutes += r.refutes[g];
-  }
-  return c;
-}
-
 void write_labelled_ply(const std::filesystem::path& path, const Mesh& mesh, std::span<const std::int32_t> source_face,
                         const ChangeResult& r, std::size_t begin) {
   const std::size_t n = mesh.triangle_count();
@@ -81,7 +65,7 @@ void write_picture(const std::filesystem::path& path, const Mesh& mesh, const Ch
   write_png(path, render_orthographic(std::span<const RenderLayer>(&layer, 1), view));
 }
 
-nlohmann::json counts_json(const Counts& c) {
+nlohmann::json counts_json(const StateCounts& c) {
   return {{"consistent", c.state[0]}, {"conflicting", c.state[1]},    {"single", c.state[2]},
           {"kept", c.kept},           {"sustainable", c.sustainable}, {"refutes", c.refutes}};
 }
@@ -109,10 +93,10 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
                                        {"ply", stem + ".ply"},
                                        {"png", params.pictures ? stem + ".png" : ""},
                                        {"triangles", input.meshes[k].triangle_count()},
-                                       {"counts", counts_json(count(r, begin, r.index.offsets[k + 1]))}});
+                                       {"counts", counts_json(count_states(r, begin, r.index.offsets[k + 1]))}});
   }
   const ChangeStats& s = r.stats;
-  summary["totals"] = counts_json(count(r, 0, r.index.size()));
+  summary["totals"] = counts_json(count_states(r, 0, r.index.size()));
   summary["totals"]["triangles"] = s.triangles;
   summary["consistent_pairs"] = s.consistent_pairs;
   summary["prefilter"] = {{"enabled", config.change.prefilter}, {"voxel_size", config.change.voxel_size},

@@ -41,7 +41,7 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& gri
 
 std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, const ChangeParams& params,
                                                    ChangeStats& stats) {
-  const std::size_t n = f.meshes.size();
+  const std::size_t n = f.acquisitions();
   std::vector<OccupancyGrid> grids;
   for (std::size_t a = 0; a < n; ++a) grids.emplace_back(params.voxel_size);
   parallel_for_blocks(n, 1, [&](std::size_t begin, std::size_t end) {
@@ -63,7 +63,7 @@ std::vector<std::uint32_t> conflict_candidates(const TriangleFrames& f, const Pa
                                                std::span<const OccupancyGrid> grids, std::size_t j,
                                                const ChangeParams& params, ChangeStats& stats) {
   std::vector<std::uint32_t> out;
-  for (std::size_t a = 0; a < f.meshes.size(); ++a) {
+  for (std::size_t a = 0; a < f.acquisitions(); ++a) {
     if (!(f.dates[a] < f.dates[j])) continue;
     for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
       if (partners.has(g, j)) continue;
@@ -89,7 +89,7 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   flags.conflicting.assign(f.size(), 0);
   flags.refutes.assign(f.size(), 0);
   std::atomic<std::uint64_t> tests{0};
-  for (std::size_t j = 0; j < f.meshes.size(); ++j) {
+  for (std::size_t j = 0; j < f.acquisitions(); ++j) {
     const std::vector<std::uint32_t> older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.empty()) continue;
     std::vector<std::uint32_t> spaces;

@@ -93,12 +93,6 @@ Samples sample_triangles(const TriangleFrames& f, double threshold) {
   return s;
 }
 
-/// +1 when the corners turn counter-clockwise about n, -1 otherwise (normals were turned
-/// towards the viewpoint, so either order occurs).
-double orientation(const TriangleCorners& q, const Vec3d& n) {
-  return dot(cross(q[1] - q[0], q[2] - q[0]), n) >= 0 ? 1.0 : -1.0;
-}
-
 /// T (centroid c) overlaps U: c lies within `threshold` of U's plane and its projection on
 /// that plane falls inside U (edges included), i.e. the point-to-triangle distance is at most
 /// the threshold and is reached inside U.
@@ -108,8 +102,11 @@ bool overlaps(const Vec3d& c, const TriangleFrames& f, std::uint32_t u, double t
   const double h = dot(c - q[0], n);
   if (std::abs(h) > threshold) return false;
   const Vec3d p = c - n * h;
+  // Inside when p is on the inner side of every edge, measured about the corners' own winding
+  // (the stored normal was turned towards the viewpoint, so its sign says nothing of it).
+  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
   for (int k = 0; k < 3; ++k) {
-    if (dot(cross(q[(k + 1) % 3] - q[k], p - q[k]), n) * orientation(q, n) < 0) return false;
+    if (dot(cross(q[(k + 1) % 3] - q[k], p - q[k]), winding) < 0) return false;
   }
   return true;
 }

@@ -28,12 +28,11 @@ bool observed_later(const TriangleFrames& f, std::size_t g, std::span<const Occu
 
 /// first/last seen over each triangle and its consistent partners, sustainability, state and
 /// the keep decision under the unconfirmed policy.
-void compute_time_series(const TriangleFrames& f, const ConflictFlags& conflicts, std::span<const OccupancyGrid> grids,
-                         const ChangeParams& params, ChangeResult& r) {
+void compute_time_series(const TriangleFrames& f, const PartnerBits& partners, const ConflictFlags& conflicts,
+                         std::span<const OccupancyGrid> grids, const ChangeParams& params, ChangeResult& r) {
   const std::size_t n = f.size();
   r.first_seen.resize(n);
   r.last_seen.resize(n);
-  std::vector<std::uint8_t> has_partner(n, 0);
   for (std::size_t g = 0; g < n; ++g) r.first_seen[g] = r.last_seen[g] = f.date_of(g);
   for (const auto& [a, b] : r.consistent_pairs) {
     const TimePoint da = f.date_of(a), db = f.date_of(b);
@@ -41,7 +40,6 @@ void compute_time_series(const TriangleFrames& f, const ConflictFlags& conflicts
     r.last_seen[a] = std::max(r.last_seen[a], db);
     r.first_seen[b] = std::min(r.first_seen[b], da);
     r.last_seen[b] = std::max(r.last_seen[b], da);
-    has_partner[a] = has_partner[b] = 1;
   }
   r.state.resize(n);
   r.sustainable.resize(n);
@@ -54,7 +52,7 @@ void compute_time_series(const TriangleFrames& f, const ConflictFlags& conflicts
         r.kept[g] = 0;
         continue;
       }
-      r.state[g] = has_partner[g] != 0 ? TriangleState::consistent : TriangleState::single;
+      r.state[g] = partners.any(g) ? TriangleState::consistent : TriangleState::single;
       bool keep = r.sustainable[g] != 0;
       if (!keep) {
         switch (params.unconfirmed) {
@@ -74,6 +72,17 @@ void compute_time_series(const TriangleFrames& f, const ConflictFlags& conflicts
 }
 
 }  // namespace
+
+StateCounts count_states(const ChangeResult& r, std::size_t begin, std::size_t end) {
+  StateCounts c;
+  for (std::size_t g = begin; g < end; ++g) {
+    ++c.state[static_cast<std::size_t>(r.state[g])];
+    c.kept += r.kept[g];
+    c.sustainable += r.sustainable[g];
+    c.refutes += r.refutes[g];
+  }
+  return c;
+}
 
 ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params) {
   ChangeResult r;
@@ -95,7 +104,7 @@ ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params
   ConflictFlags conflicts = find_conflicts(frames, partners, grids, params, r.stats);
   r.stats.seconds_conflicts = clock.restart();
 
-  compute_time_series(frames, conflicts, grids, params, r);
+  compute_time_series(frames, partners, conflicts, grids, params, r);
   r.refutes = std::move(conflicts.refutes);
   r.stats.seconds_time_series = clock.restart();
   log::debug("change detection: {} triangles, {} pairs, {} exact tests, {:.3f} s", r.stats.triangles,

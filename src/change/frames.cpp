@@ -65,10 +65,6 @@ void check_input(const ChangeInput& input) {
   }
 }
 
-Vec3d corner(const Mesh& m, std::size_t t, int k) {
-  return Vec3d(m.positions[m.triangles[t][static_cast<std::size_t>(k)]]);
-}
-
 }  // namespace
 
 TriangleCorners TriangleFrames::corners(std::size_t g) const {
@@ -107,7 +103,6 @@ Box3f TriangleFrames::empty_space_bounds(std::size_t g) const {
 TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params) {
   check_input(input);
   TriangleFrames f;
-  f.meshes = input.meshes;
   f.dates.assign(input.dates.begin(), input.dates.end());
   f.index.offsets.assign(1, 0);
   for (const Mesh& m : input.meshes) f.index.offsets.push_back(f.index.offsets.back() + m.triangle_count());
@@ -123,7 +118,9 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
     parallel_for_blocks(m.triangle_count(), 8192, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
         const Triangle& tri = m.triangles[t];
-        const Vec3d p0 = corner(m, t, 0), p1 = corner(m, t, 1), p2 = corner(m, t, 2);
+        const std::size_t g = base + t;
+        f.corner[g] = {m.positions[tri[0]], m.positions[tri[1]], m.positions[tri[2]]};
+        const Vec3d p0(f.corner[g][0]), p1(f.corner[g][1]), p2(f.corner[g][2]);
         const Vec3d c = (p0 + p1 + p2) / 3.0;
         const Vec3d v = (Vec3d(m.sensor_positions[tri[0]]) + Vec3d(m.sensor_positions[tri[1]]) +
                          Vec3d(m.sensor_positions[tri[2]])) /
@@ -136,8 +133,6 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
           normal = normal * -1.0;
           h = -h;
         }
-        const std::size_t g = base + t;
-        f.corner[g] = {m.positions[tri[0]], m.positions[tri[1]], m.positions[tri[2]]};
         f.centroid[g] = Vec3f(c);
         f.normal[g] = Vec3f(normal);
         f.viewpoint[g] = Vec3f(v);
@@ -150,7 +145,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
 
 PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs) {
   PartnerBits p;
-  p.words = (frames.meshes.size() + 63) / 64;
+  p.words = (frames.acquisitions() + 63) / 64;
   p.bits.assign(frames.size() * p.words, 0);
   for (const auto& [a, b] : pairs) {
     const std::size_t ja = frames.index.acquisition_of(a), jb = frames.index.acquisition_of(b);

@@ -15,7 +15,6 @@ namespace citymesh::change_detail {
 
 /// Derived per global triangle, in the meshes' shared local frame.
 struct TriangleFrames {
-  std::span<const Mesh> meshes;
   std::vector<TimePoint> dates;  ///< per acquisition
   GlobalTriangles index;
   std::vector<std::array<Vec3f, 3>> corner;  ///< copied out of the meshes for locality
@@ -28,6 +27,7 @@ struct TriangleFrames {
   std::vector<float> empty_scale;
 
   [[nodiscard]] std::size_t size() const { return centroid.size(); }
+  [[nodiscard]] std::size_t acquisitions() const { return dates.size(); }
   [[nodiscard]] TriangleCorners corners(std::size_t g) const;
   [[nodiscard]] TetrahedronCorners empty_space(std::size_t g) const;
   [[nodiscard]] Box3f bounds(std::size_t g) const;
@@ -57,6 +57,13 @@ struct PartnerBits {
   std::size_t words = 1;
   std::vector<std::uint64_t> bits;
   [[nodiscard]] bool has(std::size_t g, std::size_t j) const { return (bits[g * words + j / 64] >> (j % 64)) & 1u; }
+  /// Triangle g has a partner in some acquisition.
+  [[nodiscard]] bool any(std::size_t g) const {
+    for (std::size_t w = 0; w < words; ++w) {
+      if (bits[g * words + w] != 0) return true;
+    }
+    return false;
+  }
 };
 PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs);
 

@@ -264,6 +264,13 @@ TEST(DetectChanges, PrefilterAndThreadCountNeverChangeTheResult) {
   EXPECT_GT(a.stats.prefilter_skipped, 0u);
   EXPECT_LT(a.stats.exact_tests, b.stats.exact_tests);
   EXPECT_GT(std::count(a.state.begin(), a.state.end(), TriangleState::conflicting), 100);
+  const StateCounts counts = count_states(a, a.index.offsets[1], a.index.offsets[2]);
+  const auto from = a.state.begin() + static_cast<std::ptrdiff_t>(a.index.offsets[1]);
+  const auto to = a.state.begin() + static_cast<std::ptrdiff_t>(a.index.offsets[2]);
+  EXPECT_EQ(counts.state[1], static_cast<std::uint64_t>(std::count(from, to, TriangleState::conflicting)));
+  EXPECT_EQ(counts.state[0] + counts.state[1] + counts.state[2], a.index.offsets[2] - a.index.offsets[1]);
+  EXPECT_EQ(counts.kept, static_cast<std::uint64_t>(std::count(a.kept.begin() + (from - a.state.begin()),
+                                                               a.kept.begin() + (to - a.state.begin()), 1)));
   const ThreadLimit one(1);
   expect_same(a, detect(meshes, dates, with));
 }

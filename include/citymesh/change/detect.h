@@ -4,6 +4,7 @@
 // disappeared (conflicting), and which are sustainable. A tile with its halo is such a set.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string_view>
@@ -65,6 +66,13 @@ struct ChangeResult {
   std::vector<TrianglePair> consistent_pairs;
   ChangeStats stats;
 };
+
+/// Triangles per state, kept, sustainable and refuting, over global triangles [begin, end).
+struct StateCounts {
+  std::array<std::uint64_t, 3> state{};  ///< indexed by TriangleState
+  std::uint64_t kept = 0, sustainable = 0, refutes = 0;
+};
+StateCounts count_states(const ChangeResult& result, std::size_t begin, std::size_t end);
 
 /// Runs consistency, conflicts and the time series. Same input and params give the same
 /// result whatever the thread count. Throws ProcessingError when the meshes lack sensor
