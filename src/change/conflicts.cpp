@@ -57,25 +57,30 @@ std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, cons
 
 namespace {
 
+/// Triangles and their boxes, for the box collision.
+struct BoxedTriangles {
+  std::vector<std::uint32_t> ids;
+  std::vector<Box3f> boxes;
+};
+
 /// The triangles that must be tested against acquisition j's empty space: older, not
 /// consistent with j, and (with the pre-filter) near a voxel of j's grid.
-std::vector<std::uint32_t> conflict_candidates(const TriangleFrames& f, const PartnerBits& partners,
-                                               std::span<const OccupancyGrid> grids, std::size_t j,
-                                               const ChangeParams& params, ChangeStats& stats) {
-  std::vector<std::uint32_t> out;
+BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& partners,
+                                   std::span<const OccupancyGrid> grids, std::size_t j, const ChangeParams& params,
+                                   ChangeStats& stats) {
+  BoxedTriangles out;
   for (std::size_t a = 0; a < f.acquisitions(); ++a) {
     if (!(f.dates[a] < f.dates[j])) continue;
     for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
       if (partners.has(g, j)) continue;
       ++stats.conflict_candidates;
-      if (params.prefilter) {
-        const Box3f box = f.bounds(g);
-        if (!grids[j].any_in_box(box.min, box.max)) {
-          ++stats.prefilter_skipped;
-          continue;
-        }
+      const Box3f box = f.bounds(g);
+      if (params.prefilter && !grids[j].any_in_box(box.min, box.max)) {
+        ++stats.prefilter_skipped;
+        continue;
       }
-      out.push_back(static_cast<std::uint32_t>(g));
+      out.ids.push_back(static_cast<std::uint32_t>(g));
+      out.boxes.push_back(box);
     }
   }
   return out;
@@ -90,25 +95,22 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   flags.refutes.assign(f.size(), 0);
   std::atomic<std::uint64_t> tests{0};
   for (std::size_t j = 0; j < f.acquisitions(); ++j) {
-    const std::vector<std::uint32_t> older = conflict_candidates(f, partners, grids, j, params, stats);
-    if (older.empty()) continue;
+    const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
+    if (older.ids.empty()) continue;
     std::vector<std::uint32_t> spaces;
     for (std::size_t g = f.index.offsets[j]; g < f.index.offsets[j + 1]; ++g) {
       if (f.empty_scale[g] > 0) spaces.push_back(static_cast<std::uint32_t>(g));
     }
-    std::vector<Box3f> older_boxes(older.size()), space_boxes(spaces.size());
-    parallel_for_blocks(older.size(), 16384, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) older_boxes[i] = f.bounds(older[i]);
-    });
+    std::vector<Box3f> space_boxes(spaces.size());
     parallel_for_blocks(spaces.size(), 16384, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) space_boxes[i] = f.empty_space_bounds(spaces[i]);
     });
     // Every overlapping pair is tested (no early exit) so that `refutes` does not depend on
     // the order Embree reports pairs in; the flags are only ever raised, so any order of
     // raising gives the same result.
-    collide_boxes(older_boxes, space_boxes, [&](std::span<const BoxPair> batch) {
+    collide_boxes(older.boxes, space_boxes, [&](std::span<const BoxPair> batch) {
       for (const BoxPair& p : batch) {
-        const std::uint32_t t = older[p.a], u = spaces[p.b];
+        const std::uint32_t t = older.ids[p.a], u = spaces[p.b];
         if (triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
           std::atomic_ref<std::uint8_t>(flags.conflicting[t]).store(1, std::memory_order_relaxed);
           std::atomic_ref<std::uint8_t>(flags.refutes[u]).store(1, std::memory_order_relaxed);
