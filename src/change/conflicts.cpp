@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 
@@ -10,30 +11,14 @@ namespace citymesh::change_detail {
 
 namespace {
 
-Vec3f lerp(const Vec3f& a, const Vec3f& b, float t) { return a + (b - a) * t; }
-
 /// Marks every voxel the empty space of triangle g crosses: the tetrahedron is cut into slabs
-/// about one voxel long from the viewpoint, and each slab's box (the hull of its two end
-/// cross-sections contains the slab) is marked.
+/// about one voxel long and each slab's box is marked.
 void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& grid) {
   const TetrahedronCorners q = f.empty_space(g);
-  const Vec3f v(q[0]), a(q[1]), b(q[2]), c(q[3]);
-  const double length = std::max({norm(q[1] - q[0]), norm(q[2] - q[0]), norm(q[3] - q[0])});
-  const auto steps = static_cast<int>(std::clamp(std::ceil(length / grid.voxel_size()), 1.0, 100000.0));
-  const auto corner_box = [&](float t0, float t1, Vec3f& lo, Vec3f& hi) {
-    const Vec3f pts[6] = {lerp(v, a, t0), lerp(v, b, t0), lerp(v, c, t0),
-                          lerp(v, a, t1), lerp(v, b, t1), lerp(v, c, t1)};
-    lo = hi = pts[0];
-    for (const Vec3f& p : pts) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-  };
-  for (int k = 0; k < steps; ++k) {
-    Vec3f lo, hi;
-    corner_box(static_cast<float>(k) / static_cast<float>(steps), static_cast<float>(k + 1) / static_cast<float>(steps),
-               lo, hi);
-    grid.mark_box(lo, hi);
+  const int n = slab_count(q, grid.voxel_size());
+  for (int k = 0; k < n; ++k) {
+    const Box3f box = empty_space_slab(q, k, n);
+    grid.mark_box(box.min, box.max);
   }
 }
 
@@ -88,6 +73,67 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
 
 }  // namespace
 
+namespace {
+
+/// A triangle lying wholly farther than this outside one face plane of a tetrahedron misses
+/// it: far above the float rounding of the planes, so the quick rejection below is exact.
+constexpr float kPlaneRejectMargin = 1e-3f;
+
+/// The outward face planes of an empty space (unit normal, offset), for a quick rejection
+/// before the exact test; a degenerate face gets a zero plane that rejects nothing.
+struct FacePlanes {
+  std::array<Vec3f, 4> normal;
+  std::array<float, 4> offset;
+
+  explicit FacePlanes(const TetrahedronCorners& q) {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const Vec3d& a = q[(i + 1) % 4];
+      Vec3d n = cross(q[(i + 2) % 4] - a, q[(i + 3) % 4] - a);
+      const double len = norm(n);
+      n = len > 0 ? n / len : Vec3d{0, 0, 0};
+      if (dot(q[i] - a, n) > 0) n = n * -1.0;  // away from the opposite corner
+      normal[i] = Vec3f(n);
+      offset[i] = static_cast<float>(dot(n, a));
+    }
+  }
+
+  /// True when the triangle lies wholly outside one face plane, with the margin.
+  [[nodiscard]] bool misses(const std::array<Vec3f, 3>& t) const {
+    for (std::size_t i = 0; i < 4; ++i) {
+      const float limit = offset[i] + kPlaneRejectMargin;
+      if (dot(normal[i], t[0]) > limit && dot(normal[i], t[1]) > limit && dot(normal[i], t[2]) > limit) return true;
+    }
+    return false;
+  }
+};
+
+/// Acquisition j's triangles that have an empty space, with their empty spaces' boxes and
+/// face planes.
+struct EmptySpaces {
+  BoxedTriangles boxed;
+  std::vector<FacePlanes> planes;
+};
+
+EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j) {
+  EmptySpaces out;
+  for (std::size_t g = f.index.offsets[j]; g < f.index.offsets[j + 1]; ++g) {
+    if (f.empty_scale[g] > 0) out.boxed.ids.push_back(static_cast<std::uint32_t>(g));
+  }
+  const std::size_t n = out.boxed.ids.size();
+  out.boxed.boxes.resize(n);
+  out.planes.resize(n, FacePlanes(TetrahedronCorners{}));
+  parallel_for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const TetrahedronCorners q = f.empty_space(out.boxed.ids[i]);
+      out.boxed.boxes[i] = empty_space_slab(q, 0, 1);
+      out.planes[i] = FacePlanes(q);
+    }
+  });
+  return out;
+}
+
+}  // namespace
+
 ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partners, std::span<const OccupancyGrid> grids,
                              const ChangeParams& params, ChangeStats& stats) {
   ConflictFlags flags;
@@ -97,26 +143,28 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   for (std::size_t j = 0; j < f.acquisitions(); ++j) {
     const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.ids.empty()) continue;
-    std::vector<std::uint32_t> spaces;
-    for (std::size_t g = f.index.offsets[j]; g < f.index.offsets[j + 1]; ++g) {
-      if (f.empty_scale[g] > 0) spaces.push_back(static_cast<std::uint32_t>(g));
-    }
-    std::vector<Box3f> space_boxes(spaces.size());
-    parallel_for_blocks(spaces.size(), 16384, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) space_boxes[i] = f.empty_space_bounds(spaces[i]);
-    });
+    EmptySpaces spaces = empty_spaces(f, j);
+    const BoxTree tree(std::move(spaces.boxed.boxes));
     // Every overlapping pair is tested (no early exit) so that `refutes` does not depend on
-    // the order Embree reports pairs in; the flags are only ever raised, so any order of
-    // raising gives the same result.
-    collide_boxes(older.boxes, space_boxes, [&](std::span<const BoxPair> batch) {
-      for (const BoxPair& p : batch) {
-        const std::uint32_t t = older.ids[p.a], u = spaces[p.b];
-        if (triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
-          std::atomic_ref<std::uint8_t>(flags.conflicting[t]).store(1, std::memory_order_relaxed);
-          std::atomic_ref<std::uint8_t>(flags.refutes[u]).store(1, std::memory_order_relaxed);
+    // the thread count; the flags are only ever raised, so any order of raising gives the
+    // same result.
+    parallel_for_blocks(older.ids.size(), 256, [&](std::size_t begin, std::size_t end) {
+      std::vector<std::uint32_t> hits;
+      std::uint64_t tested = 0;
+      for (std::size_t i = begin; i < end; ++i) {
+        const std::uint32_t t = older.ids[i];
+        tree.overlapping(older.boxes[i], hits);
+        for (const std::uint32_t h : hits) {
+          if (spaces.planes[h].misses(f.corner[t])) continue;
+          const std::uint32_t u = spaces.boxed.ids[h];
+          ++tested;
+          if (triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
+            flags.conflicting[t] = 1;
+            std::atomic_ref<std::uint8_t>(flags.refutes[u]).store(1, std::memory_order_relaxed);
+          }
         }
       }
-      tests.fetch_add(batch.size(), std::memory_order_relaxed);
+      tests.fetch_add(tested, std::memory_order_relaxed);
     });
   }
   stats.exact_tests = tests.load();

@@ -95,9 +95,19 @@ Box3f TriangleFrames::bounds(std::size_t g) const {
   return padded_box(c);
 }
 
-Box3f TriangleFrames::empty_space_bounds(std::size_t g) const {
-  const TetrahedronCorners q = empty_space(g);
-  return padded_box(q);
+int slab_count(const TetrahedronCorners& q, double length) {
+  const double reach = std::max({norm(q[1] - q[0]), norm(q[2] - q[0]), norm(q[3] - q[0])});
+  return static_cast<int>(std::clamp(std::ceil(reach / length), 1.0, 100000.0));
+}
+
+Box3f empty_space_slab(const TetrahedronCorners& q, int k, int n) {
+  const double s0 = double(k) / n, s1 = double(k + 1) / n;
+  std::array<Vec3d, 6> cut;
+  for (int i = 0; i < 3; ++i) {
+    cut[static_cast<std::size_t>(i)] = q[0] + (q[i + 1] - q[0]) * s0;
+    cut[static_cast<std::size_t>(i + 3)] = q[0] + (q[i + 1] - q[0]) * s1;
+  }
+  return padded_box(cut);
 }
 
 TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params) {

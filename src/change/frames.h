@@ -8,7 +8,7 @@
 
 #include "citymesh/change/detect.h"
 #include "citymesh/core/geometry.h"
-#include "citymesh/spatial/box_collide.h"
+#include "citymesh/spatial/box_tree.h"
 #include "citymesh/spatial/occupancy_grid.h"
 
 namespace citymesh::change_detail {
@@ -31,18 +31,25 @@ struct TriangleFrames {
   [[nodiscard]] TriangleCorners corners(std::size_t g) const;
   [[nodiscard]] TetrahedronCorners empty_space(std::size_t g) const;
   [[nodiscard]] Box3f bounds(std::size_t g) const;
-  [[nodiscard]] Box3f empty_space_bounds(std::size_t g) const;
   [[nodiscard]] TimePoint date_of(std::size_t g) const { return dates[index.acquisition_of(g)]; }
 };
+
+/// Cuts of about `length` metres along an empty space q (viewpoint first), at least 1.
+int slab_count(const TetrahedronCorners& q, double length);
+/// Box of slab k of n of the empty space q: the hull of its cross-sections at k/n and (k+1)/n
+/// of the way from the viewpoint, which holds the slab since the empty space is convex;
+/// padded so that rounding to float loses nothing.
+Box3f empty_space_slab(const TetrahedronCorners& q, int k, int n);
 
 /// Checks the input and computes every frame (parallel, deterministic).
 TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params);
 
 /// Consistent pairs: triangles of different acquisitions whose normals are within
-/// normal_angle and where one's centroid lies within distance_threshold of the other
-/// (point-to-triangle distance). Candidates come from a nanoflann kd-tree over samples spread
-/// on every triangle at most `spacing` apart (spacing set by the coarser triangles), so the
-/// search radius is the threshold plus the spacing and no partner is missed.
+/// normal_angle and where one's centroid lies within distance_threshold of the other's plane
+/// and projects inside it (point-to-triangle distance reached inside). Candidates come from
+/// point queries in a BVH of every triangle's prism box (the triangle thickened by the
+/// threshold along its normal), which holds exactly the points that can pass the test.
+/// Sorted, each pair once.
 std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& frames, const ChangeParams& params,
                                                 ChangeStats& stats);
 

@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/partitioner.h>
 
 #include <algorithm>
@@ -39,6 +40,10 @@ void parallel_for_blocks(std::size_t count, std::size_t grain,
         }
       },
       tbb::simple_partitioner());
+}
+
+void parallel_sort(std::span<std::pair<std::uint32_t, std::uint32_t>> values) {
+  tbb::parallel_sort(values.begin(), values.end());
 }
 
 }  // namespace citymesh

@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: MIT
 // The only source that includes Embree: ray casting and box collision.
 #include "citymesh/spatial/ray_scene.h"
-#include "citymesh/spatial/box_collide.h"
+#include "citymesh/spatial/box_tree.h"
 
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <vector>
 
 #include "citymesh/core/error.h"
 
@@ -78,7 +81,7 @@ RayHit RayScene::intersect(const Vec3f& origin, const Vec3f& direction, float ma
 
 }  // namespace citymesh
 
-// ---- box collision ------------------------------------------------------------------------
+// ---- box tree ------------------------------------------------------------------------
 
 namespace citymesh {
 
@@ -102,6 +105,7 @@ void box_bounds(const RTCBoundsFunctionArguments* args) {
 /// A scene of one user geometry whose primitives are the boxes.
 RTCScene box_scene(RTCDevice device, BoxSet& set) {
   RTCScene scene = rtcNewScene(device);
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
   RTCGeometry geometry = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(geometry, static_cast<unsigned>(set.boxes.size()));
   rtcSetGeometryUserData(geometry, &set);
@@ -113,50 +117,72 @@ RTCScene box_scene(RTCDevice device, BoxSet& set) {
   return scene;
 }
 
-struct CollideContext {
-  const std::function<void(std::span<const BoxPair>)>* on_pairs;
-  std::span<const Box3f> a, b;
-};
-
 bool overlaps(const Box3f& p, const Box3f& q) {
   return p.min.x <= q.max.x && q.min.x <= p.max.x && p.min.y <= q.max.y && q.min.y <= p.max.y &&
          p.min.z <= q.max.z && q.min.z <= p.max.z;
 }
 
-void on_collisions(void* user, RTCCollision* collisions, unsigned count) {
-  const auto* ctx = static_cast<const CollideContext*>(user);
-  // Embree reports leaf pairs whose node bounds overlap; keep the pairs whose own boxes do.
-  BoxPair batch[256];
-  std::size_t n = 0;
-  for (unsigned i = 0; i < count; ++i) {
-    const BoxPair p{collisions[i].primID0, collisions[i].primID1};
-    if (!overlaps(ctx->a[p.a], ctx->b[p.b])) continue;
-    batch[n++] = p;
-    if (n == std::size(batch)) {
-      (*ctx->on_pairs)(std::span<const BoxPair>(batch, n));
-      n = 0;
-    }
+}  // namespace
+
+struct BoxTree::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<Box3f> boxes;
+  BoxSet set;
+  ~Impl() {
+    if (scene != nullptr) rtcReleaseScene(scene);
+    if (device != nullptr) rtcReleaseDevice(device);
   }
-  if (n > 0) (*ctx->on_pairs)(std::span<const BoxPair>(batch, n));
+};
+
+namespace {
+
+struct BoxQuery {
+  std::span<const Box3f> boxes;
+  Box3f query;
+  std::vector<std::uint32_t>* out;
+};
+
+/// Called by Embree for every box of a leaf whose bounds meet the query's sphere.
+bool collect_overlapping(RTCPointQueryFunctionArguments* args) {
+  auto* q = static_cast<BoxQuery*>(args->userPtr);
+  if (overlaps(q->boxes[args->primID], q->query)) q->out->push_back(args->primID);
+  return false;  // the query radius is unchanged
 }
 
 }  // namespace
 
-void collide_boxes(std::span<const Box3f> a, std::span<const Box3f> b,
-                   const std::function<void(std::span<const BoxPair>)>& on_pairs) {
-  if (a.empty() || b.empty()) return;
-  RTCDevice device = rtcNewDevice("verbose=0");
-  if (device == nullptr) throw ProcessingError("box collision: cannot create an Embree device");
-  BoxSet set_a{a}, set_b{b};
-  RTCScene scene_a = box_scene(device, set_a);
-  RTCScene scene_b = box_scene(device, set_b);
-  CollideContext ctx{&on_pairs, a, b};
-  rtcCollide(scene_a, scene_b, on_collisions, &ctx);
-  const RTCError e = rtcGetDeviceError(device);
-  rtcReleaseScene(scene_a);
-  rtcReleaseScene(scene_b);
-  rtcReleaseDevice(device);
-  if (e != RTC_ERROR_NONE) throw ProcessingError(fmt::format("box collision failed (Embree error {})", int(e)));
+BoxTree::BoxTree(std::vector<Box3f> boxes) : impl_(std::make_unique<Impl>()) {
+  impl_->boxes = std::move(boxes);
+  impl_->set.boxes = impl_->boxes;
+  impl_->device = rtcNewDevice("verbose=0");
+  if (impl_->device == nullptr) throw ProcessingError("box tree: cannot create an Embree device");
+  if (!impl_->boxes.empty()) impl_->scene = box_scene(impl_->device, impl_->set);
+  check(impl_->device, "box tree build");
+}
+
+BoxTree::~BoxTree() = default;
+
+void BoxTree::containing(const Vec3f& p, std::vector<std::uint32_t>& out) const { overlapping({p, p}, out); }
+
+void BoxTree::overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  if (impl_->scene == nullptr) return;
+  // Embree's point queries visit what meets a sphere: the one around the query box, widened
+  // by a few float steps of the coordinates for the rounding of its centre.
+  const Vec3f centre = (b.min + b.max) * 0.5f;
+  const Vec3f half = (b.max - b.min) * 0.5f;
+  const float magnitude = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)});
+  RTCPointQuery query{};
+  query.x = centre.x;
+  query.y = centre.y;
+  query.z = centre.z;
+  query.radius = std::sqrt(dot(half, half)) * (1 + 1e-6f) + 1e-6f * magnitude + 1e-7f;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  BoxQuery q{impl_->boxes, b, &out};
+  rtcPointQuery(impl_->scene, &query, &context, collect_overlapping, &q);
+  std::sort(out.begin(), out.end());
 }
 
 }  // namespace citymesh

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <cmath>
 #include <mutex>
 #include <openvdb/openvdb.h>
@@ -26,22 +27,42 @@ openvdb::Coord voxel_of(const Vec3f& p, double size) {
 
 /// Above this many voxels a box query walks the active voxels instead of the box.
 constexpr std::int64_t kDenseQueryLimit = 4096;
+/// Boxes remembered to skip marking the same box twice in a row.
+constexpr std::size_t kRecentBoxes = 1024;
+
+std::size_t box_slot(const openvdb::CoordBBox& b) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (const openvdb::Int32 v : {b.min().x(), b.min().y(), b.min().z(), b.max().x(), b.max().y(), b.max().z()}) {
+    h = (h ^ static_cast<std::uint32_t>(v)) * 1099511628211ull;
+  }
+  return static_cast<std::size_t>(h % kRecentBoxes);
+}
+
+/// Up to this many voxels a box is marked voxel by voxel, above it by a sparse fill.
+constexpr std::int64_t kSmallBoxVoxels = 64;
 
 }  // namespace
 
 struct OccupancyGrid::Impl {
   double size = 1.0;
   openvdb::BoolGrid::Ptr grid;
+  openvdb::BoolGrid::Accessor accessor;  ///< caches the last nodes marked (not thread-safe, like marking)
+  std::array<openvdb::CoordBBox, kRecentBoxes> recent;  ///< boxes marked lately, by box_slot
+  Impl(double voxel_size, openvdb::BoolGrid::Ptr g) : size(voxel_size), grid(std::move(g)), accessor(grid->getAccessor()) {}
 };
 
-OccupancyGrid::OccupancyGrid(double voxel_size) : impl_(std::make_unique<Impl>()) {
+namespace {
+double checked_voxel_size(double voxel_size) {
   if (!(voxel_size > 0) || !std::isfinite(voxel_size)) {
     throw ProcessingError(fmt::format("occupancy grid: voxel size {} must be positive", voxel_size));
   }
   initialise_openvdb();
-  impl_->size = voxel_size;
-  impl_->grid = openvdb::BoolGrid::create(false);
+  return voxel_size;
 }
+}  // namespace
+
+OccupancyGrid::OccupancyGrid(double voxel_size)
+    : impl_(std::make_unique<Impl>(checked_voxel_size(voxel_size), openvdb::BoolGrid::create(false))) {}
 
 OccupancyGrid::~OccupancyGrid() = default;
 OccupancyGrid::OccupancyGrid(OccupancyGrid&&) noexcept = default;
@@ -49,11 +70,21 @@ OccupancyGrid& OccupancyGrid::operator=(OccupancyGrid&&) noexcept = default;
 
 double OccupancyGrid::voxel_size() const { return impl_->size; }
 
-void OccupancyGrid::mark_point(const Vec3f& p) { impl_->grid->tree().setValueOn(voxel_of(p, impl_->size), true); }
+void OccupancyGrid::mark_point(const Vec3f& p) { impl_->accessor.setValueOn(voxel_of(p, impl_->size), true); }
 
 void OccupancyGrid::mark_box(const Vec3f& lo, const Vec3f& hi) {
   const openvdb::CoordBBox box(voxel_of(lo, impl_->size), voxel_of(hi, impl_->size));
-  impl_->grid->tree().sparseFill(box, true, true);
+  // Neighbouring triangles seen from nearby viewpoints mark the same voxel boxes over and
+  // over: remember recent boxes and skip repeats.
+  openvdb::CoordBBox& recent = impl_->recent[box_slot(box)];
+  if (recent == box) return;
+  recent = box;
+  if (static_cast<std::int64_t>(box.volume()) > kSmallBoxVoxels) {
+    impl_->grid->tree().sparseFill(box, true, true);
+    return;
+  }
+  // A few voxels: setting them one by one through the cached accessor beats a fill's descent.
+  for (auto it = box.begin(); it; ++it) impl_->accessor.setValueOn(*it, true);
 }
 
 bool OccupancyGrid::occupied(const Vec3f& p) const {

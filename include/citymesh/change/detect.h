@@ -39,7 +39,6 @@ using TrianglePair = std::pair<std::uint32_t, std::uint32_t>;
 
 struct ChangeStats {
   std::uint64_t triangles = 0;
-  std::uint64_t samples = 0;  ///< kd-tree points
   std::uint64_t consistent_pairs = 0;
   std::uint64_t conflict_candidates = 0;  ///< (triangle, newer acquisition) pairs without consistency
   std::uint64_t prefilter_skipped = 0;    ///< of those, ruled out by the empty-space grids

@@ -3,8 +3,11 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
+#include <utility>
 
 namespace citymesh {
 
@@ -29,5 +32,9 @@ class ThreadLimit {
 /// that are then combined in block order gives the same bytes on 1 or N threads.
 void parallel_for_blocks(std::size_t count, std::size_t grain,
                          const std::function<void(std::size_t, std::size_t)>& body);
+
+/// Sorts ascending on all threads. Keys are compared whole, so equal keys are identical and
+/// the result does not depend on the thread count.
+void parallel_sort(std::span<std::pair<std::uint32_t, std::uint32_t>> values);
 
 }  // namespace citymesh

@@ -1,0 +1,40 @@
+// SPDX-License-Identifier: MIT
+// Which boxes of a fixed set contain a point or meet a small box (an Embree BVH and its point
+// queries behind this header): the candidate searches of the change detection.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "citymesh/core/vec.h"
+
+namespace citymesh {
+
+/// Closed axis-aligned box in a local float frame.
+struct Box3f {
+  Vec3f min, max;
+};
+
+/// A fixed set of boxes, indexed for containment and overlap queries.
+class BoxTree {
+ public:
+  explicit BoxTree(std::vector<Box3f> boxes);
+  ~BoxTree();
+  BoxTree(const BoxTree&) = delete;
+  BoxTree& operator=(const BoxTree&) = delete;
+
+  /// Replaces `out` with the indices of the boxes containing p (closed boxes), in increasing
+  /// order. Thread-safe.
+  void containing(const Vec3f& p, std::vector<std::uint32_t>& out) const;
+  /// Replaces `out` with the indices of the boxes overlapping the closed box b, in increasing
+  /// order. Fast for small query boxes. Thread-safe.
+  void overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace citymesh

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/spatial/box_tree.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+namespace citymesh {
+namespace {
+
+std::vector<Box3f> random_boxes(std::mt19937& rng, std::size_t n, float world, float max_side) {
+  std::uniform_real_distribution<float> pos(0, world), side(0.01f, max_side);
+  std::vector<Box3f> boxes(n);
+  for (Box3f& b : boxes) {
+    b.min = {pos(rng), pos(rng), pos(rng)};
+    b.max = b.min + Vec3f{side(rng), side(rng), side(rng)};
+  }
+  return boxes;
+}
+
+bool meet(const Box3f& p, const Box3f& q) {
+  return p.min.x <= q.max.x && q.min.x <= p.max.x && p.min.y <= q.max.y && q.min.y <= p.max.y &&
+         p.min.z <= q.max.z && q.min.z <= p.max.z;
+}
+
+std::vector<std::uint32_t> brute_force(const std::vector<Box3f>& boxes, const Box3f& query) {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t i = 0; i < boxes.size(); ++i) {
+    if (meet(boxes[i], query)) out.push_back(i);
+  }
+  return out;
+}
+
+/// Small boxes and a few long thin ones, like triangles and empty-space tetrahedra, far from
+/// the origin like city coordinates in a tile frame.
+std::vector<Box3f> scene_boxes(std::mt19937& rng) {
+  std::vector<Box3f> boxes = random_boxes(rng, 3000, 10, 0.6f);
+  for (Box3f& box : random_boxes(rng, 50, 10, 1.0f)) {
+    box.max.x += 8;
+    boxes.push_back(box);
+  }
+  for (Box3f& b : boxes) {
+    b.min = b.min + Vec3f{500, -300, 40};
+    b.max = b.max + Vec3f{500, -300, 40};
+  }
+  return boxes;
+}
+
+TEST(BoxTree, OverlappingEqualsBruteForce) {
+  std::mt19937 rng(3);
+  const std::vector<Box3f> boxes = scene_boxes(rng);
+  const BoxTree tree(boxes);
+  std::size_t found = 0;
+  std::vector<std::uint32_t> out;
+  for (Box3f q : random_boxes(rng, 500, 10, 0.8f)) {
+    q.min = q.min + Vec3f{500, -300, 40};
+    q.max = q.max + Vec3f{500, -300, 40};
+    tree.overlapping(q, out);
+    EXPECT_EQ(out, brute_force(boxes, q));
+    found += out.size();
+  }
+  EXPECT_GT(found, 300u);
+}
+
+TEST(BoxTree, ContainingFindsBoxesWhosePointsAreOnTheirFaces) {
+  std::mt19937 rng(5);
+  const std::vector<Box3f> boxes = scene_boxes(rng);
+  const BoxTree tree(boxes);
+  std::vector<std::uint32_t> out;
+  // Each box's own corners lie on its closed boundary: it must be found.
+  for (std::uint32_t i = 0; i < boxes.size(); i += 7) {
+    for (const Vec3f& p : {boxes[i].min, boxes[i].max, Vec3f{boxes[i].min.x, boxes[i].max.y, boxes[i].min.z}}) {
+      tree.containing(p, out);
+      EXPECT_EQ(out, brute_force(boxes, {p, p}));
+      EXPECT_TRUE(std::binary_search(out.begin(), out.end(), i)) << i;
+    }
+  }
+}
+
+TEST(BoxTree, EmptySetFindsNothing) {
+  const BoxTree tree({});
+  std::vector<std::uint32_t> out{1, 2};
+  tree.containing({0, 0, 0}, out);
+  EXPECT_TRUE(out.empty());
+}
+
+}  // namespace
+}  // namespace citymesh
