@@ -26,16 +26,33 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& gri
 
 std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, const ChangeParams& params,
                                                    ChangeStats& stats) {
-  const std::size_t n = f.acquisitions();
-  std::vector<OccupancyGrid> grids;
-  for (std::size_t a = 0; a < n; ++a) grids.emplace_back(params.voxel_size);
-  parallel_for_blocks(n, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t a = begin; a < end; ++a) {
-      for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
-        if (f.empty_scale[g] > 0) mark_empty_space(f, g, grids[a]);
+  // Only empty space newer than something is ever asked about: the oldest acquisitions'
+  // grids stay empty. The others are marked in chunks of triangles, one grid each for an even
+  // load whatever the acquisition sizes, then merged (a union: the order does not matter).
+  const TimePoint oldest = *std::min_element(f.dates.begin(), f.dates.end());
+  struct Chunk {
+    std::size_t acquisition, begin, end;
+  };
+  constexpr std::size_t kChunk = 16384;
+  std::vector<Chunk> chunks;
+  for (std::size_t a = 0; a < f.acquisitions(); ++a) {
+    if (!(oldest < f.dates[a])) continue;
+    for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; g += kChunk) {
+      chunks.push_back({a, g, std::min(g + kChunk, f.index.offsets[a + 1])});
+    }
+  }
+  std::vector<OccupancyGrid> chunk_grids;
+  for (std::size_t c = 0; c < chunks.size(); ++c) chunk_grids.emplace_back(params.voxel_size);
+  parallel_for_blocks(chunks.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) {
+      for (std::size_t g = chunks[c].begin; g < chunks[c].end; ++g) {
+        if (f.empty_scale[g] > 0) mark_empty_space(f, g, chunk_grids[c]);
       }
     }
   });
+  std::vector<OccupancyGrid> grids;
+  for (std::size_t a = 0; a < f.acquisitions(); ++a) grids.emplace_back(params.voxel_size);
+  for (std::size_t c = 0; c < chunks.size(); ++c) grids[chunks[c].acquisition].merge(std::move(chunk_grids[c]));
   for (const OccupancyGrid& grid : grids) stats.marked_voxels += grid.marked_voxels();
   return grids;
 }

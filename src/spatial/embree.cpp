@@ -182,7 +182,6 @@ void BoxTree::overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const
   rtcInitPointQueryContext(&context);
   BoxQuery q{impl_->boxes, b, &out};
   rtcPointQuery(impl_->scene, &query, &context, collect_overlapping, &q);
-  std::sort(out.begin(), out.end());
 }
 
 }  // namespace citymesh

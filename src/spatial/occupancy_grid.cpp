@@ -109,6 +109,17 @@ bool OccupancyGrid::any_in_box(const Vec3f& lo, const Vec3f& hi) const {
   return false;
 }
 
+void OccupancyGrid::merge(OccupancyGrid&& other) {
+  if (other.impl_->size != impl_->size) {
+    throw ProcessingError(
+        fmt::format("occupancy grid: cannot merge voxels of {} m into {} m", other.impl_->size, impl_->size));
+  }
+  impl_->grid->tree().topologyUnion(other.impl_->grid->tree());
+  other.impl_->grid->clear();
+  other.impl_->accessor.clear();
+  impl_->accessor.clear();  // the union may have replaced cached nodes
+}
+
 std::size_t OccupancyGrid::marked_voxels() const {
   return static_cast<std::size_t>(impl_->grid->tree().activeVoxelCount());
 }

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -57,6 +58,7 @@ TEST(BoxTree, OverlappingEqualsBruteForce) {
     q.min = q.min + Vec3f{500, -300, 40};
     q.max = q.max + Vec3f{500, -300, 40};
     tree.overlapping(q, out);
+    std::sort(out.begin(), out.end());
     EXPECT_EQ(out, brute_force(boxes, q));
     found += out.size();
   }
@@ -72,6 +74,7 @@ TEST(BoxTree, ContainingFindsBoxesWhosePointsAreOnTheirFaces) {
   for (std::uint32_t i = 0; i < boxes.size(); i += 7) {
     for (const Vec3f& p : {boxes[i].min, boxes[i].max, Vec3f{boxes[i].min.x, boxes[i].max.y, boxes[i].min.z}}) {
       tree.containing(p, out);
+      std::sort(out.begin(), out.end());
       EXPECT_EQ(out, brute_force(boxes, {p, p}));
       EXPECT_TRUE(std::binary_search(out.begin(), out.end(), i)) << i;
     }

@@ -57,6 +57,21 @@ TEST(OccupancyGrid, MarksAndQueriesLikeAVoxelSet) {
   }
 }
 
+TEST(OccupancyGrid, MergeIsTheUnionAndRepeatedBoxesStayMarked) {
+  OccupancyGrid a(0.5), b(0.5);
+  a.mark_box({0, 0, 0}, {0.9f, 0.4f, 0.4f});  // 2 voxels
+  a.mark_box({0, 0, 0}, {0.9f, 0.4f, 0.4f});  // the same box again: skipped, still 2
+  b.mark_box({0.6f, 0, 0}, {1.4f, 0.4f, 0.4f});  // 2 voxels, one shared with a
+  b.mark_point({-3, -3, -3});
+  a.merge(std::move(b));
+  EXPECT_EQ(a.marked_voxels(), 4u);
+  EXPECT_TRUE(a.occupied({1.2f, 0.1f, 0.1f}));
+  EXPECT_TRUE(a.occupied({-2.9f, -2.9f, -2.9f}));
+  EXPECT_EQ(b.marked_voxels(), 0u);  // NOLINT(bugprone-use-after-move): merge leaves it empty
+  OccupancyGrid c(1.0);
+  EXPECT_ANY_THROW(a.merge(std::move(c)));
+}
+
 TEST(OccupancyGrid, RefusesNonPositiveVoxelSize) {
   EXPECT_ANY_THROW(OccupancyGrid(0.0));
   EXPECT_ANY_THROW(OccupancyGrid(-1.0));

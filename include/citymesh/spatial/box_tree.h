@@ -25,11 +25,11 @@ class BoxTree {
   BoxTree(const BoxTree&) = delete;
   BoxTree& operator=(const BoxTree&) = delete;
 
-  /// Replaces `out` with the indices of the boxes containing p (closed boxes), in increasing
-  /// order. Thread-safe.
+  /// Replaces `out` with the indices of the boxes containing p (closed boxes), in no
+  /// particular order. Thread-safe.
   void containing(const Vec3f& p, std::vector<std::uint32_t>& out) const;
-  /// Replaces `out` with the indices of the boxes overlapping the closed box b, in increasing
-  /// order. Fast for small query boxes. Thread-safe.
+  /// Replaces `out` with the indices of the boxes overlapping the closed box b, in no
+  /// particular order. Fast for small query boxes. Thread-safe.
   void overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const;
 
  private:

@@ -27,6 +27,8 @@ class OccupancyGrid {
   /// True when any voxel overlapping the closed box [lo, hi] is marked.
   [[nodiscard]] bool any_in_box(const Vec3f& lo, const Vec3f& hi) const;
   [[nodiscard]] std::size_t marked_voxels() const;
+  /// Marks every voxel marked in `other` (same voxel size), which is left empty.
+  void merge(OccupancyGrid&& other);
 
  private:
   struct Impl;
