@@ -1,0 +1,72 @@
+// SPDX-License-Identifier: MIT
+// A pseudo-boolean energy of unary and pairwise terms over binary variables, and the ways we
+// minimise it: an exact graph cut when flipping some variables makes every term submodular,
+// otherwise QPBO (roof duality: a max-flow on the doubled graph, keeping only the strongly
+// persistent labels) followed by QPBO-I improvement of the unlabelled variables.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+namespace citymesh {
+
+/// E(x) = sum_i unary[i][x_i] + sum_(i,j) e[x_i][x_j].
+struct BinaryEnergy {
+  struct Pair {
+    std::uint32_t i = 0, j = 0;
+    double e00 = 0, e01 = 0, e10 = 0, e11 = 0;
+    [[nodiscard]] bool submodular() const { return e00 + e11 <= e01 + e10; }
+  };
+  std::vector<std::array<double, 2>> unary;
+  std::vector<Pair> pairs;
+
+  [[nodiscard]] std::size_t size() const { return unary.size(); }
+  /// E(x) for a complete labelling (every entry 0 or 1).
+  [[nodiscard]] double evaluate(std::span<const std::int8_t> x) const;
+};
+
+/// Label of a variable: 0, 1, or unlabelled.
+constexpr std::int8_t kUnlabelled = -1;
+
+/// Variables to flip (x -> 1 - x) so that every pairwise term becomes submodular, when such a
+/// set exists (a two-colouring of the pair graph where non-submodular pairs join different
+/// colours and submodular ones equal colours); nullopt when it does not. With two meshes and
+/// overlap terms between them only, flipping one mesh is such a set.
+std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e);
+
+/// Exact minimum of an energy whose terms are all submodular once the variables in `flips`
+/// are flipped: one graph cut. Returns a complete labelling.
+std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
+
+/// QPBO: the strongly persistent partial labelling (every labelled variable takes that label
+/// in every global minimum); the others are kUnlabelled.
+std::vector<std::int8_t> qpbo(const BinaryEnergy& e);
+
+struct ImproveParams {
+  int rounds = 3;             ///< random orders tried
+  std::uint64_t seed = 1;     ///< fixed: the same input gives the same labelling
+};
+
+/// QPBO-I (Rother et al. 2007): completes a partial labelling (unlabelled variables first set
+/// by iterated conditional modes), then repeatedly fixes unlabelled variables, in a random
+/// order, to their current value and re-runs QPBO on the unlabelled part; the new labels are
+/// kept when the energy does not rise. Never returns a labelling worse than its start (the
+/// completed one, whose energy goes to `completed_energy` when given).
+std::vector<std::int8_t> improve_qpbo_i(const BinaryEnergy& e, std::span<const std::int8_t> partial,
+                                        const ImproveParams& params, double* completed_energy = nullptr);
+
+struct MinimiseStats {
+  bool exact = false;               ///< solved by one cut after flipping
+  std::size_t unlabelled_after_qpbo = 0;
+  double energy_before_improvement = 0;  ///< QPBO's labels completed by ICM
+  double energy = 0;
+  double seconds_qpbo = 0, seconds_improvement = 0;
+};
+
+/// The whole strategy: exact flipped cut when possible, else QPBO then QPBO-I.
+std::vector<std::int8_t> minimise(const BinaryEnergy& e, const ImproveParams& params, MinimiseStats& stats);
+
+}  // namespace citymesh

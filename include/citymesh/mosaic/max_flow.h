@@ -1,0 +1,83 @@
+// SPDX-License-Identifier: MIT
+// Minimum s-t cut / maximum flow on a directed graph with real capacities: our own
+// Boykov-Kolmogorov algorithm (two search trees grown from the terminals and kept between
+// augmentations; orphans re-adopted), the engine under the mosaic's QPBO.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace citymesh {
+
+class MaxFlow {
+ public:
+  using Node = std::uint32_t;
+
+  explicit MaxFlow(std::size_t nodes = 0);
+
+  /// Adds a node and returns its index.
+  Node add_node();
+  [[nodiscard]] std::size_t node_count() const { return nodes_.size(); }
+
+  /// Adds capacity from the source to i and from i to the sink (both >= 0, accumulated).
+  void add_terminal(Node i, double from_source, double to_sink);
+  /// Adds an arc i -> j of capacity `cap` and its reverse j -> i of capacity `rev_cap`
+  /// (both >= 0). i != j.
+  void add_edge(Node i, Node j, double cap, double rev_cap);
+
+  /// Computes a maximum flow and returns its value. Call once, after every node and edge.
+  double solve();
+
+  /// After solve(): the nodes reachable from the source in the residual graph (the source side
+  /// of the minimum cut that is smallest on the source side), one flag per node. Residuals
+  /// below 1e-12 of the largest capacity count as zero (rounding left by the pushes).
+  [[nodiscard]] std::vector<std::uint8_t> source_side() const;
+
+  /// Path augmentations made by solve(), for benchmarks.
+  [[nodiscard]] std::uint64_t augmentations() const { return augmentations_; }
+
+ private:
+  using Arc = std::uint32_t;
+  static constexpr Arc kNone = UINT32_MAX;
+  static constexpr Arc kTerminal = UINT32_MAX - 1;  ///< parent of a node hanging from its terminal
+  static constexpr Arc kOrphan = UINT32_MAX - 2;
+
+  enum class Tree : std::uint8_t { free, source, sink };
+
+  struct NodeData {
+    Arc first = kNone;   ///< first outgoing arc
+    Arc parent = kNone;  ///< arc from the node to its parent (towards the terminal)
+    Node next_active = 0;
+    bool active = false;
+    Tree tree = Tree::free;
+    double terminal = 0;  ///< residual: > 0 from the source, < 0 to the sink
+    std::uint32_t stamp = 0, distance = 0;  ///< distance-to-terminal heuristic, valid at `stamp`
+  };
+  struct ArcData {
+    Node head = 0;
+    Arc next = kNone;  ///< next arc out of the same tail
+    double residual = 0;
+  };
+  // The reverse of arc a is a ^ 1: arcs are added in pairs.
+
+  void set_active(Node i);
+  Node next_active();
+  bool grow(Node i, Arc& bridge);
+  void augment(Arc bridge);
+  void adopt(Node i);
+  [[nodiscard]] bool rooted(Node i, std::uint32_t& distance);
+
+  std::vector<NodeData> nodes_;
+  std::vector<ArcData> arcs_;
+  std::vector<Node> orphans_;
+  Node active_first_ = 0, active_last_ = 0;
+  bool have_active_ = false;
+  std::uint32_t time_ = 0;
+  double flow_ = 0;
+  double largest_ = 0;  ///< largest capacity given
+  double zero_ = 0;     ///< residuals at or below this count as saturated
+  static constexpr double kRelativeZero = 1e-12;
+  std::uint64_t augmentations_ = 0;
+};
+
+}  // namespace citymesh

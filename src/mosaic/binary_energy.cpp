@@ -1,0 +1,150 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/mosaic/binary_energy.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <deque>
+#include <numeric>
+#include <random>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/stopwatch.h"
+#include "citymesh/mosaic/max_flow.h"
+
+namespace citymesh {
+
+double BinaryEnergy::evaluate(std::span<const std::int8_t> x) const {
+  double e = 0;
+  for (std::size_t i = 0; i < unary.size(); ++i) e += unary[i][static_cast<std::size_t>(x[i])];
+  for (const Pair& p : pairs) {
+    const bool a = x[p.i] != 0, b = x[p.j] != 0;
+    e += a ? (b ? p.e11 : p.e10) : (b ? p.e01 : p.e00);
+  }
+  return e;
+}
+
+namespace {
+
+/// The interaction strength of a pair: e01 + e10 - e00 - e11, > 0 for submodular terms.
+double coupling(const BinaryEnergy::Pair& p) { return p.e01 + p.e10 - p.e00 - p.e11; }
+
+/// The cut graph of an energy. Variable i is node i, x_i = 0 on the source side. With
+/// `doubled`, node n + i stands for the negation of x_i (source side when x_i = 1) and every
+/// term is entered twice, once per copy, which is QPBO's construction; without, every term
+/// must be submodular. Returns the graph ready to solve.
+MaxFlow cut_graph(const BinaryEnergy& e, bool doubled) {
+  const std::size_t n = e.size();
+  MaxFlow g(doubled ? 2 * n : n);
+  std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0
+  for (std::size_t i = 0; i < n; ++i) cost_of_one[i] = e.unary[i][1] - e.unary[i][0];
+  const auto bar = [n](std::uint32_t i) { return static_cast<MaxFlow::Node>(n + i); };
+  for (const BinaryEnergy::Pair& p : e.pairs) {
+    // E = e00 + (e10 - e00) x_i + (e11 - e10) x_j + c (1 - x_i) x_j, c = coupling, for a
+    // submodular term; a non-submodular one is the same in (x_i, 1 - x_j) with -c.
+    cost_of_one[p.i] += p.e10 - p.e00;
+    cost_of_one[p.j] += p.e11 - p.e10;
+    const double c = coupling(p);
+    if (c >= 0) {
+      if (c == 0) continue;
+      g.add_edge(p.i, p.j, c, 0);  // cut when x_i = 0 and x_j = 1
+      if (doubled) g.add_edge(bar(p.j), bar(p.i), c, 0);
+    } else {
+      if (!doubled) throw ProcessingError("graph cut: a non-submodular term in a single cut");
+      // In (x_i, y_j = 1 - x_j): E = e01 + (e11 - e01) x_i + (e11 - e10) x_j - c (1 - x_i)(1 - x_j);
+      // the unary part of x_i differs from the one entered above by -c.
+      cost_of_one[p.i] -= c;
+      g.add_edge(p.i, bar(p.j), -c, 0);  // cut when x_i = 0 and x_j = 0
+      g.add_edge(p.j, bar(p.i), -c, 0);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = cost_of_one[i];
+    const auto v = static_cast<MaxFlow::Node>(i);
+    if (d > 0) {
+      g.add_terminal(v, d, 0);  // x_i = 1: node on the sink side, cutting source -> i
+      if (doubled) g.add_terminal(bar(v), 0, d);
+    } else if (d < 0) {
+      g.add_terminal(v, 0, -d);
+      if (doubled) g.add_terminal(bar(v), -d, 0);
+    }
+  }
+  return g;
+}
+
+}  // namespace
+
+std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e) {
+  const std::size_t n = e.size();
+  // Adjacency: for each pair with a real coupling, whether its ends must differ.
+  std::vector<std::vector<std::pair<std::uint32_t, bool>>> adjacent(n);
+  for (const BinaryEnergy::Pair& p : e.pairs) {
+    const double c = coupling(p);
+    if (c == 0) continue;
+    adjacent[p.i].emplace_back(p.j, c < 0);
+    adjacent[p.j].emplace_back(p.i, c < 0);
+  }
+  std::vector<std::int8_t> colour(n, -1);
+  std::deque<std::uint32_t> queue;
+  for (std::uint32_t s = 0; s < n; ++s) {
+    if (colour[s] >= 0) continue;
+    colour[s] = 0;
+    queue.push_back(s);
+    while (!queue.empty()) {
+      const std::uint32_t i = queue.front();
+      queue.pop_front();
+      for (const auto& [j, differ] : adjacent[i]) {
+        const auto want = static_cast<std::int8_t>(differ ? 1 - colour[i] : colour[i]);
+        if (colour[j] < 0) {
+          colour[j] = want;
+          queue.push_back(j);
+        } else if (colour[j] != want) {
+          return std::nullopt;
+        }
+      }
+    }
+  }
+  return std::vector<std::uint8_t>(colour.begin(), colour.end());
+}
+
+std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
+  BinaryEnergy f = e;
+  for (std::size_t i = 0; i < f.size(); ++i) {
+    if (flips[i] != 0) std::swap(f.unary[i][0], f.unary[i][1]);
+  }
+  for (BinaryEnergy::Pair& p : f.pairs) {
+    if (flips[p.i] != 0) {
+      std::swap(p.e00, p.e10);
+      std::swap(p.e01, p.e11);
+    }
+    if (flips[p.j] != 0) {
+      std::swap(p.e00, p.e01);
+      std::swap(p.e10, p.e11);
+    }
+    // Rounding can leave a modular term a hair non-submodular: it carries no coupling.
+    if (!p.submodular() && coupling(p) > -1e-12 * (std::abs(p.e00) + std::abs(p.e11) + 1)) p.e11 = p.e01 + p.e10 - p.e00;
+  }
+  MaxFlow g = cut_graph(f, /*doubled=*/false);
+  g.solve();
+  const std::vector<std::uint8_t> source = g.source_side();
+  std::vector<std::int8_t> x(e.size());
+  for (std::size_t i = 0; i < x.size(); ++i) x[i] = static_cast<std::int8_t>((source[i] != 0 ? 0 : 1) ^ flips[i]);
+  return x;
+}
+
+std::vector<std::int8_t> qpbo(const BinaryEnergy& e) {
+  const std::size_t n = e.size();
+  MaxFlow g = cut_graph(e, /*doubled=*/true);
+  g.solve();
+  // Nodes reachable from the source lie on the source side of every minimum cut: x_i = 0 when
+  // i is, x_i = 1 when its negation is; both never happen (that would be an s-t path).
+  const std::vector<std::uint8_t> source = g.source_side();
+  std::vector<std::int8_t> x(n, kUnlabelled);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (source[i] != 0) x[i] = 0;
+    if (source[n + i] != 0) x[i] = 1;
+  }
+  return x;
+}
+
+}  // namespace citymesh

@@ -1,0 +1,273 @@
+// SPDX-License-Identifier: MIT
+// Boykov-Kolmogorov max-flow (Boykov & Kolmogorov, "An experimental comparison of min-cut/
+// max-flow algorithms for energy minimization in vision", PAMI 2004), written from the paper:
+// a search tree grows from each terminal; when they meet, the path is augmented; nodes cut
+// from their tree by saturated arcs (orphans) look for a new parent in the same tree or
+// become free. The trees are kept between augmentations, which is what makes it fast on the
+// grid-like graphs of image and mesh labelling.
+#include "citymesh/mosaic/max_flow.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <limits>
+
+#include "citymesh/core/error.h"
+
+namespace citymesh {
+
+MaxFlow::MaxFlow(std::size_t nodes) : nodes_(nodes) {}
+
+MaxFlow::Node MaxFlow::add_node() {
+  nodes_.emplace_back();
+  return static_cast<Node>(nodes_.size() - 1);
+}
+
+void MaxFlow::add_terminal(Node i, double from_source, double to_sink) {
+  // Fold the node's current net capacity into the new pair, push the common part straight
+  // through (it is flow s -> i -> t whatever the cut) and keep the difference.
+  NodeData& n = nodes_[i];
+  if (n.terminal > 0) {
+    from_source += n.terminal;
+  } else {
+    to_sink -= n.terminal;
+  }
+  flow_ += std::min(from_source, to_sink);
+  n.terminal = from_source - to_sink;
+  largest_ = std::max(largest_, std::abs(n.terminal));
+}
+
+void MaxFlow::add_edge(Node i, Node j, double cap, double rev_cap) {
+  if (i == j) throw ProcessingError("max-flow: an edge from a node to itself");
+  largest_ = std::max({largest_, cap, rev_cap});
+  if (arcs_.size() + 2 >= kOrphan) throw ProcessingError("max-flow: too many edges");
+  const auto a = static_cast<Arc>(arcs_.size());
+  arcs_.push_back({j, nodes_[i].first, cap});
+  arcs_.push_back({i, nodes_[j].first, rev_cap});
+  nodes_[i].first = a;
+  nodes_[j].first = a + 1;
+}
+
+void MaxFlow::set_active(Node i) {
+  NodeData& n = nodes_[i];
+  if (n.active) return;
+  n.active = true;
+  if (have_active_) {
+    nodes_[active_last_].next_active = i;
+  } else {
+    active_first_ = i;
+    have_active_ = true;
+  }
+  active_last_ = i;
+}
+
+MaxFlow::Node MaxFlow::next_active() {
+  while (have_active_) {
+    const Node i = active_first_;
+    NodeData& n = nodes_[i];
+    if (i == active_last_) {
+      have_active_ = false;
+    } else {
+      active_first_ = n.next_active;
+    }
+    n.active = false;
+    if (n.tree != Tree::free) return i;
+  }
+  return std::numeric_limits<Node>::max();
+}
+
+bool MaxFlow::grow(Node i, Arc& bridge) {
+  const NodeData& ni = nodes_[i];
+  const bool source = ni.tree == Tree::source;
+  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
+    // Source tree: grow along i -> j. Sink tree: along j -> i (the reverse arc a ^ 1).
+    if (!((source ? arcs_[a].residual : arcs_[a ^ 1].residual) > zero_)) continue;
+    const Node j = arcs_[a].head;
+    NodeData& nj = nodes_[j];
+    if (nj.tree == Tree::free) {
+      nj.tree = ni.tree;
+      nj.parent = a ^ 1;
+      nj.stamp = ni.stamp;
+      nj.distance = ni.distance + 1;
+      set_active(j);
+    } else if (nj.tree != ni.tree) {
+      bridge = source ? a : a ^ 1;  // always from the source tree to the sink tree
+      return true;
+    } else if (nj.stamp <= ni.stamp && nj.distance > ni.distance) {
+      // A shorter way to the terminal through i: re-hang j (keeps the trees shallow).
+      nj.parent = a ^ 1;
+      nj.stamp = ni.stamp;
+      nj.distance = ni.distance + 1;
+    }
+  }
+  return false;
+}
+
+void MaxFlow::augment(Arc bridge) {
+  // Bottleneck: the bridge, the source-side path (arcs parent -> child), the sink-side path
+  // (arcs child -> parent) and the two terminal capacities.
+  double f = arcs_[bridge].residual;
+  Node i = arcs_[bridge ^ 1].head;
+  for (Arc p; (p = nodes_[i].parent) != kTerminal; i = arcs_[p].head) f = std::min(f, arcs_[p ^ 1].residual);
+  f = std::min(f, nodes_[i].terminal);
+  i = arcs_[bridge].head;
+  for (Arc p; (p = nodes_[i].parent) != kTerminal; i = arcs_[p].head) f = std::min(f, arcs_[p].residual);
+  f = std::min(f, -nodes_[i].terminal);
+
+  arcs_[bridge].residual -= f;
+  arcs_[bridge ^ 1].residual += f;
+  i = arcs_[bridge ^ 1].head;
+  for (Arc p; (p = nodes_[i].parent) != kTerminal;) {
+    arcs_[p].residual += f;
+    arcs_[p ^ 1].residual -= f;
+    const Node up = arcs_[p].head;
+    if (!(arcs_[p ^ 1].residual > zero_)) {
+      nodes_[i].parent = kOrphan;
+      orphans_.push_back(i);
+    }
+    i = up;
+  }
+  nodes_[i].terminal -= f;
+  if (!(nodes_[i].terminal > zero_)) {
+    nodes_[i].parent = kOrphan;
+    orphans_.push_back(i);
+  }
+  i = arcs_[bridge].head;
+  for (Arc p; (p = nodes_[i].parent) != kTerminal;) {
+    arcs_[p ^ 1].residual += f;
+    arcs_[p].residual -= f;
+    const Node up = arcs_[p].head;
+    if (!(arcs_[p].residual > zero_)) {
+      nodes_[i].parent = kOrphan;
+      orphans_.push_back(i);
+    }
+    i = up;
+  }
+  nodes_[i].terminal += f;
+  if (!(nodes_[i].terminal < -zero_)) {
+    nodes_[i].parent = kOrphan;
+    orphans_.push_back(i);
+  }
+  flow_ += f;
+  ++augmentations_;
+}
+
+bool MaxFlow::rooted(Node j, std::uint32_t& distance) {
+  // Walk up to the terminal (or to a node already checked in this round, whose distance is
+  // known); an orphan on the way means j is cut off.
+  std::uint32_t d = 0;
+  for (Node k = j;;) {
+    NodeData& n = nodes_[k];
+    if (n.stamp == time_) {
+      d += n.distance;
+      break;
+    }
+    const Arc p = n.parent;
+    ++d;
+    if (p == kTerminal) {
+      n.stamp = time_;
+      n.distance = 1;
+      break;
+    }
+    if (p == kOrphan || p == kNone) return false;
+    k = arcs_[p].head;
+  }
+  // Record the distances along the path for the next queries of this round.
+  distance = d;
+  for (Node k = j; nodes_[k].stamp != time_; k = arcs_[nodes_[k].parent].head) {
+    nodes_[k].stamp = time_;
+    nodes_[k].distance = d--;
+  }
+  return true;
+}
+
+void MaxFlow::adopt(Node i) {
+  NodeData& ni = nodes_[i];
+  const bool source = ni.tree == Tree::source;
+  Arc best = kNone;
+  std::uint32_t best_distance = std::numeric_limits<std::uint32_t>::max();
+  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
+    // A parent j must send (source tree: j -> i) or take (sink tree: i -> j) flow.
+    if (!((source ? arcs_[a ^ 1].residual : arcs_[a].residual) > zero_)) continue;
+    const Node j = arcs_[a].head;
+    if (nodes_[j].tree != ni.tree) continue;
+    std::uint32_t d = 0;
+    if (rooted(j, d) && d < best_distance) {
+      best = a;
+      best_distance = d;
+    }
+  }
+  if (best != kNone) {
+    ni.parent = best;
+    ni.stamp = time_;
+    ni.distance = best_distance + 1;
+    return;
+  }
+  // No parent: i leaves its tree. Its children become orphans; neighbours that could grow
+  // into it again are made active.
+  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
+    const Node j = arcs_[a].head;
+    NodeData& nj = nodes_[j];
+    if (nj.tree != ni.tree) continue;
+    if ((source ? arcs_[a ^ 1].residual : arcs_[a].residual) > zero_) set_active(j);
+    if (nj.parent != kTerminal && nj.parent != kOrphan && nj.parent != kNone && arcs_[nj.parent].head == i) {
+      nj.parent = kOrphan;
+      orphans_.push_back(j);
+    }
+  }
+  ni.tree = Tree::free;
+  ni.parent = kNone;
+}
+
+double MaxFlow::solve() {
+  // Sums of pushes leave rounding crumbs on arcs that are saturated in exact arithmetic:
+  // residuals this far below the largest capacity count as zero, or the cut would leak.
+  zero_ = largest_ * kRelativeZero;
+  for (Node i = 0; i < nodes_.size(); ++i) {
+    NodeData& n = nodes_[i];
+    if (!(std::abs(n.terminal) > zero_)) continue;
+    n.tree = n.terminal > 0 ? Tree::source : Tree::sink;
+    n.parent = kTerminal;
+    n.stamp = 0;
+    n.distance = 1;
+    set_active(i);
+  }
+  for (Node i; (i = next_active()) != std::numeric_limits<Node>::max();) {
+    Arc bridge = kNone;
+    if (!grow(i, bridge)) continue;
+    set_active(i);  // its remaining arcs are still to be scanned
+    ++time_;
+    augment(bridge);
+    while (!orphans_.empty()) {
+      const Node o = orphans_.back();
+      orphans_.pop_back();
+      adopt(o);
+    }
+  }
+  return flow_;
+}
+
+std::vector<std::uint8_t> MaxFlow::source_side() const {
+  std::vector<std::uint8_t> side(nodes_.size(), 0);
+  std::deque<Node> queue;
+  for (Node i = 0; i < nodes_.size(); ++i) {
+    if (nodes_[i].terminal > zero_) {
+      side[i] = 1;
+      queue.push_back(i);
+    }
+  }
+  while (!queue.empty()) {
+    const Node i = queue.front();
+    queue.pop_front();
+    for (Arc a = nodes_[i].first; a != kNone; a = arcs_[a].next) {
+      const Node j = arcs_[a].head;
+      if (side[j] == 0 && arcs_[a].residual > zero_) {
+        side[j] = 1;
+        queue.push_back(j);
+      }
+    }
+  }
+  return side;
+}
+
+}  // namespace citymesh
