@@ -199,6 +199,12 @@ std::vector<KeyDef> make_keys() {
       "skip exact conflict tests where the empty-space grids show no newer empty space (never changes results)",
       [](auto& c) -> auto& { return c.change.prefilter; }));
 
+  keys.push_back(enum_key(mosaic, "method",
+      "how kept triangles are merged: the paper's energy solved by QPBO, or its baseline (keep unless something "
+      "older lies within the distance threshold)",
+      [](auto& c) -> auto& { return c.mosaic.method; },
+      std::vector<std::pair<std::string, MosaicMethod>>{{"energy", MosaicMethod::energy},
+                                                        {"update-model", MosaicMethod::update_model}}));
   keys.push_back(enum_key(mosaic, "quality", "per-triangle quality Q (constant favours the finer mesh)",
       [](auto& c) -> auto& { return c.mosaic.quality; },
       std::vector<std::pair<std::string, QualityMeasure>>{{"constant", QualityMeasure::constant},
@@ -206,12 +212,17 @@ std::vector<KeyDef> make_keys() {
                                                           {"resolution", QualityMeasure::resolution}}));
   keys.push_back(real_key(mosaic, "quality_weight", "lambda 1: reward for keeping quality",
       [](auto& c) -> auto& { return c.mosaic.quality_weight; }, 0, 1e6));
-  keys.push_back(real_key(mosaic, "boundary_weight", "lambda 2: cost per metre of mesh boundary kept",
+  keys.push_back(real_key(mosaic, "boundary_weight", "lambda 2: cost per mean edge length of mesh boundary kept",
       [](auto& c) -> auto& { return c.mosaic.boundary_weight; }, 0, 1e6));
   keys.push_back(real_key(mosaic, "overlap_weight", "lambda 3: cost of keeping two overlapping triangles",
       [](auto& c) -> auto& { return c.mosaic.overlap_weight; }, 0, 1e9));
-  keys.push_back(real_key(mosaic, "seam_weight", "lambda 4: cost per metre of seam inside a mesh",
+  keys.push_back(real_key(mosaic, "seam_weight", "lambda 4: cost per mean edge length of seam inside a mesh",
       [](auto& c) -> auto& { return c.mosaic.seam_weight; }, 0, 1e6));
+  keys.push_back(count_key(mosaic, "sweeps", "sweeps of group moves at most (each re-solves every acquisition against what is kept)",
+      [](auto& c) -> auto& { return c.mosaic.sweeps; }, 1, 100));
+  keys.push_back(real_key(mosaic, "stitch_reach",
+      "stitching joins boundaries of pieces from different sources closer than this times distance_threshold",
+      [](auto& c) -> auto& { return c.mosaic.stitch_reach; }, 0.1, 100));
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));

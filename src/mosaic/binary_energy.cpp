@@ -36,26 +36,43 @@ double coupling(const BinaryEnergy::Pair& p) { return p.e01 + p.e10 - p.e00 - p.
 MaxFlow cut_graph(const BinaryEnergy& e, bool doubled) {
   const std::size_t n = e.size();
   MaxFlow g(doubled ? 2 * n : n);
-  std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0
+  std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0 (constants dropped)
   for (std::size_t i = 0; i < n; ++i) cost_of_one[i] = e.unary[i][1] - e.unary[i][0];
   const auto bar = [n](std::uint32_t i) { return static_cast<MaxFlow::Node>(n + i); };
   for (const BinaryEnergy::Pair& p : e.pairs) {
-    // E = e00 + (e10 - e00) x_i + (e11 - e10) x_j + c (1 - x_i) x_j, c = coupling, for a
-    // submodular term; a non-submodular one is the same in (x_i, 1 - x_j) with -c.
-    cost_of_one[p.i] += p.e10 - p.e00;
-    cost_of_one[p.j] += p.e11 - p.e10;
+    // Each term is written as unary parts plus two "both ways" costs of weights alpha and
+    // beta (alpha + beta = |coupling|), split so that the unary parts are balanced: unary
+    // parts push flow through the graph from terminal to terminal, and a split that leaves
+    // the overlap terms none spares millions of augmentations.
     const double c = coupling(p);
+    const auto i = static_cast<MaxFlow::Node>(p.i), j = static_cast<MaxFlow::Node>(p.j);
     if (c >= 0) {
-      if (c == 0) continue;
-      g.add_edge(p.i, p.j, c, 0);  // cut when x_i = 0 and x_j = 1
-      if (doubled) g.add_edge(bar(p.j), bar(p.i), c, 0);
+      // e00 + u_i x_i + u_j x_j + alpha [x_i=0, x_j=1] + beta [x_i=1, x_j=0].
+      const double beta = std::clamp((2 * p.e10 - p.e00 - p.e11) / 2, 0.0, c), alpha = c - beta;
+      cost_of_one[p.i] += p.e10 - p.e00 - beta;
+      cost_of_one[p.j] += p.e01 - p.e00 - alpha;
+      if (alpha > 0) {
+        g.add_edge(i, j, alpha, 0);  // cut when i is on the source side and j is not
+        if (doubled) g.add_edge(bar(j), bar(i), alpha, 0);
+      }
+      if (beta > 0) {
+        g.add_edge(j, i, beta, 0);
+        if (doubled) g.add_edge(bar(i), bar(j), beta, 0);
+      }
     } else {
       if (!doubled) throw ProcessingError("graph cut: a non-submodular term in a single cut");
-      // In (x_i, y_j = 1 - x_j): E = e01 + (e11 - e01) x_i + (e11 - e10) x_j - c (1 - x_i)(1 - x_j);
-      // the unary part of x_i differs from the one entered above by -c.
-      cost_of_one[p.i] -= c;
-      g.add_edge(p.i, bar(p.j), -c, 0);  // cut when x_i = 0 and x_j = 0
-      g.add_edge(p.j, bar(p.i), -c, 0);
+      // k + u_i x_i + u_j x_j + alpha [x_i=0, x_j=0] + beta [x_i=1, x_j=1].
+      const double beta = std::clamp((2 * p.e11 - p.e01 - p.e10) / 2, 0.0, -c), alpha = -c - beta;
+      cost_of_one[p.i] += p.e11 - p.e01 - beta;
+      cost_of_one[p.j] += p.e11 - p.e10 - beta;
+      if (alpha > 0) {
+        g.add_edge(i, bar(j), alpha, 0);  // x_i = 0 (i source side), x_j = 0 (bar j sink side)
+        g.add_edge(j, bar(i), alpha, 0);
+      }
+      if (beta > 0) {
+        g.add_edge(bar(i), j, beta, 0);  // x_i = 1 (bar i source side), x_j = 1 (j sink side)
+        g.add_edge(bar(j), i, beta, 0);
+      }
     }
   }
   for (std::size_t i = 0; i < n; ++i) {

@@ -192,6 +192,48 @@ std::vector<std::int8_t> improve_qpbo_i(const BinaryEnergy& e, std::span<const s
   return x;
 }
 
+GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std::uint32_t> group,
+                                      std::vector<std::int8_t>& x, int max_sweeps) {
+  const PairIndex index(e);
+  GroupMoveStats stats;
+  const std::uint32_t groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
+  std::vector<std::uint32_t> to_local(e.size(), UINT32_MAX);
+  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+    ++stats.sweeps;
+    bool changed = false;
+    for (std::uint32_t k = 0; k < groups; ++k) {
+      std::vector<std::uint32_t> open;
+      for (std::uint32_t v = 0; v < e.size(); ++v) {
+        if (group[v] == k || x[v] == 1) open.push_back(v);
+      }
+      if (open.empty()) continue;
+      ++stats.moves;
+      const BinaryEnergy sub = restricted(e, index, x, open, to_local);
+      std::vector<std::int8_t> y;
+      if (const auto flips = submodular_flips(sub)) {
+        y = minimise_by_flipped_cut(sub, *flips);
+        ++stats.exact_moves;
+      } else {
+        y = qpbo(sub);  // persistent labels only; the others keep their value
+        for (std::size_t l = 0; l < y.size(); ++l) {
+          if (y[l] == kUnlabelled) y[l] = x[open[l]];
+        }
+      }
+      // The restricted energy differs from the whole one by a constant: compare there.
+      std::vector<std::int8_t> now(open.size());
+      for (std::size_t l = 0; l < open.size(); ++l) now[l] = x[open[l]];
+      const double before = sub.evaluate(now), after = sub.evaluate(y);
+      if (after < before - 1e-9 * (1 + std::abs(before))) {
+        for (std::size_t l = 0; l < open.size(); ++l) x[open[l]] = y[l];
+        ++stats.improving_moves;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
+  return stats;
+}
+
 std::vector<std::int8_t> minimise(const BinaryEnergy& e, const ImproveParams& params, MinimiseStats& stats) {
   Stopwatch clock;
   if (const auto flips = submodular_flips(e)) {

@@ -130,6 +130,43 @@ TEST(Qpbo, TwoMeshEnergiesAreFlippedAndSolvedExactly) {
   }
 }
 
+TEST(GroupMoves, NeverRaiseTheEnergyAndUsuallyReachTheMinimumOnThreeMeshEnergies) {
+  // Three "meshes": overlap terms across meshes (odd cycles: QPBO cannot label them), seam
+  // terms inside each; every move must be exact and improving or rejected.
+  std::mt19937 rng(24);
+  int optimal = 0;
+  const int trials = 200;
+  for (int trial = 0; trial < trials; ++trial) {
+    const std::size_t n = 3 + rng() % 10;
+    BinaryEnergy e;
+    std::uniform_real_distribution<double> reward(-1.5, 0.3), w(0, 1);
+    std::vector<std::uint32_t> group(n);
+    for (std::size_t v = 0; v < n; ++v) {
+      group[v] = static_cast<std::uint32_t>(v % 3);
+      e.unary.push_back({0.0, reward(rng)});
+    }
+    for (std::size_t k = 0; k < 2 * n; ++k) {
+      const auto i = static_cast<std::uint32_t>(rng() % n), j = static_cast<std::uint32_t>(rng() % n);
+      if (i == j) continue;
+      if (group[i] != group[j]) {
+        e.pairs.push_back({i, j, 0, 0, 0, 10});
+      } else {
+        const double c = w(rng);
+        e.pairs.push_back({i, j, 0, c, c, 0});
+      }
+    }
+    std::vector<std::int8_t> x(n, 0);
+    const double start = e.evaluate(x);
+    const GroupMoveStats stats = improve_by_group_moves(e, group, x, 5);
+    const double energy = e.evaluate(x);
+    ASSERT_LE(energy, start + 1e-12) << "trial " << trial;
+    ASSERT_EQ(stats.exact_moves, stats.moves) << "trial " << trial;  // no overlaps among the kept
+    ASSERT_GE(energy, enumerate(e).minimum - 1e-9);
+    optimal += energy <= enumerate(e).minimum + 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(optimal, trials * 8 / 10) << optimal;
+}
+
 TEST(Qpbo, ThreeMutuallyOverlappingTrianglesCannotBeFlipped) {
   BinaryEnergy e;
   e.unary = {{0, -1}, {0, -1}, {0, -1}};

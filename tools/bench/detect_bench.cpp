@@ -12,9 +12,7 @@
 #include "citymesh/change/detect.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
-#include "citymesh/scan/sensor_grid.h"
-#include "citymesh/sim/scanner.h"
-#include "citymesh/sim/scene.h"
+#include "bench_scene.h"
 
 using namespace citymesh;
 
@@ -55,17 +53,10 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--length") == 0) street.length = std::stof(argv[i + 1]);
     if (std::strcmp(argv[i], "--epochs") == 0) street.epochs = std::stoi(argv[i + 1]);
   }
-  const Scene scene = make_street_scene(street);
-  std::vector<Mesh> meshes;
-  std::vector<TimePoint> dates;
-  std::size_t triangles = 0;
-  for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
-    Mesh m = mesh_sensor_grid(scan_epoch(scene, k, {}).front(), {}, static_cast<std::uint32_t>(k)).mesh;
-    m.origin = meshes.empty() ? m.origin : meshes.front().origin;
-    triangles += m.triangle_count();
-    meshes.push_back(std::move(m));
-    dates.push_back(scene.epochs[k].date);
-  }
+  bench::BenchScene scene = bench::simulated_street(street.length, street.epochs);
+  std::vector<Mesh>& meshes = scene.meshes;
+  const std::vector<TimePoint>& dates = scene.dates;
+  const std::size_t triangles = scene.triangles;
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", street.length, meshes.size(), triangles);
 
   ChangeParams without = with;

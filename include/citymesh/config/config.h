@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "citymesh/change/change_params.h"
+#include "citymesh/mosaic/mosaic_params.h"
 #include "citymesh/core/mesh.h"
 #include "citymesh/core/time.h"
 #include "citymesh/geo/crs.h"
@@ -36,16 +37,6 @@ struct AcquisitionEntry {
   std::filesystem::path path;  ///< absolute (resolved against the config file's folder)
   TimePoint time{};
   std::string name;  ///< defaults to the file stem
-};
-
-enum class QualityMeasure { constant, area, resolution };
-
-struct MosaicParams {
-  QualityMeasure quality = QualityMeasure::constant;
-  double quality_weight = 1.0;    ///< lambda 1
-  double boundary_weight = 0.5;   ///< lambda 2, per metre of mesh boundary
-  double overlap_weight = 100.0;  ///< lambda 3
-  double seam_weight = 1.0;       ///< lambda 4, per metre of seam
 };
 
 struct TilingParams {

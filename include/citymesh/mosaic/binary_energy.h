@@ -58,6 +58,21 @@ struct ImproveParams {
 std::vector<std::int8_t> improve_qpbo_i(const BinaryEnergy& e, std::span<const std::int8_t> partial,
                                         const ImproveParams& params, double* completed_energy = nullptr);
 
+struct GroupMoveStats {
+  std::size_t moves = 0, exact_moves = 0, improving_moves = 0, sweeps = 0;
+};
+
+/// Group moves, a QPBO-I whose fixed set is chosen so that the re-solve is exact: `group`
+/// gives each variable a group (a mesh) with no non-submodular term inside a group. For each
+/// group k in turn, the variables of k and the variables of other groups now at 1 are
+/// re-solved together, every other variable fixed to its value in x. With overlap-like terms
+/// (non-submodular only across groups, and none among the variables at 1) that restricted
+/// energy flips to submodular and one cut solves it exactly; otherwise QPBO's persistent
+/// labels of it are taken. A move is kept only when it lowers the energy, so x never gets
+/// worse. Sweeps over the groups until a sweep changes nothing or `max_sweeps`.
+GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std::uint32_t> group,
+                                      std::vector<std::int8_t>& x, int max_sweeps);
+
 struct MinimiseStats {
   bool exact = false;               ///< solved by one cut after flipping
   std::size_t unlabelled_after_qpbo = 0;

@@ -1,0 +1,63 @@
+// SPDX-License-Identifier: MIT
+// The mesh mosaic (paper §IV): among the triangles the change step kept, a non-overlapping
+// set that keeps the best pieces of every acquisition with short seams, as the minimum of
+//   E(x) = -l1 sum Q(T) x_T + l2 sum L_b(T) x_T + l3 sum_(T,U) consistent x_T x_U
+//          + l4 sum_(T,U) same mesh, shared edge L(T,U) XOR(x_T, x_U)
+// and the paper's baseline "update model", on one in-memory set of meshes with global ids.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "citymesh/change/detect.h"
+#include "citymesh/core/mesh.h"
+#include "citymesh/mosaic/binary_energy.h"
+#include "citymesh/mosaic/mosaic_params.h"
+
+namespace citymesh {
+
+struct MosaicInput {
+  std::span<const Mesh> meshes;  ///< the change step's input: same local origin, global ids
+  std::span<const TimePoint> dates;
+  const ChangeResult* change = nullptr;
+  double distance_threshold = 0.10;  ///< the change step's, for the update model
+};
+
+struct MosaicStats {
+  std::uint64_t candidates = 0;  ///< triangles the change step kept: the variables
+  std::uint64_t overlap_terms = 0, seam_terms = 0, selected = 0;
+  double length_unit = 0;  ///< metres: the mean edge length of the candidates
+  /// Weighted energy terms of the selection (the quality term is negative).
+  double quality = 0, boundary = 0, overlap = 0, seam = 0, energy = 0;
+  MinimiseStats solver;  ///< solver.exact: the whole energy was solved by one flipped cut
+  GroupMoveStats moves;  ///< otherwise: the group moves (one group per acquisition)
+  double seconds_build = 0, seconds_solve = 0;
+};
+
+struct MosaicSelection {
+  std::vector<std::uint8_t> selected;  ///< per global triangle
+  MosaicStats stats;
+};
+
+/// The energy of the candidates (variables in global-id order of the kept triangles) and the
+/// global id of each variable.
+struct MosaicEnergy {
+  BinaryEnergy energy;  ///< pairs: the seam terms first, then the overlap terms
+  std::vector<std::uint32_t> triangle_of;  ///< variable -> global triangle
+  std::vector<double> quality, boundary;   ///< per variable: its weighted unary parts
+  MosaicStats stats;                       ///< counts and length unit
+};
+MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& params);
+
+/// Minimises the mosaic energy: one exact cut when it can be flipped submodular (two meshes),
+/// else group moves per acquisition from an empty selection (sweeps sweeps at
+/// most). Deterministic.
+MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& params);
+
+/// The baseline: acquisitions in date order (config order on equal dates); a kept triangle is
+/// selected unless an already selected triangle of an earlier acquisition lies within the
+/// distance threshold of its centroid.
+MosaicSelection select_update_model(const MosaicInput& input);
+
+}  // namespace citymesh

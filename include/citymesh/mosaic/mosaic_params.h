@@ -1,0 +1,43 @@
+// SPDX-License-Identifier: MIT
+// Parameters of the mesh mosaic and of stitching ([mosaic] in the config).
+#pragma once
+
+#include <string_view>
+
+namespace citymesh {
+
+/// Per-triangle quality Q in the mosaic energy, normalised so that its mean is about 1.
+enum class QualityMeasure {
+  constant,    ///< 1 per triangle: more triangles per area win, so the finer mesh is favoured
+  area,        ///< area / mean area: coverage wins, whatever the resolution
+  resolution,  ///< area / mean area x mean edge / own longest edge: coverage at a finer resolution
+};
+
+/// How the kept triangles of the change step are merged into one mesh.
+enum class MosaicMethod {
+  energy,        ///< the paper's energy, solved with our QPBO (the default)
+  update_model,  ///< the paper's baseline: acquisitions in date order, a triangle is kept unless
+                 ///< something already kept lies within the distance threshold
+};
+
+struct MosaicParams {
+  MosaicMethod method = MosaicMethod::energy;
+  QualityMeasure quality = QualityMeasure::constant;
+  // Lengths in the energy are counted in mean edge lengths of the input triangles, so that the
+  // weights mean the same at every scan resolution: one edge of seam costs lambda 4.
+  double quality_weight = 1.0;    ///< lambda 1
+  double boundary_weight = 0.5;   ///< lambda 2, per mean edge length of mesh boundary kept
+  double overlap_weight = 100.0;  ///< lambda 3, per pair of overlapping triangles kept
+  double seam_weight = 1.0;       ///< lambda 4, per mean edge length of seam inside a mesh
+  /// Group-move sweeps at most (each re-solves every acquisition once); 2 reach the fixed
+  /// point on the simulated street.
+  int sweeps = 2;
+  /// Stitching joins boundaries of pieces from different sources closer than this factor
+  /// times the change step's distance threshold.
+  double stitch_reach = 2.0;
+};
+
+std::string_view quality_measure_name(QualityMeasure q);
+std::string_view mosaic_method_name(MosaicMethod m);
+
+}  // namespace citymesh

@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/mosaic/mosaic.h"
+
+#include <algorithm>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/stopwatch.h"
+#include "internal.h"
+#include "mesh_edges.h"
+
+namespace citymesh {
+
+using mosaic_detail::MeshEdges;
+
+std::string_view quality_measure_name(QualityMeasure q) {
+  switch (q) {
+    case QualityMeasure::area:
+      return "area";
+    case QualityMeasure::resolution:
+      return "resolution";
+    default:
+      return "constant";
+  }
+}
+
+std::string_view mosaic_method_name(MosaicMethod m) {
+  return m == MosaicMethod::update_model ? "update-model" : "energy";
+}
+
+void mosaic_detail::check_mosaic_input(const MosaicInput& input) {
+  if (input.change == nullptr) throw ProcessingError("mosaic: no change detection result");
+  std::size_t total = 0;
+  for (const Mesh& m : input.meshes) total += m.triangle_count();
+  if (total != input.change->index.size() || input.change->kept.size() != total) {
+    throw ProcessingError("mosaic: the change detection result does not match the meshes");
+  }
+  if (input.dates.size() != input.meshes.size()) throw ProcessingError("mosaic: one date per mesh is needed");
+}
+
+namespace {
+
+struct TriangleShape {
+  double area = 0, longest_edge = 0;
+};
+
+TriangleShape shape(const Mesh& m, std::size_t t) {
+  const Triangle& tri = m.triangles[t];
+  const Vec3d a(m.positions[tri[0]]), b(m.positions[tri[1]]), c(m.positions[tri[2]]);
+  return {0.5 * doubled_area(a, b, c), std::max({norm(b - a), norm(c - b), norm(a - c)})};
+}
+
+}  // namespace
+
+MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& params) {
+  mosaic_detail::check_mosaic_input(input);
+  const ChangeResult& change = *input.change;
+  const GlobalTriangles& index = change.index;
+  MosaicEnergy out;
+  std::vector<std::uint32_t> variable_of(index.size(), UINT32_MAX);
+  for (std::uint32_t g = 0; g < index.size(); ++g) {
+    if (change.kept[g] == 0) continue;
+    variable_of[g] = static_cast<std::uint32_t>(out.triangle_of.size());
+    out.triangle_of.push_back(g);
+  }
+  const std::size_t n = out.triangle_of.size();
+  out.stats.candidates = n;
+
+  std::vector<MeshEdges> edges(input.meshes.size());
+  parallel_for_blocks(input.meshes.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t a = begin; a < end; ++a) {
+      const std::span<const std::uint8_t> kept(change.kept.data() + index.offsets[a], input.meshes[a].triangle_count());
+      edges[a] = mosaic_detail::mesh_edges(input.meshes[a], kept);
+    }
+  });
+  double length_sum = 0;
+  std::uint64_t length_count = 0;
+  for (const MeshEdges& e : edges) {
+    length_sum += e.edge_length_sum;
+    length_count += e.edge_count;
+  }
+  const double unit = length_count > 0 && length_sum > 0 ? length_sum / double(length_count) : 1.0;
+  out.stats.length_unit = unit;
+
+  std::vector<TriangleShape> shapes(n);
+  parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      const std::uint32_t g = out.triangle_of[v], a = index.acquisition_of(g);
+      shapes[v] = shape(input.meshes[a], g - index.offsets[a]);
+    }
+  });
+  double area_sum = 0;
+  for (const TriangleShape& s : shapes) area_sum += s.area;
+  const double mean_area = n > 0 && area_sum > 0 ? area_sum / double(n) : 1.0;
+
+  out.energy.unary.resize(n);
+  out.quality.resize(n);
+  out.boundary.resize(n);
+  parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      const std::uint32_t g = out.triangle_of[v], a = index.acquisition_of(g);
+      double q = 1.0;
+      if (params.quality == QualityMeasure::area) q = shapes[v].area / mean_area;
+      if (params.quality == QualityMeasure::resolution) {
+        q = shapes[v].area / mean_area * unit / std::max(shapes[v].longest_edge, 1e-9);
+      }
+      out.quality[v] = -params.quality_weight * q;
+      out.boundary[v] = params.boundary_weight * edges[a].boundary_length[g - index.offsets[a]] / unit;
+      out.energy.unary[v] = {0.0, out.quality[v] + out.boundary[v]};
+    }
+  });
+  for (std::size_t a = 0; a < edges.size(); ++a) {
+    for (const auto& s : edges[a].shared) {
+      const double w = params.seam_weight * s.length / unit;
+      out.energy.pairs.push_back({variable_of[index.offsets[a] + s.a], variable_of[index.offsets[a] + s.b], 0, w, w, 0});
+    }
+  }
+  out.stats.seam_terms = out.energy.pairs.size();
+  for (const auto& [g, u] : change.consistent_pairs) {
+    if (variable_of[g] == UINT32_MAX || variable_of[u] == UINT32_MAX) continue;
+    out.energy.pairs.push_back({variable_of[g], variable_of[u], 0, 0, 0, params.overlap_weight});
+  }
+  out.stats.overlap_terms = out.energy.pairs.size() - out.stats.seam_terms;
+  return out;
+}
+
+namespace {
+
+/// The weighted terms of labelling x, for the report.
+void account(const MosaicEnergy& e, std::span<const std::int8_t> x, MosaicStats& stats) {
+  for (std::size_t v = 0; v < x.size(); ++v) {
+    if (x[v] == 0) continue;
+    stats.quality += e.quality[v];
+    stats.boundary += e.boundary[v];
+    ++stats.selected;
+  }
+  for (std::size_t k = 0; k < e.energy.pairs.size(); ++k) {
+    const auto& p = e.energy.pairs[k];
+    if (k < stats.seam_terms) {
+      if (x[p.i] != x[p.j]) stats.seam += p.e01;
+    } else if (x[p.i] != 0 && x[p.j] != 0) {
+      stats.overlap += p.e11;
+    }
+  }
+  stats.energy = stats.quality + stats.boundary + stats.seam + stats.overlap;
+}
+
+}  // namespace
+
+MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& params) {
+  Stopwatch clock;
+  MosaicEnergy e = build_mosaic_energy(input, params);
+  MosaicSelection out;
+  out.stats = e.stats;
+  out.stats.seconds_build = clock.restart();
+  std::vector<std::int8_t> x;
+  if (const auto flips = submodular_flips(e.energy)) {
+    // Two meshes (or overlaps that never close an odd cycle): one exact cut.
+    x = minimise_by_flipped_cut(e.energy, *flips);
+    out.stats.solver.exact = true;
+  } else {
+    // Start from nothing kept and let each mesh in turn take the places where it does better
+    // than what is kept: every move is an exact cut, none raises the energy.
+    std::vector<std::uint32_t> group(e.triangle_of.size());
+    for (std::size_t v = 0; v < group.size(); ++v) group[v] = input.change->index.acquisition_of(e.triangle_of[v]);
+    x.assign(e.triangle_of.size(), 0);
+    out.stats.moves = improve_by_group_moves(e.energy, group, x, std::max(1, params.sweeps));
+  }
+  out.stats.seconds_solve = clock.restart();
+  out.selected.assign(input.change->index.size(), 0);
+  for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
+  account(e, x, out.stats);
+  return out;
+}
+
+}  // namespace citymesh
