@@ -15,67 +15,25 @@
 #include "citymesh/sim/simulate.h"
 #include "command.h"
 #include "detect_output.h"
+#include "face_table.h"
+#include "mosaic_eval.h"
 
 namespace citymesh::app {
 
 namespace {
 
-nlohmann::json read_json(const std::filesystem::path& path, std::string_view what) {
-  std::ifstream in(path);
-  if (!in) throw InputError(fmt::format("{}: cannot open ({})", path.string(), what));
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(fmt::format("{}: {}", path.string(), e.what()));
-  }
-}
-
-struct ObjectInfo {
-  std::string cls, fate;
-  double area = 0, kept_area = 0;
-  std::uint64_t triangles = 0;
-};
-
-std::map<std::uint32_t, ObjectInfo> objects_by_id(const std::filesystem::path& sim) {
-  std::map<std::uint32_t, ObjectInfo> objects;
-  for (ObjectRecord& o : read_objects(sim)) objects[o.id] = {std::move(o.cls), std::move(o.fate)};
-  return objects;
-}
-
 /// Adds the area of every face of one labelled PLY to its ground-truth object.
 void score_acquisition(const std::filesystem::path& ply, const std::filesystem::path& truth_file,
                        std::map<std::uint32_t, ObjectInfo>& objects) {
   const std::vector<std::uint32_t> truth = read_truth(truth_file);
-  PlyReadParams params;
-  params.require_sensor_origin = false;
-  params.extra_face_properties = {kSourceFaceProperty, kKeptProperty};
-  PlyReader reader(ply, params);
-  PlyVertexChunk vertices;
-  PlyFaceChunk faces;
-  std::vector<Vec3d> positions;
-  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;
-       kind = reader.next(vertices, faces)) {
-    if (kind == PlyReader::ChunkKind::vertices) {
-      positions.insert(positions.end(), vertices.positions.begin(), vertices.positions.end());
-      continue;
-    }
-    for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
-      const double source = faces.extras[0][t];
-      if (!(source >= 0 && source < static_cast<double>(truth.size()))) {
-        throw InputError(fmt::format("{}: face {}: source_face {} is not a face of {} ({} faces)", ply.string(),
-                                     faces.faces[t], source, truth_file.string(), truth.size()));
-      }
-      const auto it = objects.find(truth[static_cast<std::size_t>(source)]);
-      if (it == objects.end()) {
-        throw InputError(fmt::format("{}: object {} is not in objects.json", truth_file.string(),
-                                     truth[static_cast<std::size_t>(source)]));
-      }
-      const Triangle& tri = faces.triangles[t];
-      const double area = 0.5 * doubled_area(positions[tri[0]], positions[tri[1]], positions[tri[2]]);
-      it->second.area += area;
-      it->second.kept_area += faces.extras[1][t] != 0 ? area : 0.0;
-      ++it->second.triangles;
-    }
+  const FaceTable table = read_face_table(ply, {kSourceFaceProperty, kKeptProperty});
+  for (std::size_t t = 0; t < table.triangles.size(); ++t) {
+    ObjectInfo& o = object_of(objects, truth, table.extras[0][t], {ply, truth_file, table.faces[t]});
+    const TriangleCorners c = table.corners(t);
+    const double area = 0.5 * doubled_area(c[0], c[1], c[2]);
+    o.area += area;
+    o.kept_area += table.extras[1][t] != 0 ? area : 0.0;
+    ++o.triangles;
   }
 }
 
@@ -156,6 +114,23 @@ void print_summary(const nlohmann::json& e, std::ostream& out) {
       100 * e["no_surface_fraction"].get<double>(), 100 * e["no_surface_kept"].get<double>());
 }
 
+void print_mosaic_summary(const nlohmann::json& m, std::ostream& out) {
+  out << fmt::format("mosaic ({}): {} triangles, {:.1f} m2\n", m["method"].get<std::string>(),
+                     m["triangles"].get<std::uint64_t>(), m["area"].get<double>());
+  out << fmt::format("  static completeness   {:.2f} % of the static input area lies within the distance threshold\n",
+                     100 * m["static_completeness"].get<double>());
+  out << fmt::format("  dynamic residue       {:.3f} % of the output area belongs to objects that must go\n",
+                     100 * m["dynamic_residue"].get<double>());
+  out << fmt::format("  overlap ratio         {:.3f} % of the output area doubles output of another source\n",
+                     100 * m["overlap_ratio"].get<double>());
+  out << fmt::format("  hole ratio            {:.3f} % of the static input area has no output over it\n",
+                     100 * m["hole_ratio"].get<double>());
+  out << fmt::format("  seams                 {:.1f} m open between sources ({:.1f} m of open boundary in all)\n",
+                     m["seam_length"].get<double>(), m["open_boundary_length"].get<double>());
+  out << fmt::format("  mean edge length      {:.3f} m, {:.2f} x the finest input's\n", m["mean_edge_length"].get<double>(),
+                     m["edge_length_ratio"].get<double>());
+}
+
 class EvalCommand final : public Command {
  public:
   std::string_view name() const override { return "eval"; }
@@ -179,17 +154,23 @@ class EvalCommand final : public Command {
     std::map<std::uint32_t, ObjectInfo> objects = objects_by_id(truth_);
     try {
       for (const auto& a : summary.at("acquisitions")) {
-        const std::filesystem::path input = a.at("input").get<std::string>();
-        const std::filesystem::path truth =
-            std::filesystem::path(truth_) / input.filename().replace_extension(".truth");
-        score_acquisition(detect / a.at("ply").get<std::string>(), truth, objects);
+        score_acquisition(detect / a.at("ply").get<std::string>(), truth_file(truth_, a), objects);
       }
     } catch (const nlohmann::json::exception& e) {
       throw InputError(fmt::format("{}: {}", (detect / "summary.json").string(), e.what()));
     }
-    const nlohmann::json result = evaluate(objects);
+    nlohmann::json result = evaluate(objects);
+    const bool mosaic = std::filesystem::exists(std::filesystem::path(output_) / "mosaic" / "summary.json");
+    if (mosaic) {
+      try {
+        result["mosaic"] = evaluate_mosaic(output_, truth_, summary, objects_by_id(truth_));
+      } catch (const nlohmann::json::exception& e) {
+        throw InputError(fmt::format("{}: {}", (std::filesystem::path(output_) / "mosaic").string(), e.what()));
+      }
+    }
     write_file_atomically(std::filesystem::path(output_) / "eval.json", result.dump(1) + "\n");
     print_summary(result, std::cout);
+    if (mosaic) print_mosaic_summary(result["mosaic"], std::cout);
   }
 
  private:

@@ -1,0 +1,107 @@
+// SPDX-License-Identifier: MIT
+#include "mosaic_output.h"
+
+#include <array>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/io/ply_writer.h"
+#include "citymesh/render/render.h"
+
+namespace citymesh::app {
+
+Rgb8 source_color(std::int32_t acquisition) {
+  if (acquisition < 0) return {230, 0, 230};
+  // Well separated hues, none of them magenta; they repeat after ten acquisitions.
+  static constexpr std::array<Rgb8, 10> kPalette{{{31, 119, 180},
+                                                  {255, 127, 14},
+                                                  {44, 160, 44},
+                                                  {214, 39, 40},
+                                                  {140, 86, 75},
+                                                  {23, 190, 207},
+                                                  {188, 189, 34},
+                                                  {127, 127, 127},
+                                                  {148, 103, 189},
+                                                  {0, 80, 40}}};
+  return kPalette[static_cast<std::size_t>(acquisition) % kPalette.size()];
+}
+
+namespace {
+
+/// The face index in the input file of every merged triangle (-1 for stitch triangles).
+std::vector<std::int32_t> source_faces(const LoadedAcquisitions& input, const MergedMesh& merged) {
+  std::vector<std::vector<std::int32_t>> per_acquisition(input.meshes.size());
+  for (std::size_t k = 0; k < input.meshes.size(); ++k) per_acquisition[k] = input.source_faces(k);
+  std::vector<std::int32_t> out(merged.source_acq.size(), kNoSource);
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    const std::int32_t a = merged.source_acq[t];
+    if (a >= 0) out[t] = per_acquisition[static_cast<std::size_t>(a)][static_cast<std::size_t>(merged.source_triangle[t])];
+  }
+  return out;
+}
+
+void write_picture(const std::filesystem::path& path, const MergedMesh& merged, double pixel_size) {
+  RenderLayer layer{&merged.mesh, {}};
+  layer.face_colors.reserve(merged.source_acq.size());
+  for (const std::int32_t a : merged.source_acq) layer.face_colors.push_back(source_color(a));
+  ViewParams view;
+  view.pixel_size = pixel_size;
+  write_png(path, render_orthographic(std::span<const RenderLayer>(&layer, 1), view));
+}
+
+}  // namespace
+
+void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
+                          const MosaicStats& s, const MosaicOutputParams& params) {
+  std::filesystem::create_directories(params.dir);
+  const std::vector<std::int32_t> faces = source_faces(input, merged);
+  write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
+                 {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
+                  {"source_face", std::span<const std::int32_t>(faces)}});
+  if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
+
+  nlohmann::json summary;
+  summary["config"] = config.file.string();
+  summary["method"] = mosaic_method_name(config.mosaic.method);
+  summary["distance_threshold"] = config.change.distance_threshold;
+  summary["quality"] = quality_measure_name(config.mosaic.quality);
+  summary["weights"] = {{"quality", config.mosaic.quality_weight},
+                        {"boundary", config.mosaic.boundary_weight},
+                        {"overlap", config.mosaic.overlap_weight},
+                        {"seam", config.mosaic.seam_weight}};
+  std::vector<std::uint64_t> per_source(input.meshes.size(), 0);
+  std::uint64_t stitched = 0;
+  for (const std::int32_t a : merged.source_acq) {
+    if (a >= 0) {
+      ++per_source[static_cast<std::size_t>(a)];
+    } else {
+      ++stitched;
+    }
+  }
+  for (std::size_t k = 0; k < input.meshes.size(); ++k) {
+    summary["acquisitions"].push_back({{"index", k},
+                                       {"name", config.acquisitions[k].name},
+                                       {"date", format_iso8601(input.dates[k])},
+                                       {"input", input.acquisitions[k].path.string()},
+                                       {"triangles_kept", per_source[k]}});
+  }
+  summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected},
+                       {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
+                       {"overlap_terms", s.overlap_terms}, {"seam_terms", s.seam_terms}};
+  summary["energy"] = {{"total", s.energy},
+                       {"quality", s.quality},
+                       {"boundary", s.boundary},
+                       {"seam", s.seam},
+                       {"overlap", s.overlap},
+                       {"length_unit_m", s.length_unit},
+                       {"exact", s.solver.exact},
+                       {"group_moves", s.moves.moves},
+                       {"improving_moves", s.moves.improving_moves},
+                       {"sweeps", s.moves.sweeps}};
+  summary["stitch"] = params.stitch;
+  summary["seconds"] = params.seconds;
+  summary["ply"] = kMosaicFile;
+  summary["png"] = params.pictures ? "mosaic.png" : "";
+  write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
+}
+
+}  // namespace citymesh::app

@@ -1,0 +1,35 @@
+// SPDX-License-Identifier: MIT
+// What `citymesh run` writes for the mosaic: the merged mesh with provenance (DESIGN §3), a
+// top-down picture coloured by source acquisition, and a summary JSON. `citymesh eval` reads
+// them back.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "acquisitions.h"
+#include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/mosaic.h"
+
+namespace citymesh::app {
+
+/// Face properties of the mosaic PLY (int; -1 for triangles that stitching created).
+inline constexpr const char* kSourceAcqProperty = "source_acq";
+inline constexpr const char* kMosaicFile = "mosaic.ply";
+
+struct MosaicOutputParams {
+  std::filesystem::path dir;  ///< <output>/mosaic
+  double pixel_size = 0.05;
+  bool pictures = true;
+  nlohmann::json seconds;  ///< time per step, for the summary
+  nlohmann::json stitch;   ///< stitching figures, for the summary
+};
+
+/// Writes <dir>/mosaic.ply, mosaic.png and summary.json (last), each atomically.
+void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
+                          const MosaicStats& stats, const MosaicOutputParams& params);
+
+/// Colour of a source acquisition in the pictures (stitch triangles: magenta).
+Rgb8 source_color(std::int32_t acquisition);
+
+}  // namespace citymesh::app

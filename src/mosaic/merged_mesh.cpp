@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh {
+
+namespace {
+
+/// Appends vertex v of `from` to `to`, with every per-vertex attribute `to` carries.
+void copy_vertex(const Mesh& from, std::uint32_t v, Mesh& to) {
+  to.positions.push_back(from.positions[v]);
+  if (!from.sensor_positions.empty()) to.sensor_positions.push_back(from.sensor_positions[v]);
+  if (!from.times.empty()) to.times.push_back(from.times[v]);
+  if (!from.intensities.empty()) to.intensities.push_back(from.intensities[v]);
+  if (!from.colors.empty()) to.colors.push_back(from.colors[v]);
+}
+
+/// An attribute is kept only when every input has it.
+void drop_partial_attributes(std::span<const Mesh> meshes, Mesh& out) {
+  for (const Mesh& m : meshes) {
+    if (m.sensor_positions.empty()) out.sensor_positions.clear();
+    if (m.times.empty()) out.times.clear();
+    if (m.intensities.empty()) out.intensities.clear();
+    if (m.colors.empty()) out.colors.clear();
+  }
+}
+
+}  // namespace
+
+MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& index,
+                           std::span<const std::uint8_t> selected) {
+  MergedMesh out;
+  if (!meshes.empty()) out.mesh.origin = meshes.front().origin;
+  for (std::size_t a = 0; a < meshes.size(); ++a) {
+    const Mesh& m = meshes[a];
+    std::vector<std::uint32_t> new_index(m.vertex_count(), UINT32_MAX);
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      if (selected[index.offsets[a] + t] == 0) continue;
+      Triangle tri = m.triangles[t];
+      for (std::uint32_t& v : tri) {
+        if (new_index[v] == UINT32_MAX) {
+          new_index[v] = static_cast<std::uint32_t>(out.mesh.positions.size());
+          copy_vertex(m, v, out.mesh);
+        }
+        v = new_index[v];
+      }
+      out.mesh.triangles.push_back(tri);
+      if (!m.triangle_ids.empty()) out.mesh.triangle_ids.push_back(m.triangle_ids[t]);
+      out.source_acq.push_back(static_cast<std::int32_t>(a));
+      out.source_triangle.push_back(static_cast<std::int32_t>(t));
+    }
+  }
+  drop_partial_attributes(meshes, out.mesh);
+  if (out.mesh.triangle_ids.size() != out.mesh.triangles.size()) out.mesh.triangle_ids.clear();
+  return out;
+}
+
+}  // namespace citymesh

@@ -1,0 +1,74 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/mosaic/proximity.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "citymesh/core/geometry.h"
+#include "citymesh/spatial/box_tree.h"
+
+namespace citymesh {
+
+namespace {
+
+TriangleCorners corners_of(const Mesh& m, std::size_t t) {
+  const Triangle& tri = m.triangles[t];
+  return {Vec3d(m.positions[tri[0]]), Vec3d(m.positions[tri[1]]), Vec3d(m.positions[tri[2]])};
+}
+
+/// p within `reach` of the triangle's plane and projecting inside it.
+bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
+  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
+  const double len = norm(winding);
+  if (!(len > 0)) return false;
+  const Vec3d n = winding / len;
+  const double h = dot(p - q[0], n);
+  if (std::abs(h) > reach) return false;
+  const Vec3d f = p - n * h;
+  for (int k = 0; k < 3; ++k) {
+    if (dot(cross(q[(k + 1) % 3] - q[k], f - q[k]), winding) < 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+MeshProximity::MeshProximity(const Mesh& mesh, double max_reach) : mesh_(mesh) {
+  std::vector<Box3f> boxes(mesh.triangle_count());
+  for (std::size_t t = 0; t < boxes.size(); ++t) {
+    const TriangleCorners c = corners_of(mesh, t);
+    Vec3d lo = c[0], hi = c[0];
+    for (const Vec3d& p : c) {
+      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
+      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
+    }
+    const double pad = max_reach + 1e-5;
+    boxes[t] = {Vec3f(lo - Vec3d{pad, pad, pad}), Vec3f(hi + Vec3d{pad, pad, pad})};
+  }
+  tree_ = std::make_unique<BoxTree>(std::move(boxes));
+}
+
+MeshProximity::~MeshProximity() = default;
+
+bool MeshProximity::any_within(const Vec3d& p, double reach, const std::function<bool(std::uint32_t)>& accept) const {
+  thread_local std::vector<std::uint32_t> hits;
+  tree_->containing(Vec3f(p), hits);
+  const double reach_sq = reach * reach;
+  return std::any_of(hits.begin(), hits.end(), [&](std::uint32_t t) {
+    return (!accept || accept(t)) && point_triangle_distance_sq(p, corners_of(mesh_, t)) <= reach_sq;
+  });
+}
+
+}  // namespace citymesh
+
+namespace citymesh {
+
+bool MeshProximity::any_over(const Vec3d& p, double reach, const std::function<bool(std::uint32_t)>& accept) const {
+  thread_local std::vector<std::uint32_t> hits;
+  tree_->containing(Vec3f(p), hits);
+  return std::any_of(hits.begin(), hits.end(),
+                     [&](std::uint32_t t) { return (!accept || accept(t)) && over(p, corners_of(mesh_, t), reach); });
+}
+
+}  // namespace citymesh
