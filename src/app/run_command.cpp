@@ -10,6 +10,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/merged_mesh.h"
 #include "citymesh/mosaic/mosaic.h"
+#include "citymesh/mosaic/stitch.h"
 #include "command.h"
 #include "mosaic_output.h"
 #include "pipeline.h"
@@ -17,6 +18,9 @@
 namespace citymesh::app {
 
 namespace {
+
+/// Strip corners closer than this many distance thresholds are welded (5 mm at 10 cm).
+constexpr double kWeldInThresholds = 0.05;
 
 MosaicSelection select(const Config& config, const DetectStep& d) {
   const MosaicInput input{d.input.meshes, d.input.dates, &d.result, config.change.distance_threshold};
@@ -58,8 +62,22 @@ class RunCommand final : public Command {
     const DetectStep detect = run_detect_step(config, pictures);
     Stopwatch clock;
     const MosaicSelection selection = select(config, detect);
-    const MergedMesh merged = merge_selection(detect.input.meshes, detect.result.index, selection.selected);
+    MergedMesh merged = merge_selection(detect.input.meshes, detect.result.index, selection.selected);
     const double mosaic_seconds = clock.restart();
+    nlohmann::json stitch_summary = nlohmann::json::object();
+    if (config.mosaic.method == MosaicMethod::energy) {  // the baseline, like the paper's, is not stitched
+      const StitchStats s = stitch(merged, {.reach = config.mosaic.stitch_reach * config.change.distance_threshold,
+                                            .weld = kWeldInThresholds * config.change.distance_threshold});
+      stitch_summary = {{"open_boundary_before_m", s.open_boundary_before},
+                        {"open_boundary_after_m", s.open_boundary_after},
+                        {"strips", s.strips},
+                        {"triangles_added", s.triangles_added},
+                        {"vertices_welded", s.vertices_welded},
+                        {"rejected", s.rejected}};
+      std::cout << fmt::format("stitching: {} strips, {} triangles, open boundary {:.1f} m -> {:.1f} m\n", s.strips,
+                               s.triangles_added, s.open_boundary_before, s.open_boundary_after);
+    }
+    const double stitch_seconds = clock.restart();
     const std::filesystem::path dir = config.project.output / "mosaic";
     write_mosaic_outputs(config, detect.input, merged, selection.stats,
                          {.dir = dir,
@@ -68,9 +86,10 @@ class RunCommand final : public Command {
                           .seconds = {{"read", detect.read_seconds},
                                       {"detect", detect.detect_seconds},
                                       {"mosaic", mosaic_seconds},
+                                      {"stitch", stitch_seconds},
                                       {"energy", selection.stats.seconds_build},
                                       {"solve", selection.stats.seconds_solve}},
-                          .stitch = nlohmann::json::object()});
+                          .stitch = stitch_summary});
     report(dir, merged, selection.stats);
   }
 

@@ -1,0 +1,277 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/mosaic/stitch.h"
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+#include "citymesh/core/stopwatch.h"
+#include "citymesh/spatial/kd_tree.h"
+
+namespace citymesh {
+
+namespace {
+
+struct Edge {
+  std::uint32_t lo, hi, triangle;
+  auto operator<=>(const Edge&) const = default;
+};
+
+std::vector<Edge> sorted_edges(const Mesh& m) {
+  std::vector<Edge> edges;
+  edges.reserve(3 * m.triangle_count());
+  for (std::uint32_t t = 0; t < m.triangle_count(); ++t) {
+    const Triangle& tri = m.triangles[t];
+    for (int k = 0; k < 3; ++k) edges.push_back({std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3]), t});
+  }
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+Vec3d position(const Mesh& m, std::uint32_t v) { return Vec3d(m.positions[v]); }
+
+Vec3d face_normal(const Mesh& m, std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+  return cross(position(m, b) - position(m, a), position(m, c) - position(m, a));
+}
+
+/// The boundary of the pieces: for each vertex, the boundary half-edge leaving it (the
+/// direction of its triangle), and the triangle it belongs to.
+struct Boundary {
+  std::unordered_map<std::uint32_t, std::uint32_t> next, prev;  ///< vertex -> vertex along the boundary
+  std::unordered_map<std::uint32_t, std::uint32_t> triangle_of;  ///< boundary vertex -> triangle of its outgoing edge
+  std::vector<std::uint32_t> vertices;                          ///< in increasing order
+};
+
+Boundary find_boundary(const Mesh& m) {
+  const std::vector<Edge> edges = sorted_edges(m);
+  Boundary b;
+  std::unordered_map<std::uint32_t, int> outgoing;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    if (j - i == 1) {
+      const Triangle& tri = m.triangles[edges[i].triangle];
+      // Orient as in the triangle: the half-edge u -> v whose reverse no triangle has.
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
+        if (std::min(u, v) != edges[i].lo || std::max(u, v) != edges[i].hi) continue;
+        if (++outgoing[u] == 1 && !b.prev.contains(v)) {
+          b.next[u] = v;
+          b.prev[v] = u;
+          b.triangle_of[u] = edges[i].triangle;
+        }
+      }
+    }
+    i = j;
+  }
+  for (const auto& [v, n] : b.next) b.vertices.push_back(v);
+  std::sort(b.vertices.begin(), b.vertices.end());
+  return b;
+}
+
+struct StitchContext {
+  MergedMesh& merged;
+  const StitchParams& params;
+  Boundary boundary;
+  std::vector<std::uint32_t> partner;             ///< per boundary vertex (index in boundary.vertices)
+  std::unordered_map<std::uint32_t, std::uint32_t> slot;  ///< vertex -> index in boundary.vertices
+  std::unordered_map<std::uint32_t, bool> consumed;      ///< boundary half-edge (by its start) joined
+  StitchStats stats;
+
+  [[nodiscard]] std::int32_t source(std::uint32_t v) const {
+    return merged.source_acq[boundary.triangle_of.at(v)];
+  }
+};
+
+/// For every boundary vertex, the nearest boundary vertex of another source within reach.
+void match_vertices(StitchContext& c) {
+  const Mesh& m = c.merged.mesh;
+  std::vector<Vec3f> points;
+  for (const std::uint32_t v : c.boundary.vertices) points.push_back(m.positions[v]);
+  for (std::uint32_t i = 0; i < c.boundary.vertices.size(); ++i) c.slot[c.boundary.vertices[i]] = i;
+  const PointKdTree tree(points);
+  c.partner.assign(points.size(), UINT32_MAX);
+  std::vector<std::uint32_t> near;
+  for (std::uint32_t i = 0; i < points.size(); ++i) {
+    const std::uint32_t v = c.boundary.vertices[i];
+    tree.radius_search(points[i], static_cast<float>(c.params.reach), near);
+    double best = c.params.reach * c.params.reach;
+    for (const std::uint32_t j : near) {
+      const std::uint32_t w = c.boundary.vertices[j];
+      if (c.source(w) == c.source(v)) continue;
+      const Vec3d d = position(m, w) - position(m, v);
+      if (dot(d, d) <= best) {
+        best = dot(d, d);
+        c.partner[i] = w;
+      }
+    }
+  }
+}
+
+/// The matched vertex of another source, UINT32_MAX for none (or when v starts no boundary
+/// half-edge, at a pinched vertex).
+std::uint32_t partner_of(const StitchContext& c, std::uint32_t v) {
+  const auto it = c.slot.find(v);
+  return it == c.slot.end() ? UINT32_MAX : c.partner[it->second];
+}
+
+/// Q's boundary from `from` to `to` walking backwards (against Q's orientation, which faces
+/// P's), at most `limit` steps; empty when `to` is not reached or an edge is taken.
+std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from, std::uint32_t to, std::size_t limit) {
+  std::vector<std::uint32_t> run{from};
+  for (std::uint32_t v = from; v != to;) {
+    const auto it = c.boundary.prev.find(v);
+    if (it == c.boundary.prev.end() || run.size() > limit || c.consumed.contains(it->second)) return {};
+    v = it->second;
+    run.push_back(v);
+  }
+  return run;
+}
+
+/// Adds the strip triangle (a, b, c) unless it is degenerate or faces against `reference`.
+bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std::uint32_t d, const Vec3d& reference) {
+  const Mesh& m = c.merged.mesh;
+  const Vec3d n = face_normal(m, a, b, d);
+  const double len = norm(n);
+  if (!(len > 1e-10) || dot(n, reference) <= 0) {
+    ++c.stats.rejected;
+    return false;
+  }
+  c.merged.mesh.triangles.push_back({a, b, d});
+  c.merged.mesh.triangle_ids.push_back({});
+  c.merged.source_acq.push_back(kNoSource);
+  c.merged.source_triangle.push_back(kNoSource);
+  ++c.stats.triangles_added;
+  return true;
+}
+
+/// Zippers P's run a (oriented as P's boundary) with Q's facing run b (oriented the same way
+/// along the seam): one new triangle per step, advancing the side with the shorter diagonal.
+void zip(StitchContext& c, const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
+  const Mesh& m = c.merged.mesh;
+  std::size_t i = 0, j = 0;
+  while (i + 1 < a.size() || j + 1 < b.size()) {
+    const bool advance_a =
+        j + 1 >= b.size() ||
+        (i + 1 < a.size() && norm(position(m, a[i + 1]) - position(m, b[j])) <= norm(position(m, a[i]) - position(m, b[j + 1])));
+    // Reference: the piece triangle beside the boundary edge the new triangle takes.
+    if (advance_a) {
+      const Triangle& t = m.triangles[c.boundary.triangle_of.at(a[i])];
+      add_strip_triangle(c, a[i + 1], a[i], b[j], face_normal(m, t[0], t[1], t[2]));
+      ++i;
+    } else {
+      const Triangle& t = m.triangles[c.boundary.triangle_of.at(b[j + 1])];
+      add_strip_triangle(c, a[i], b[j], b[j + 1], face_normal(m, t[0], t[1], t[2]));
+      ++j;
+    }
+  }
+  for (std::size_t k = 0; k + 1 < a.size(); ++k) c.consumed[a[k]] = true;
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) c.consumed[b[k + 1]] = true;  // Q's half-edge b[k+1] -> b[k]
+  ++c.stats.strips;
+}
+
+/// Walks one boundary loop from `start`: runs of consecutive vertices facing the same other
+/// source, along half-edges not joined yet, are zipped to that source's facing run.
+void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_map<std::uint32_t, bool>& visited) {
+  std::vector<std::uint32_t> run;
+  std::int32_t facing = kNoSource;
+  const auto flush = [&] {
+    if (run.size() >= 2) {
+      const std::vector<std::uint32_t> b =
+          facing_run(c, partner_of(c, run.front()), partner_of(c, run.back()), 4 * run.size() + 8);
+      if (!b.empty()) zip(c, run, b);
+    }
+    run.clear();
+    facing = kNoSource;
+  };
+  std::uint32_t v = start;
+  for (;;) {
+    visited[v] = true;
+    const std::uint32_t p = partner_of(c, v);
+    const std::int32_t q = p == UINT32_MAX ? kNoSource : c.source(p);
+    if (!run.empty() && (q != facing || c.consumed.contains(run.back()))) flush();
+    if (q != kNoSource) {
+      facing = q;
+      run.push_back(v);
+    }
+    const auto it = c.boundary.next.find(v);
+    if (it == c.boundary.next.end() || it->second == start || visited.contains(it->second)) break;
+    v = it->second;
+  }
+  flush();
+}
+
+/// Merges strip corners closer than the weld tolerance and drops the triangles that collapse.
+void weld(StitchContext& c) {
+  Mesh& m = c.merged.mesh;
+  std::vector<std::uint32_t> target(m.vertex_count());
+  std::iota(target.begin(), target.end(), 0);
+  const double tol_sq = c.params.weld * c.params.weld;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    if (c.merged.source_acq[t] != kNoSource) continue;
+    for (int k = 0; k < 3; ++k) {
+      std::uint32_t u = m.triangles[t][k], v = m.triangles[t][(k + 1) % 3];
+      while (target[u] != u) u = target[u];
+      while (target[v] != v) v = target[v];
+      if (u == v) continue;
+      const Vec3d d = position(m, u) - position(m, v);
+      if (dot(d, d) <= tol_sq) {
+        target[std::max(u, v)] = std::min(u, v);
+        ++c.stats.vertices_welded;
+      }
+    }
+  }
+  std::size_t kept = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    Triangle tri = m.triangles[t];
+    for (std::uint32_t& v : tri) {
+      while (target[v] != v) v = target[v];
+    }
+    if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
+    m.triangles[kept] = tri;
+    m.triangle_ids[kept] = m.triangle_ids[t];
+    c.merged.source_acq[kept] = c.merged.source_acq[t];
+    c.merged.source_triangle[kept] = c.merged.source_triangle[t];
+    ++kept;
+  }
+  m.triangles.resize(kept);
+  m.triangle_ids.resize(kept);
+  c.merged.source_acq.resize(kept);
+  c.merged.source_triangle.resize(kept);
+}
+
+}  // namespace
+
+double open_boundary_length(const Mesh& m) {
+  const std::vector<Edge> edges = sorted_edges(m);
+  double total = 0;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
+    if (j - i == 1) total += norm(position(m, edges[i].lo) - position(m, edges[i].hi));
+    i = j;
+  }
+  return total;
+}
+
+StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
+  Stopwatch clock;
+  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, {}, {}};
+  c.stats.open_boundary_before = open_boundary_length(merged.mesh);
+  match_vertices(c);
+  // Open chains (broken at pinched vertices) are walked from their head, so that each is
+  // one walk; closed loops from their smallest vertex.
+  std::unordered_map<std::uint32_t, bool> visited;
+  for (const std::uint32_t v : c.boundary.vertices) {
+    if (!c.boundary.prev.contains(v)) stitch_loop(c, v, visited);
+  }
+  for (const std::uint32_t v : c.boundary.vertices) {
+    if (!visited.contains(v)) stitch_loop(c, v, visited);
+  }
+  weld(c);
+  c.stats.open_boundary_after = open_boundary_length(merged.mesh);
+  c.stats.seconds = clock.seconds();
+  return c.stats;
+}
+
+}  // namespace citymesh
