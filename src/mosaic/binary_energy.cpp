@@ -29,35 +29,50 @@ namespace {
 /// The interaction strength of a pair: e01 + e10 - e00 - e11, > 0 for submodular terms.
 double coupling(const BinaryEnergy::Pair& p) { return p.e01 + p.e10 - p.e00 - p.e11; }
 
-/// The cut graph of an energy. Variable i is node i, x_i = 0 on the source side. With
-/// `doubled`, node n + i stands for the negation of x_i (source side when x_i = 1) and every
-/// term is entered twice, once per copy, which is QPBO's construction; without, every term
-/// must be submodular. Returns the graph ready to solve.
-MaxFlow cut_graph(const BinaryEnergy& e, bool doubled) {
+/// Loads a cut graph into our max-flow.
+MaxFlow max_flow_of(const CutGraph& c) {
+  MaxFlow g(c.nodes);
+  for (std::size_t i = 0; i < c.nodes; ++i) {
+    if (c.terminal[i][0] > 0 || c.terminal[i][1] > 0) {
+      g.add_terminal(static_cast<MaxFlow::Node>(i), c.terminal[i][0], c.terminal[i][1]);
+    }
+  }
+  for (const CutGraph::Arc& a : c.arcs) g.add_edge(a.from, a.to, a.capacity, 0);
+  return g;
+}
+
+}  // namespace
+
+CutGraph cut_graph(const BinaryEnergy& e, bool doubled) {
   const std::size_t n = e.size();
-  MaxFlow g(doubled ? 2 * n : n);
+  CutGraph g;
+  g.nodes = doubled ? 2 * n : n;
+  g.terminal.assign(g.nodes, {0.0, 0.0});
+  const auto add_edge = [&g](std::uint32_t from, std::uint32_t to, double capacity) {
+    g.arcs.push_back({from, to, capacity});
+  };
   std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0 (constants dropped)
   for (std::size_t i = 0; i < n; ++i) cost_of_one[i] = e.unary[i][1] - e.unary[i][0];
-  const auto bar = [n](std::uint32_t i) { return static_cast<MaxFlow::Node>(n + i); };
+  const auto bar = [n](std::uint32_t i) { return static_cast<std::uint32_t>(n + i); };
   for (const BinaryEnergy::Pair& p : e.pairs) {
     // Each term is written as unary parts plus two "both ways" costs of weights alpha and
     // beta (alpha + beta = |coupling|), split so that the unary parts are balanced: unary
     // parts push flow through the graph from terminal to terminal, and a split that leaves
     // the overlap terms none spares millions of augmentations.
     const double c = coupling(p);
-    const auto i = static_cast<MaxFlow::Node>(p.i), j = static_cast<MaxFlow::Node>(p.j);
+    const std::uint32_t i = p.i, j = p.j;
     if (c >= 0) {
       // e00 + u_i x_i + u_j x_j + alpha [x_i=0, x_j=1] + beta [x_i=1, x_j=0].
       const double beta = std::clamp((2 * p.e10 - p.e00 - p.e11) / 2, 0.0, c), alpha = c - beta;
       cost_of_one[p.i] += p.e10 - p.e00 - beta;
       cost_of_one[p.j] += p.e01 - p.e00 - alpha;
       if (alpha > 0) {
-        g.add_edge(i, j, alpha, 0);  // cut when i is on the source side and j is not
-        if (doubled) g.add_edge(bar(j), bar(i), alpha, 0);
+        add_edge(i, j, alpha);  // cut when i is on the source side and j is not
+        if (doubled) add_edge(bar(j), bar(i), alpha);
       }
       if (beta > 0) {
-        g.add_edge(j, i, beta, 0);
-        if (doubled) g.add_edge(bar(i), bar(j), beta, 0);
+        add_edge(j, i, beta);
+        if (doubled) add_edge(bar(i), bar(j), beta);
       }
     } else {
       if (!doubled) throw ProcessingError("graph cut: a non-submodular term in a single cut");
@@ -66,30 +81,29 @@ MaxFlow cut_graph(const BinaryEnergy& e, bool doubled) {
       cost_of_one[p.i] += p.e11 - p.e01 - beta;
       cost_of_one[p.j] += p.e11 - p.e10 - beta;
       if (alpha > 0) {
-        g.add_edge(i, bar(j), alpha, 0);  // x_i = 0 (i source side), x_j = 0 (bar j sink side)
-        g.add_edge(j, bar(i), alpha, 0);
+        add_edge(i, bar(j), alpha);  // x_i = 0 (i source side), x_j = 0 (bar j sink side)
+        add_edge(j, bar(i), alpha);
       }
       if (beta > 0) {
-        g.add_edge(bar(i), j, beta, 0);  // x_i = 1 (bar i source side), x_j = 1 (j sink side)
-        g.add_edge(bar(j), i, beta, 0);
+        add_edge(bar(i), j, beta);  // x_i = 1 (bar i source side), x_j = 1 (j sink side)
+        add_edge(bar(j), i, beta);
       }
     }
   }
   for (std::size_t i = 0; i < n; ++i) {
     const double d = cost_of_one[i];
-    const auto v = static_cast<MaxFlow::Node>(i);
+    const auto v = static_cast<std::uint32_t>(i);
     if (d > 0) {
-      g.add_terminal(v, d, 0);  // x_i = 1: node on the sink side, cutting source -> i
-      if (doubled) g.add_terminal(bar(v), 0, d);
+      g.terminal[v][0] += d;  // x_i = 1: node on the sink side, cutting source -> i
+      if (doubled) g.terminal[bar(v)][1] += d;
     } else if (d < 0) {
-      g.add_terminal(v, 0, -d);
-      if (doubled) g.add_terminal(bar(v), -d, 0);
+      g.terminal[v][1] -= d;
+      if (doubled) g.terminal[bar(v)][0] -= d;
     }
   }
   return g;
 }
 
-}  // namespace
 
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e) {
   const std::size_t n = e.size();
@@ -124,7 +138,7 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   return std::vector<std::uint8_t>(colour.begin(), colour.end());
 }
 
-std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
+BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
   BinaryEnergy f = e;
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (flips[i] != 0) std::swap(f.unary[i][0], f.unary[i][1]);
@@ -141,7 +155,11 @@ std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::spa
     // Rounding can leave a modular term a hair non-submodular: it carries no coupling.
     if (!p.submodular() && coupling(p) > -1e-12 * (std::abs(p.e00) + std::abs(p.e11) + 1)) p.e11 = p.e01 + p.e10 - p.e00;
   }
-  MaxFlow g = cut_graph(f, /*doubled=*/false);
+  return f;
+}
+
+std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
+  MaxFlow g = max_flow_of(cut_graph(flipped(e, flips), /*doubled=*/false));
   g.solve();
   const std::vector<std::uint8_t> source = g.source_side();
   std::vector<std::int8_t> x(e.size());
@@ -151,7 +169,7 @@ std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::spa
 
 std::vector<std::int8_t> qpbo(const BinaryEnergy& e) {
   const std::size_t n = e.size();
-  MaxFlow g = cut_graph(e, /*doubled=*/true);
+  MaxFlow g = max_flow_of(cut_graph(e, /*doubled=*/true));
   g.solve();
   // Nodes reachable from the source lie on the source side of every minimum cut: x_i = 0 when
   // i is, x_i = 1 when its negation is; both never happen (that would be an s-t path).

@@ -232,10 +232,15 @@ double MaxFlow::solve() {
     n.distance = 1;
     set_active(i);
   }
-  for (Node i; (i = next_active()) != std::numeric_limits<Node>::max();) {
+  constexpr Node kNoNode = std::numeric_limits<Node>::max();
+  Node current = kNoNode;  // a node that found a path is grown again first: its tree is warm
+  for (;;) {
+    Node i = current != kNoNode && nodes_[current].tree != Tree::free ? current : next_active();
+    current = kNoNode;
+    if (i == kNoNode) break;
     Arc bridge = kNone;
     if (!grow(i, bridge)) continue;
-    set_active(i);  // its remaining arcs are still to be scanned
+    current = i;
     ++time_;
     augment(bridge);
     while (!orphans_.empty()) {

@@ -37,6 +37,23 @@ constexpr std::int8_t kUnlabelled = -1;
 /// overlap terms between them only, flipping one mesh is such a set.
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e);
 
+/// The energy with the variables in `flips` flipped (x -> 1 - x): same minimum, relabelled.
+BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
+
+/// The s-t graph whose minimum cut minimises an energy: node i is x_i (source side: 0); with
+/// `doubled`, node n + i is its negation (QPBO's construction), else every term must be
+/// submodular. Terms are split so that unary parts stay balanced (fewer augmentations).
+struct CutGraph {
+  struct Arc {
+    std::uint32_t from = 0, to = 0;
+    double capacity = 0;
+  };
+  std::size_t nodes = 0;
+  std::vector<std::array<double, 2>> terminal;  ///< per node: from the source, to the sink
+  std::vector<Arc> arcs;
+};
+CutGraph cut_graph(const BinaryEnergy& e, bool doubled);
+
 /// Exact minimum of an energy whose terms are all submodular once the variables in `flips`
 /// are flipped: one graph cut. Returns a complete labelling.
 std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
