@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Static kd-tree over 3D points in a local frame (nanoflann behind this header). The change
-// detection finds candidate consistent triangles with it.
+// Static kd-tree over 3D points in a local frame (nanoflann behind this header). Stitching
+// matches boundary vertices with it.
 #pragma once
 
 #include <cstdint>
