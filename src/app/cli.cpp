@@ -19,6 +19,7 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   commands.push_back(make_render_command());
   commands.push_back(make_mesh_command());
   commands.push_back(make_detect_command());
+  commands.push_back(make_mosaic_command());
   commands.push_back(make_run_command());
   commands.push_back(make_eval_command());
   return commands;

@@ -31,6 +31,7 @@ std::unique_ptr<Command> make_mesh_command();
 std::unique_ptr<Command> make_detect_command();
 std::unique_ptr<Command> make_eval_command();
 std::unique_ptr<Command> make_run_command();
+std::unique_ptr<Command> make_mosaic_command();
 
 /// Every command, in the order `citymesh --help` lists them. New commands register here.
 std::vector<std::unique_ptr<Command>> make_commands();

@@ -8,6 +8,7 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/render/render.h"
@@ -95,6 +96,11 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
                                        {"triangles", input.meshes[k].triangle_count()},
                                        {"counts", counts_json(count_states(r, begin, r.index.offsets[k + 1]))}});
   }
+  std::vector<std::uint32_t> flat;
+  flat.reserve(2 * r.consistent_pairs.size());
+  for (const auto& [a, b] : r.consistent_pairs) flat.insert(flat.end(), {a, b});
+  write_u32_records(params.dir / kPairsFile, kPairsMagic, flat);
+  summary["pairs"] = kPairsFile;
   const ChangeStats& s = r.stats;
   summary["totals"] = counts_json(count_states(r, 0, r.index.size()));
   summary["totals"]["triangles"] = s.triangles;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string_view>
 
 #include "acquisitions.h"
 #include "citymesh/change/detect.h"
@@ -14,6 +15,9 @@ namespace citymesh::app {
 inline constexpr const char* kStateProperty = "state";          ///< uchar: 0 consistent, 1 conflicting, 2 single
 inline constexpr const char* kKeptProperty = "kept";            ///< uchar: survives the time series
 inline constexpr const char* kSourceFaceProperty = "source_face";  ///< int: face index in the input file
+/// The consistent pairs (global triangle ids, config order), as uint32 a0 b0 a1 b1 ... with a < b.
+inline constexpr const char* kPairsFile = "pairs.bin";
+inline constexpr std::string_view kPairsMagic = "CMPAIRS1";
 
 struct DetectOutputParams {
   std::filesystem::path dir;  ///< <output>/detect
@@ -22,7 +26,8 @@ struct DetectOutputParams {
   double read_seconds = 0;
 };
 
-/// Writes <dir>/<k>_<name>.ply and .png per acquisition and <dir>/summary.json, each atomically.
+/// Writes <dir>/<k>_<name>.ply and .png per acquisition, <dir>/pairs.bin and
+/// <dir>/summary.json (last), each atomically.
 void write_detect_outputs(const Config& config, const LoadedAcquisitions& input, const ChangeResult& result,
                           const DetectOutputParams& params);
 

@@ -2,10 +2,9 @@
 // Ground-truth sidecar files and object fates.
 #include <fmt/format.h>
 
-#include <cstring>
 #include <fstream>
 
-#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/record_file.h"
 #include "citymesh/core/error.h"
 #include <nlohmann/json.hpp>
 
@@ -15,14 +14,7 @@
 namespace citymesh {
 
 namespace {
-constexpr char kMagic[8] = {'C', 'M', 'T', 'R', 'U', 'T', 'H', '1'};
-
-std::uint64_t fnv1a(const void* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
+constexpr std::string_view kMagic = "CMTRUTH1";
 }  // namespace
 
 std::string_view fate_name(Fate f) {
@@ -45,36 +37,11 @@ Fate fate_of(const SceneObject& object, const std::vector<EpochDrive>& epochs, D
 }
 
 void write_truth(const std::filesystem::path& path, std::span<const std::uint32_t> ids) {
-  AtomicFile file(path);
-  const std::uint64_t count = ids.size(), sum = fnv1a(ids.data(), ids.size_bytes());
-  file.write(kMagic, sizeof kMagic);
-  file.write(&count, sizeof count);
-  file.write(ids.data(), ids.size_bytes());
-  file.write(&sum, sizeof sum);
-  file.commit();
+  write_u32_records(path, kMagic, ids);
 }
 
 std::vector<std::uint32_t> read_truth(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open ground truth", path.string()));
-  char magic[8];
-  std::uint64_t count = 0, sum = 0;
-  if (!in.read(magic, 8) || std::memcmp(magic, kMagic, 8) != 0) {
-    throw InputError(fmt::format("{}: not a citymesh ground-truth file", path.string()));
-  }
-  in.read(reinterpret_cast<char*>(&count), sizeof count);
-  std::error_code ec;
-  const auto size = std::filesystem::file_size(path, ec);
-  if (!in || ec || size < 24 || (size - 24) % 4 != 0 || count != (size - 24) / 4) {
-    throw InputError(fmt::format("{}: ground truth is truncated or its count is wrong", path.string()));
-  }
-  std::vector<std::uint32_t> ids(count);
-  in.read(reinterpret_cast<char*>(ids.data()), static_cast<std::streamsize>(count * 4));
-  in.read(reinterpret_cast<char*>(&sum), sizeof sum);
-  if (!in || sum != fnv1a(ids.data(), ids.size() * 4)) {
-    throw InputError(fmt::format("{}: ground truth checksum mismatch", path.string()));
-  }
-  return ids;
+  return read_u32_records(path, kMagic, "ground truth");
 }
 
 std::vector<ObjectRecord> read_objects(const std::filesystem::path& sim) {

@@ -92,6 +92,27 @@ TEST(RunEval, SameInputGivesSameMosaicBytesOnOneAndTwoThreads) {
   const std::string one = test::read_text(dir / "sim/out/mosaic/mosaic.ply");
   ASSERT_EQ(test::run_citymesh(fmt::format("run {}/config.toml --no-pictures --threads 2", sim)).exit_code, 0);
   EXPECT_EQ(test::read_text(dir / "sim/out/mosaic/mosaic.ply"), one);
+  // The mosaic alone, on the detect output the run left, gives the same bytes.
+  std::filesystem::remove(dir / "sim/out/mosaic/mosaic.ply");
+  const auto mosaic = test::run_citymesh(fmt::format("mosaic {}/config.toml --no-pictures", sim));
+  ASSERT_EQ(mosaic.exit_code, 0) << mosaic.err;
+  EXPECT_EQ(test::read_text(dir / "sim/out/mosaic/mosaic.ply"), one);
+}
+
+TEST(RunEval, MosaicRefusesAMissingOrDamagedDetectOutput) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const auto missing = test::run_citymesh(fmt::format("mosaic {}/config.toml", sim));
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("run citymesh detect first"), std::string::npos) << missing.err;
+  ASSERT_EQ(test::run_citymesh(fmt::format("detect {}/config.toml --no-pictures", sim)).exit_code, 0);
+  const std::string pairs = test::read_text(dir / "sim/out/detect/pairs.bin");
+  test::write_text(dir / "sim/out/detect/pairs.bin", pairs.substr(0, pairs.size() / 2));
+  const auto damaged = test::run_citymesh(fmt::format("mosaic {}/config.toml", sim));
+  EXPECT_EQ(damaged.exit_code, 2);
+  EXPECT_NE(damaged.err.find("pairs.bin"), std::string::npos) << damaged.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/out/mosaic/summary.json"));
 }
 
 TEST(RunEval, EvalRefusesAMosaicThatDoesNotMatchTheRun) {

@@ -1,0 +1,117 @@
+// SPDX-License-Identifier: MIT
+#include "mosaic_step.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/record_file.h"
+#include "citymesh/core/stopwatch.h"
+#include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/mosaic.h"
+#include "citymesh/mosaic/stitch.h"
+#include "detect_output.h"
+#include "face_table.h"
+#include "mosaic_eval.h"
+#include "mosaic_output.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// Strip corners closer than this many distance thresholds are welded (5 mm at 10 cm).
+constexpr double kWeldInThresholds = 0.05;
+
+MosaicSelection select(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change) {
+  const MosaicInput in{input.meshes, input.dates, &change, config.change.distance_threshold};
+  return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in) : select_mosaic(in, config.mosaic);
+}
+
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
+  const StitchStats s = stitch(merged, {.reach = config.mosaic.stitch_reach * config.change.distance_threshold,
+                                        .weld = kWeldInThresholds * config.change.distance_threshold});
+  std::cout << fmt::format("stitching: {} strips, {} triangles, open boundary {:.1f} m -> {:.1f} m\n", s.strips,
+                           s.triangles_added, s.open_boundary_before, s.open_boundary_after);
+  return {{"open_boundary_before_m", s.open_boundary_before},
+          {"open_boundary_after_m", s.open_boundary_after},
+          {"strips", s.strips},
+          {"triangles_added", s.triangles_added},
+          {"vertices_welded", s.vertices_welded},
+          {"rejected", s.rejected},
+          {"seconds", s.seconds}};
+}
+
+void report(const std::filesystem::path& dir, const MergedMesh& merged, const MosaicStats& s) {
+  std::cout << fmt::format("{}: {} triangles kept of {} candidates", dir.string(), merged.mesh.triangle_count(),
+                           s.candidates);
+  if (s.seam_terms + s.overlap_terms > 0) {
+    std::cout << fmt::format("; energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f})",
+                             s.energy, s.quality, s.boundary, s.seam, s.overlap);
+  }
+  std::cout << fmt::format("\n  {:.3f} s: energy {:.3f}, solve {:.3f}\n", s.seconds_build + s.seconds_solve,
+                           s.seconds_build, s.seconds_solve);
+}
+
+}  // namespace
+
+void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
+                     const PictureOptions& pictures, nlohmann::json seconds) {
+  Stopwatch clock;
+  const MosaicSelection selection = select(config, input, change);
+  MergedMesh merged = merge_selection(input.meshes, change.index, selection.selected);
+  seconds["mosaic"] = clock.restart();
+  seconds["energy"] = selection.stats.seconds_build;
+  seconds["solve"] = selection.stats.seconds_solve;
+  // The baseline, like the paper's, is not stitched.
+  const nlohmann::json stitched =
+      config.mosaic.method == MosaicMethod::energy ? stitch_and_report(config, merged) : nlohmann::json::object();
+  seconds["stitch"] = clock.restart();
+  const std::filesystem::path dir = config.project.output / "mosaic";
+  write_mosaic_outputs(config, input, merged, selection.stats,
+                       {.dir = dir,
+                        .pixel_size = pictures.pixel_size,
+                        .pictures = pictures.pictures,
+                        .seconds = std::move(seconds),
+                        .stitch = stitched});
+  report(dir, merged, selection.stats);
+}
+
+ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAcquisitions& input) {
+  const nlohmann::json summary = read_json(dir / "summary.json", "run citymesh detect first");
+  ChangeResult r;
+  r.index.offsets.assign(1, 0);
+  for (const Mesh& m : input.meshes) r.index.offsets.push_back(r.index.offsets.back() + m.triangle_count());
+  try {
+    const auto& acquisitions = summary.at("acquisitions");
+    if (acquisitions.size() != input.meshes.size()) {
+      throw InputError(fmt::format("{}: {} acquisitions, the config has {} (run citymesh detect again)",
+                                   (dir / "summary.json").string(), acquisitions.size(), input.meshes.size()));
+    }
+    for (std::size_t k = 0; k < input.meshes.size(); ++k) {
+      const std::filesystem::path ply = dir / acquisitions[k].at("ply").get<std::string>();
+      const FaceTable t = read_face_table(ply, {kKeptProperty});
+      if (t.triangles.size() != input.meshes[k].triangle_count()) {
+        throw InputError(fmt::format("{}: {} triangles, {} has {} (run citymesh detect again)", ply.string(),
+                                     t.triangles.size(), input.acquisitions[k].path.string(),
+                                     input.meshes[k].triangle_count()));
+      }
+      for (const double kept : t.extras[0]) r.kept.push_back(kept != 0 ? 1 : 0);
+    }
+    const std::filesystem::path pairs_file = dir / summary.at("pairs").get<std::string>();
+    const std::vector<std::uint32_t> flat = read_u32_records(pairs_file, kPairsMagic, "consistent pairs");
+    const std::size_t n = r.index.size();
+    for (std::size_t k = 0; k + 1 < flat.size(); k += 2) {
+      if (flat[k] >= n || flat[k + 1] >= n || !(flat[k] < flat[k + 1])) {
+        throw InputError(fmt::format("{}: pair {} ({}, {}) is not a pair of the {} triangles", pairs_file.string(),
+                                     k / 2, flat[k], flat[k + 1], n));
+      }
+      r.consistent_pairs.emplace_back(flat[k], flat[k + 1]);
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: {}", (dir / "summary.json").string(), e.what()));
+  }
+  return r;
+}
+
+}  // namespace citymesh::app
