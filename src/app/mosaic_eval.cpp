@@ -10,6 +10,7 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/mosaic/edges.h"
 #include "citymesh/mosaic/proximity.h"
 #include "citymesh/sim/simulate.h"
 #include "detect_output.h"
@@ -102,32 +103,16 @@ OutputMesh read_output(const std::filesystem::path& ply) {
 /// Boundary edges of the output (used by one triangle) and the part of them lying within
 /// `reach` of output from another source: the seams left open.
 std::pair<double, double> boundary_and_seam_length(const OutputMesh& o, const MeshProximity& near, double reach) {
-  struct Edge {
-    std::uint32_t lo, hi, triangle;
-    auto operator<=>(const Edge&) const = default;
-  };
-  std::vector<Edge> edges;
-  for (std::uint32_t t = 0; t < o.table.triangles.size(); ++t) {
-    const Triangle& tri = o.table.triangles[t];
-    for (int k = 0; k < 3; ++k) edges.push_back({std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3]), t});
-  }
-  std::sort(edges.begin(), edges.end());
-  std::vector<Edge> boundary;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
-    if (j - i == 1) boundary.push_back(edges[i]);
-    i = j;
-  }
+  const std::vector<EdgeUse> boundary = boundary_edges(o.table.triangles);
   double total = 0;
   const double seam = parallel_sum(boundary.size(), [&](std::size_t i) {
-    const Edge& e = boundary[i];
+    const EdgeUse& e = boundary[i];
     const double length = norm(o.table.positions[e.lo] - o.table.positions[e.hi]);
     const Vec3d mid = (Vec3d(o.local.positions[e.lo]) + Vec3d(o.local.positions[e.hi])) * 0.5;
     const std::int32_t own = o.source[e.triangle];
     return near.any_within(mid, reach, [&](std::uint32_t u) { return o.source[u] != own; }) ? length : 0.0;
   });
-  for (const Edge& e : boundary) total += norm(o.table.positions[e.lo] - o.table.positions[e.hi]);
+  for (const EdgeUse& e : boundary) total += norm(o.table.positions[e.lo] - o.table.positions[e.hi]);
   return {total, seam};
 }
 

@@ -6,27 +6,12 @@
 #include <unordered_map>
 
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
 
 namespace citymesh {
 
 namespace {
-
-struct Edge {
-  std::uint32_t lo, hi, triangle;
-  auto operator<=>(const Edge&) const = default;
-};
-
-std::vector<Edge> sorted_edges(const Mesh& m) {
-  std::vector<Edge> edges;
-  edges.reserve(3 * m.triangle_count());
-  for (std::uint32_t t = 0; t < m.triangle_count(); ++t) {
-    const Triangle& tri = m.triangles[t];
-    for (int k = 0; k < 3; ++k) edges.push_back({std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3]), t});
-  }
-  std::sort(edges.begin(), edges.end());
-  return edges;
-}
 
 Vec3d position(const Mesh& m, std::uint32_t v) { return Vec3d(m.positions[v]); }
 
@@ -43,26 +28,20 @@ struct Boundary {
 };
 
 Boundary find_boundary(const Mesh& m) {
-  const std::vector<Edge> edges = sorted_edges(m);
   Boundary b;
   std::unordered_map<std::uint32_t, int> outgoing;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
-    if (j - i == 1) {
-      const Triangle& tri = m.triangles[edges[i].triangle];
-      // Orient as in the triangle: the half-edge u -> v whose reverse no triangle has.
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
-        if (std::min(u, v) != edges[i].lo || std::max(u, v) != edges[i].hi) continue;
-        if (++outgoing[u] == 1 && !b.prev.contains(v)) {
-          b.next[u] = v;
-          b.prev[v] = u;
-          b.triangle_of[u] = edges[i].triangle;
-        }
+  for (const EdgeUse& e : boundary_edges(m.triangles)) {
+    const Triangle& tri = m.triangles[e.triangle];
+    // Orient as in the triangle: the half-edge u -> v whose reverse no triangle has.
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
+      if (std::min(u, v) != e.lo || std::max(u, v) != e.hi) continue;
+      if (++outgoing[u] == 1 && !b.prev.contains(v)) {
+        b.next[u] = v;
+        b.prev[v] = u;
+        b.triangle_of[u] = e.triangle;
       }
     }
-    i = j;
   }
   for (const auto& [v, n] : b.next) b.vertices.push_back(v);
   std::sort(b.vertices.begin(), b.vertices.end());
@@ -243,14 +222,8 @@ void weld(StitchContext& c) {
 }  // namespace
 
 double open_boundary_length(const Mesh& m) {
-  const std::vector<Edge> edges = sorted_edges(m);
   double total = 0;
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && edges[j].lo == edges[i].lo && edges[j].hi == edges[i].hi) ++j;
-    if (j - i == 1) total += norm(position(m, edges[i].lo) - position(m, edges[i].hi));
-    i = j;
-  }
+  for (const EdgeUse& e : boundary_edges(m.triangles)) total += norm(position(m, e.lo) - position(m, e.hi));
   return total;
 }
 
