@@ -45,8 +45,7 @@ struct TriangleShape {
 };
 
 TriangleShape shape(const Mesh& m, std::size_t t) {
-  const Triangle& tri = m.triangles[t];
-  const Vec3d a(m.positions[tri[0]]), b(m.positions[tri[1]]), c(m.positions[tri[2]]);
+  const auto [a, b, c] = m.corners(t);
   return {0.5 * doubled_area(a, b, c), std::max({norm(b - a), norm(c - b), norm(a - c)})};
 }
 

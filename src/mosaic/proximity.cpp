@@ -12,11 +12,6 @@ namespace citymesh {
 
 namespace {
 
-TriangleCorners corners_of(const Mesh& m, std::size_t t) {
-  const Triangle& tri = m.triangles[t];
-  return {Vec3d(m.positions[tri[0]]), Vec3d(m.positions[tri[1]]), Vec3d(m.positions[tri[2]])};
-}
-
 /// p within `reach` of the triangle's plane and projecting inside it.
 bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
   const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
@@ -37,7 +32,7 @@ bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
 MeshProximity::MeshProximity(const Mesh& mesh, double max_reach) : mesh_(mesh) {
   std::vector<Box3f> boxes(mesh.triangle_count());
   for (std::size_t t = 0; t < boxes.size(); ++t) {
-    const TriangleCorners c = corners_of(mesh, t);
+    const TriangleCorners c = mesh.corners(t);
     Vec3d lo = c[0], hi = c[0];
     for (const Vec3d& p : c) {
       lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
@@ -56,7 +51,7 @@ bool MeshProximity::any_within(const Vec3d& p, double reach, const std::function
   tree_->containing(Vec3f(p), hits);
   const double reach_sq = reach * reach;
   return std::any_of(hits.begin(), hits.end(), [&](std::uint32_t t) {
-    return (!accept || accept(t)) && point_triangle_distance_sq(p, corners_of(mesh_, t)) <= reach_sq;
+    return (!accept || accept(t)) && point_triangle_distance_sq(p, mesh_.corners(t)) <= reach_sq;
   });
 }
 
@@ -68,7 +63,7 @@ bool MeshProximity::any_over(const Vec3d& p, double reach, const std::function<b
   thread_local std::vector<std::uint32_t> hits;
   tree_->containing(Vec3f(p), hits);
   return std::any_of(hits.begin(), hits.end(),
-                     [&](std::uint32_t t) { return (!accept || accept(t)) && over(p, corners_of(mesh_, t), reach); });
+                     [&](std::uint32_t t) { return (!accept || accept(t)) && over(p, mesh_.corners(t), reach); });
 }
 
 }  // namespace citymesh

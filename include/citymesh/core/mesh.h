@@ -65,6 +65,11 @@ struct Mesh {
   [[nodiscard]] bool has_sensor_positions() const { return !sensor_positions.empty(); }
   /// Absolute position in the project CRS.
   [[nodiscard]] Vec3d world_position(std::size_t v) const { return origin + Vec3d(positions[v]); }
+  /// The corners of triangle t in the local frame, as doubles for exact-in-intent geometry.
+  [[nodiscard]] std::array<Vec3d, 3> corners(std::size_t t) const {
+    const Triangle& tri = triangles[t];
+    return {Vec3d(positions[tri[0]]), Vec3d(positions[tri[1]]), Vec3d(positions[tri[2]])};
+  }
   [[nodiscard]] Vec3d world_sensor_position(std::size_t v) const {
     return origin + Vec3d(sensor_positions[v]);
   }
