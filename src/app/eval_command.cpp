@@ -151,7 +151,8 @@ class EvalCommand final : public Command {
   void run() override {
     const std::filesystem::path detect = std::filesystem::path(output_) / "detect";
     const nlohmann::json summary = read_json(detect / "summary.json", "run citymesh detect first");
-    std::map<std::uint32_t, ObjectInfo> objects = objects_by_id(truth_);
+    const std::map<std::uint32_t, ObjectInfo> catalogue = objects_by_id(truth_);
+    std::map<std::uint32_t, ObjectInfo> objects = catalogue;  // areas added up per object
     try {
       for (const auto& a : summary.at("acquisitions")) {
         score_acquisition(detect / a.at("ply").get<std::string>(), truth_file(truth_, a), objects);
@@ -163,7 +164,7 @@ class EvalCommand final : public Command {
     const bool mosaic = std::filesystem::exists(std::filesystem::path(output_) / "mosaic" / "summary.json");
     if (mosaic) {
       try {
-        result["mosaic"] = evaluate_mosaic(output_, truth_, summary, objects_by_id(truth_));
+        result["mosaic"] = evaluate_mosaic(output_, truth_, summary, catalogue);
       } catch (const nlohmann::json::exception& e) {
         throw InputError(fmt::format("{}: {}", (std::filesystem::path(output_) / "mosaic").string(), e.what()));
       }

@@ -35,8 +35,11 @@ std::map<std::uint32_t, ObjectInfo> objects_by_id(const std::filesystem::path& s
   return objects;
 }
 
-ObjectInfo& object_of(std::map<std::uint32_t, ObjectInfo>& objects, const std::vector<std::uint32_t>& truth,
-                      double source_face, const FaceOrigin& origin) {
+namespace {
+
+/// The lookup both object_of overloads share (Map: the catalogue, const or not).
+template <class Map>
+auto& find_object(Map& objects, const std::vector<std::uint32_t>& truth, double source_face, const FaceOrigin& origin) {
   if (!(source_face >= 0 && source_face < static_cast<double>(truth.size()))) {
     throw InputError(fmt::format("{}: face {}: source_face {} is not a face of {} ({} faces)", origin.ply.string(),
                                  origin.face, source_face, origin.truth.string(), truth.size()));
@@ -45,6 +48,18 @@ ObjectInfo& object_of(std::map<std::uint32_t, ObjectInfo>& objects, const std::v
   const auto it = objects.find(id);
   if (it == objects.end()) throw InputError(fmt::format("{}: object {} is not in objects.json", origin.truth.string(), id));
   return it->second;
+}
+
+}  // namespace
+
+ObjectInfo& object_of(std::map<std::uint32_t, ObjectInfo>& objects, const std::vector<std::uint32_t>& truth,
+                      double source_face, const FaceOrigin& origin) {
+  return find_object(objects, truth, source_face, origin);
+}
+
+const ObjectInfo& object_of(const std::map<std::uint32_t, ObjectInfo>& objects, const std::vector<std::uint32_t>& truth,
+                            double source_face, const FaceOrigin& origin) {
+  return find_object(objects, truth, source_face, origin);
 }
 
 std::filesystem::path truth_file(const std::filesystem::path& truth_dir, const nlohmann::json& acquisition) {
@@ -120,30 +135,34 @@ std::pair<double, double> boundary_and_seam_length(const OutputMesh& o, const Me
 
 nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::filesystem::path& truth_dir,
                                const nlohmann::json& detect_summary,
-                               const std::map<std::uint32_t, ObjectInfo>& objects_in) {
+                               const std::map<std::uint32_t, ObjectInfo>& objects) {
   const std::filesystem::path dir = output / "mosaic";
   const nlohmann::json summary = read_json(dir / "summary.json", "run citymesh run first");
   const double reach = summary.at("distance_threshold").get<double>();
-  const OutputMesh out = read_output(dir / kMosaicFile);
+  const std::filesystem::path output_ply = dir / kMosaicFile;
+  const OutputMesh out = read_output(output_ply);
   const MeshProximity near(out.local, reach);
-  std::map<std::uint32_t, ObjectInfo> objects = objects_in;
   const auto& acquisitions = detect_summary.at("acquisitions");
 
   // The output's own faces: dynamic residue, overlap, edge length.
+  std::vector<std::filesystem::path> truth_paths;
   std::vector<std::vector<std::uint32_t>> truths;
-  for (const auto& a : acquisitions) truths.push_back(read_truth(truth_file(truth_dir, a)));
+  for (const auto& a : acquisitions) {
+    truth_paths.push_back(truth_file(truth_dir, a));
+    truths.push_back(read_truth(truth_paths.back()));
+  }
   double out_area = 0, out_dynamic = 0, out_edges = 0;
   std::uint64_t out_edge_count = 0;
   for (std::size_t t = 0; t < out.source.size(); ++t) {
     const std::int32_t a = out.source[t];
     if (a < 0) continue;
     if (static_cast<std::size_t>(a) >= truths.size()) {
-      throw InputError(fmt::format("{}: face {}: source_acq {} is not an acquisition of the run", (dir / kMosaicFile).string(),
+      throw InputError(fmt::format("{}: face {}: source_acq {} is not an acquisition of the run", output_ply.string(),
                                    out.table.faces[t], a));
     }
     const TriangleCorners c = out.table.corners(t);
-    const FaceOrigin origin{dir / kMosaicFile, truth_file(truth_dir, acquisitions[static_cast<std::size_t>(a)]), out.table.faces[t]};
-    const ObjectInfo& o = object_of(objects, truths[static_cast<std::size_t>(a)], out.table.extras[1][t], origin);
+    const auto k = static_cast<std::size_t>(a);
+    const ObjectInfo& o = object_of(objects, truths[k], out.table.extras[1][t], {output_ply, truth_paths[k], out.table.faces[t]});
     out_area += area(c);
     out_dynamic += o.fate == "remove" ? area(c) : 0.0;
     out_edges += norm(c[1] - c[0]) + norm(c[2] - c[1]) + norm(c[0] - c[2]);
@@ -178,7 +197,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
       }
     });
     for (std::size_t t = 0; t < in.triangles.size(); ++t) {
-      const ObjectInfo& o = object_of(objects, truths[k], in.extras[0][t], {ply, truth_file(truth_dir, acquisitions[k]), in.faces[t]});
+      const ObjectInfo& o = object_of(objects, truths[k], in.extras[0][t], {ply, truth_paths[k], in.faces[t]});
       if (o.fate == "keep") {
         static_area += face_area[t];
         static_covered += covered[t] * face_area[t];

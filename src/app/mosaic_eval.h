@@ -23,9 +23,10 @@ struct ObjectInfo {
 /// The simulation's objects (objects.json), with the no-surface record.
 std::map<std::uint32_t, ObjectInfo> objects_by_id(const std::filesystem::path& sim);
 
-/// Where a face came from, for error messages.
+/// Where a face came from, for error messages (built per face: it refers, never copies).
 struct FaceOrigin {
-  std::filesystem::path ply, truth;
+  const std::filesystem::path& ply;
+  const std::filesystem::path& truth;
   std::uint64_t face = 0;
 };
 
@@ -33,6 +34,8 @@ struct FaceOrigin {
 /// InputError naming the files when the face or the object does not exist.
 ObjectInfo& object_of(std::map<std::uint32_t, ObjectInfo>& objects, const std::vector<std::uint32_t>& truth,
                       double source_face, const FaceOrigin& origin);
+const ObjectInfo& object_of(const std::map<std::uint32_t, ObjectInfo>& objects, const std::vector<std::uint32_t>& truth,
+                            double source_face, const FaceOrigin& origin);
 
 /// The mosaic's scores (overlap ratio, seam length, hole ratio, static completeness, dynamic
 /// residue, mean edge length against the finest input) from <output>/mosaic and the detect
