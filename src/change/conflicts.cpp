@@ -88,10 +88,6 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
   return out;
 }
 
-}  // namespace
-
-namespace {
-
 /// A triangle lying wholly farther than this outside one face plane of a tetrahedron misses
 /// it: far above the float rounding of the planes, so the quick rejection below is exact.
 constexpr float kPlaneRejectMargin = 1e-3f;
@@ -170,12 +166,13 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
       std::uint64_t tested = 0;
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t t = older.ids[i];
+        const TriangleCorners corners = f.corners(t);  // once per candidate, not per test
         tree.overlapping(older.boxes[i], hits);
         for (const std::uint32_t h : hits) {
           if (spaces.planes[h].misses(f.corner[t])) continue;
           const std::uint32_t u = spaces.boxed.ids[h];
           ++tested;
-          if (triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
+          if (triangle_intersects_tetrahedron(corners, f.empty_space(u))) {
             flags.conflicting[t] = 1;
             std::atomic_ref<std::uint8_t>(flags.refutes[u]).store(1, std::memory_order_relaxed);
           }

@@ -17,10 +17,7 @@ namespace citymesh {
 double BinaryEnergy::evaluate(std::span<const std::int8_t> x) const {
   double e = 0;
   for (std::size_t i = 0; i < unary.size(); ++i) e += unary[i][static_cast<std::size_t>(x[i])];
-  for (const Pair& p : pairs) {
-    const bool a = x[p.i] != 0, b = x[p.j] != 0;
-    e += a ? (b ? p.e11 : p.e10) : (b ? p.e01 : p.e00);
-  }
+  for (const Pair& p : pairs) e += p.value(x[p.i] != 0, x[p.j] != 0);
   return e;
 }
 

@@ -33,17 +33,13 @@ struct PairIndex {
   }
 };
 
-double term(const BinaryEnergy::Pair& p, bool xi, bool xj) {
-  return xi ? (xj ? p.e11 : p.e10) : (xj ? p.e01 : p.e00);
-}
-
 /// Cost of v taking label `l` given every other variable's label in x.
 double local_cost(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x, std::uint32_t v,
                   bool l) {
   double c = e.unary[v][l ? 1 : 0];
   for (const std::uint32_t k : index.of(v)) {
     const auto& p = e.pairs[k];
-    c += p.i == v ? term(p, l, x[p.j] != 0) : term(p, x[p.i] != 0, l);
+    c += p.i == v ? p.value(l, x[p.j] != 0) : p.value(x[p.i] != 0, l);
   }
   return c;
 }
@@ -107,8 +103,8 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
         if (p.i == v) r.pairs.push_back({l, to_local[o], p.e00, p.e01, p.e10, p.e11});  // once, from its i end
         continue;
       }
-      for (int b = 0; b < 2; ++b) r.unary[l][static_cast<std::size_t>(b)] += p.i == v ? term(p, b != 0, x[o] != 0)
-                                                                                       : term(p, x[o] != 0, b != 0);
+      for (int b = 0; b < 2; ++b) r.unary[l][static_cast<std::size_t>(b)] += p.i == v ? p.value(b != 0, x[o] != 0)
+                                                                                       : p.value(x[o] != 0, b != 0);
     }
   }
   for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;
@@ -126,7 +122,7 @@ double component_energy(const BinaryEnergy& e, const PairIndex& index, std::span
       const auto& p = e.pairs[k];
       const std::uint32_t o = p.i == v ? p.j : p.i;
       if (mark[o] != 0 && o < v) continue;  // both ends inside: counted once
-      sum += term(p, x[p.i] != 0, x[p.j] != 0);
+      sum += p.value(x[p.i] != 0, x[p.j] != 0);
     }
   }
   for (const std::uint32_t v : component) mark[v] = 0;

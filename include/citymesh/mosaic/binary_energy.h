@@ -19,6 +19,7 @@ struct BinaryEnergy {
     std::uint32_t i = 0, j = 0;
     double e00 = 0, e01 = 0, e10 = 0, e11 = 0;
     [[nodiscard]] bool submodular() const { return e00 + e11 <= e01 + e10; }
+    [[nodiscard]] double value(bool xi, bool xj) const { return xi ? (xj ? e11 : e10) : (xj ? e01 : e00); }
   };
   std::vector<std::array<double, 2>> unary;
   std::vector<Pair> pairs;
