@@ -15,42 +15,54 @@
 
 namespace citymesh {
 
-struct RayScene::Impl {
+namespace {
+
+/// An Embree device and the one scene built on it, released together; errors name `owner`.
+struct EmbreeScene {
+  const char* owner;
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
-  ~Impl() {
+
+  explicit EmbreeScene(const char* who) : owner(who), device(rtcNewDevice("verbose=0")) {
+    if (device == nullptr) throw ProcessingError(fmt::format("{}: cannot create an Embree device", owner));
+  }
+  EmbreeScene(const EmbreeScene&) = delete;
+  EmbreeScene& operator=(const EmbreeScene&) = delete;
+  ~EmbreeScene() {
     if (scene != nullptr) rtcReleaseScene(scene);
-    if (device != nullptr) rtcReleaseDevice(device);
+    rtcReleaseDevice(device);
+  }
+  void check(const char* what) const {
+    const RTCError e = rtcGetDeviceError(device);
+    if (e != RTC_ERROR_NONE) throw ProcessingError(fmt::format("{}: {} failed (Embree error {})", owner, what, int(e)));
   }
 };
 
-namespace {
-void check(RTCDevice device, const char* what) {
-  const RTCError e = rtcGetDeviceError(device);
-  if (e != RTC_ERROR_NONE) throw ProcessingError(fmt::format("ray scene: {} failed (Embree error {})", what, int(e)));
-}
 }  // namespace
+
+struct RayScene::Impl {
+  EmbreeScene embree{"ray scene"};
+};
 
 RayScene::RayScene(std::span<const Vec3f> vertices, std::span<const Triangle> triangles)
     : impl_(std::make_unique<Impl>()) {
-  impl_->device = rtcNewDevice("verbose=0");
-  if (impl_->device == nullptr) throw ProcessingError("ray scene: cannot create an Embree device");
-  impl_->scene = rtcNewScene(impl_->device);
+  EmbreeScene& e = impl_->embree;
+  e.scene = rtcNewScene(e.device);
   // Robust traversal: no missed hits on shared edges, and results independent of build order.
-  rtcSetSceneFlags(impl_->scene, RTC_SCENE_FLAG_ROBUST);
-  RTCGeometry geometry = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  rtcSetSceneFlags(e.scene, RTC_SCENE_FLAG_ROBUST);
+  RTCGeometry geometry = rtcNewGeometry(e.device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                         3 * sizeof(float), vertices.size()));
   auto* t = static_cast<std::uint32_t*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                                                 3 * sizeof(std::uint32_t), triangles.size()));
-  check(impl_->device, "buffer allocation");
+  e.check("buffer allocation");
   std::memcpy(v, vertices.data(), vertices.size_bytes());
   std::memcpy(t, triangles.data(), triangles.size_bytes());
   rtcCommitGeometry(geometry);
-  rtcAttachGeometry(impl_->scene, geometry);
+  rtcAttachGeometry(e.scene, geometry);
   rtcReleaseGeometry(geometry);
-  rtcCommitScene(impl_->scene);
-  check(impl_->device, "scene build");
+  rtcCommitScene(e.scene);
+  e.check("scene build");
 }
 
 RayScene::~RayScene() = default;
@@ -69,7 +81,7 @@ RayHit RayScene::intersect(const Vec3f& origin, const Vec3f& direction, float ma
   rh.ray.tfar = max_distance;
   rh.ray.mask = 0xFFFFFFFFu;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &context, &rh);
+  rtcIntersect1(impl_->embree.scene, &context, &rh);
   RayHit hit;
   if (rh.hit.geomID != RTC_INVALID_GEOMETRY_ID) {
     hit.hit = true;
@@ -125,14 +137,9 @@ bool overlaps(const Box3f& p, const Box3f& q) {
 }  // namespace
 
 struct BoxTree::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
+  EmbreeScene embree{"box tree"};
   std::vector<Box3f> boxes;
   BoxSet set;
-  ~Impl() {
-    if (scene != nullptr) rtcReleaseScene(scene);
-    if (device != nullptr) rtcReleaseDevice(device);
-  }
 };
 
 namespace {
@@ -155,10 +162,9 @@ bool collect_overlapping(RTCPointQueryFunctionArguments* args) {
 BoxTree::BoxTree(std::vector<Box3f> boxes) : impl_(std::make_unique<Impl>()) {
   impl_->boxes = std::move(boxes);
   impl_->set.boxes = impl_->boxes;
-  impl_->device = rtcNewDevice("verbose=0");
-  if (impl_->device == nullptr) throw ProcessingError("box tree: cannot create an Embree device");
-  if (!impl_->boxes.empty()) impl_->scene = box_scene(impl_->device, impl_->set);
-  check(impl_->device, "box tree build");
+  EmbreeScene& e = impl_->embree;
+  if (!impl_->boxes.empty()) e.scene = box_scene(e.device, impl_->set);
+  e.check("build");
 }
 
 BoxTree::~BoxTree() = default;
@@ -167,7 +173,7 @@ void BoxTree::containing(const Vec3f& p, std::vector<std::uint32_t>& out) const 
 
 void BoxTree::overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const {
   out.clear();
-  if (impl_->scene == nullptr) return;
+  if (impl_->embree.scene == nullptr) return;
   // Embree's point queries visit what meets a sphere: the one around the query box, widened
   // by a few float steps of the coordinates for the rounding of its centre.
   const Vec3f centre = (b.min + b.max) * 0.5f;
@@ -181,7 +187,7 @@ void BoxTree::overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const
   RTCPointQueryContext context;
   rtcInitPointQueryContext(&context);
   BoxQuery q{impl_->boxes, b, &out};
-  rtcPointQuery(impl_->scene, &query, &context, collect_overlapping, &q);
+  rtcPointQuery(impl_->embree.scene, &query, &context, collect_overlapping, &q);
 }
 
 }  // namespace citymesh
