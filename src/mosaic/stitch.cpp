@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <numeric>
 #include <unordered_map>
+#include <unordered_set>
 
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/edges.h"
@@ -52,9 +53,8 @@ struct StitchContext {
   MergedMesh& merged;
   const StitchParams& params;
   Boundary boundary;
-  std::vector<std::uint32_t> partner;             ///< per boundary vertex (index in boundary.vertices)
-  std::unordered_map<std::uint32_t, std::uint32_t> slot;  ///< vertex -> index in boundary.vertices
-  std::unordered_map<std::uint32_t, bool> consumed;      ///< boundary half-edge (by its start) joined
+  std::unordered_map<std::uint32_t, std::uint32_t> partner;  ///< boundary vertex -> matched vertex of another source
+  std::unordered_set<std::uint32_t> consumed;                 ///< boundary half-edges (by their start) joined
   StitchStats stats;
 
   [[nodiscard]] std::int32_t source(std::uint32_t v) const {
@@ -67,9 +67,7 @@ void match_vertices(StitchContext& c) {
   const Mesh& m = c.merged.mesh;
   std::vector<Vec3f> points;
   for (const std::uint32_t v : c.boundary.vertices) points.push_back(m.positions[v]);
-  for (std::uint32_t i = 0; i < c.boundary.vertices.size(); ++i) c.slot[c.boundary.vertices[i]] = i;
   const PointKdTree tree(points);
-  c.partner.assign(points.size(), UINT32_MAX);
   std::vector<std::uint32_t> near;
   for (std::uint32_t i = 0; i < points.size(); ++i) {
     const std::uint32_t v = c.boundary.vertices[i];
@@ -81,7 +79,7 @@ void match_vertices(StitchContext& c) {
       const Vec3d d = position(m, w) - position(m, v);
       if (dot(d, d) <= best) {
         best = dot(d, d);
-        c.partner[i] = w;
+        c.partner[v] = w;
       }
     }
   }
@@ -90,8 +88,8 @@ void match_vertices(StitchContext& c) {
 /// The matched vertex of another source, UINT32_MAX for none (or when v starts no boundary
 /// half-edge, at a pinched vertex).
 std::uint32_t partner_of(const StitchContext& c, std::uint32_t v) {
-  const auto it = c.slot.find(v);
-  return it == c.slot.end() ? UINT32_MAX : c.partner[it->second];
+  const auto it = c.partner.find(v);
+  return it == c.partner.end() ? UINT32_MAX : it->second;
 }
 
 /// Q's boundary from `from` to `to` walking backwards (against Q's orientation, which faces
@@ -134,24 +132,25 @@ void zip(StitchContext& c, const std::vector<std::uint32_t>& a, const std::vecto
         j + 1 >= b.size() ||
         (i + 1 < a.size() && norm(position(m, a[i + 1]) - position(m, b[j])) <= norm(position(m, a[i]) - position(m, b[j + 1])));
     // Reference: the piece triangle beside the boundary edge the new triangle takes.
+    // (A value, not a reference: adding the strip triangle may move the triangle array.)
+    const Triangle beside = m.triangles[c.boundary.triangle_of.at(advance_a ? a[i] : b[j + 1])];
+    const Vec3d reference = face_normal(m, beside[0], beside[1], beside[2]);
     if (advance_a) {
-      const Triangle& t = m.triangles[c.boundary.triangle_of.at(a[i])];
-      add_strip_triangle(c, a[i + 1], a[i], b[j], face_normal(m, t[0], t[1], t[2]));
+      add_strip_triangle(c, a[i + 1], a[i], b[j], reference);
       ++i;
     } else {
-      const Triangle& t = m.triangles[c.boundary.triangle_of.at(b[j + 1])];
-      add_strip_triangle(c, a[i], b[j], b[j + 1], face_normal(m, t[0], t[1], t[2]));
+      add_strip_triangle(c, a[i], b[j], b[j + 1], reference);
       ++j;
     }
   }
-  for (std::size_t k = 0; k + 1 < a.size(); ++k) c.consumed[a[k]] = true;
-  for (std::size_t k = 0; k + 1 < b.size(); ++k) c.consumed[b[k + 1]] = true;  // Q's half-edge b[k+1] -> b[k]
+  for (std::size_t k = 0; k + 1 < a.size(); ++k) c.consumed.insert(a[k]);
+  for (std::size_t k = 0; k + 1 < b.size(); ++k) c.consumed.insert(b[k + 1]);  // Q's half-edge b[k+1] -> b[k]
   ++c.stats.strips;
 }
 
 /// Walks one boundary loop from `start`: runs of consecutive vertices facing the same other
 /// source, along half-edges not joined yet, are zipped to that source's facing run.
-void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_map<std::uint32_t, bool>& visited) {
+void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_set<std::uint32_t>& visited) {
   std::vector<std::uint32_t> run;
   std::int32_t facing = kNoSource;
   const auto flush = [&] {
@@ -165,7 +164,7 @@ void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_map<std::
   };
   std::uint32_t v = start;
   for (;;) {
-    visited[v] = true;
+    visited.insert(v);
     const std::uint32_t p = partner_of(c, v);
     const std::int32_t q = p == UINT32_MAX ? kNoSource : c.source(p);
     if (!run.empty() && (q != facing || c.consumed.contains(run.back()))) flush();
@@ -229,12 +228,12 @@ double open_boundary_length(const Mesh& m) {
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
-  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, {}, {}};
+  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, {}};
   c.stats.open_boundary_before = open_boundary_length(merged.mesh);
   match_vertices(c);
   // Open chains (broken at pinched vertices) are walked from their head, so that each is
   // one walk; closed loops from their smallest vertex.
-  std::unordered_map<std::uint32_t, bool> visited;
+  std::unordered_set<std::uint32_t> visited;
   for (const std::uint32_t v : c.boundary.vertices) {
     if (!c.boundary.prev.contains(v)) stitch_loop(c, v, visited);
   }
