@@ -37,4 +37,11 @@ LoadedAcquisitions load_acquisitions(const Config& config) {
   return out;
 }
 
+nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k) {
+  return {{"index", k},
+          {"name", config.acquisitions[k].name},
+          {"date", format_iso8601(input.dates[k])},
+          {"input", input.acquisitions[k].path.string()}};
+}
+
 }  // namespace citymesh::app

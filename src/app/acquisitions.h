@@ -2,6 +2,7 @@
 // Reading a config's acquisitions into meshes sharing one local frame (the pipeline's input).
 #pragma once
 
+#include <nlohmann/json.hpp>
 #include <vector>
 
 #include "citymesh/config/config.h"
@@ -16,6 +17,9 @@ struct LoadedAcquisitions {
   /// Per acquisition, per triangle: the face index in the file (the provenance id).
   [[nodiscard]] std::vector<std::int32_t> source_faces(std::size_t acquisition) const;
 };
+
+/// How the summaries describe acquisition k: index, name, date, input file.
+nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k);
 
 /// Reads every acquisition of `config` whole. Throws InputError naming the file, and
 /// ProcessingError when a file has no sensor positions.

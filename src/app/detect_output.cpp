@@ -87,14 +87,12 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
     const std::vector<std::int32_t> faces = input.source_faces(k);
     write_labelled_ply(params.dir / (stem + ".ply"), input.meshes[k], faces, r, begin);
     if (params.pictures) write_picture(params.dir / (stem + ".png"), input.meshes[k], r, begin, params.pixel_size);
-    summary["acquisitions"].push_back({{"index", k},
-                                       {"name", config.acquisitions[k].name},
-                                       {"date", format_iso8601(input.dates[k])},
-                                       {"input", input.acquisitions[k].path.string()},
-                                       {"ply", stem + ".ply"},
-                                       {"png", params.pictures ? stem + ".png" : ""},
-                                       {"triangles", input.meshes[k].triangle_count()},
-                                       {"counts", counts_json(count_states(r, begin, r.index.offsets[k + 1]))}});
+    nlohmann::json entry = acquisition_json(config, input, k);
+    entry["ply"] = stem + ".ply";
+    entry["png"] = params.pictures ? stem + ".png" : "";
+    entry["triangles"] = input.meshes[k].triangle_count();
+    entry["counts"] = counts_json(count_states(r, begin, r.index.offsets[k + 1]));
+    summary["acquisitions"].push_back(std::move(entry));
   }
   std::vector<std::uint32_t> flat;
   flat.reserve(2 * r.consistent_pairs.size());

@@ -78,11 +78,9 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
     }
   }
   for (std::size_t k = 0; k < input.meshes.size(); ++k) {
-    summary["acquisitions"].push_back({{"index", k},
-                                       {"name", config.acquisitions[k].name},
-                                       {"date", format_iso8601(input.dates[k])},
-                                       {"input", input.acquisitions[k].path.string()},
-                                       {"triangles_kept", per_source[k]}});
+    nlohmann::json entry = acquisition_json(config, input, k);
+    entry["triangles_kept"] = per_source[k];
+    summary["acquisitions"].push_back(std::move(entry));
   }
   summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected},
                        {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
