@@ -74,7 +74,10 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
   std::vector<std::vector<TrianglePair>> per_block((f.size() + kGrain - 1) / kGrain);
   parallel_for_blocks(f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint32_t> hits;
-    for (std::size_t g = begin; g < end; ++g) pairs_of(f, prisms, g, threshold, cos_min, hits, per_block[begin / kGrain]);
+    // In the tree's order, a triangle's candidates are near the previous one's: warm caches.
+    for (std::size_t i = begin; i < end; ++i) {
+      pairs_of(f, prisms, prisms.storage_order()[i], threshold, cos_min, hits, per_block[begin / kGrain]);
+    }
   });
   std::size_t total = 0;
   for (const auto& b : per_block) total += b.size();

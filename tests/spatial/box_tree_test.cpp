@@ -81,6 +81,22 @@ TEST(BoxTree, ContainingFindsBoxesWhosePointsAreOnTheirFaces) {
   }
 }
 
+TEST(BoxTree, CoincidentBoxesAreAllFoundAndOrderedOnce) {
+  // Every centre on one Morton cell (a flat extent) and more boxes than one node holds.
+  std::vector<Box3f> boxes(100, Box3f{{1, 2, 3}, {1, 2.5f, 3}});
+  boxes[37] = {{0, 0, 0}, {0.5f, 0.5f, 0.5f}};
+  const BoxTree tree(boxes);
+  std::vector<std::uint32_t> out;
+  tree.containing({1, 2.2f, 3}, out);
+  std::sort(out.begin(), out.end());
+  EXPECT_EQ(out, brute_force(boxes, {{1, 2.2f, 3}, {1, 2.2f, 3}}));
+  EXPECT_EQ(out.size(), 99u);
+  std::vector<std::uint32_t> order(tree.storage_order().begin(), tree.storage_order().end());
+  std::sort(order.begin(), order.end());
+  for (std::uint32_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i);
+  EXPECT_EQ(order.size(), boxes.size());
+}
+
 TEST(BoxTree, EmptySetFindsNothing) {
   const BoxTree tree({});
   std::vector<std::uint32_t> out{1, 2};

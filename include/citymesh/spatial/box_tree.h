@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Which boxes of a fixed set contain a point or meet a small box (an Embree BVH and its point
-// queries behind this header): the candidate searches of the change detection.
+// Which boxes of a fixed set contain a point or meet a small box (a packed tree of boxes in
+// Morton order behind this header): the candidate searches of the change detection.
 #pragma once
 
 #include <cstdint>
@@ -25,12 +25,15 @@ class BoxTree {
   BoxTree(const BoxTree&) = delete;
   BoxTree& operator=(const BoxTree&) = delete;
 
-  /// Replaces `out` with the indices of the boxes containing p (closed boxes), in no
-  /// particular order. Thread-safe.
+  /// Replaces `out` with the indices of the boxes containing p (closed boxes), in an order
+  /// that depends on the boxes only. Thread-safe.
   void containing(const Vec3f& p, std::vector<std::uint32_t>& out) const;
-  /// Replaces `out` with the indices of the boxes overlapping the closed box b, in no
-  /// particular order. Fast for small query boxes. Thread-safe.
+  /// Replaces `out` with the indices of the boxes overlapping the closed box b, in an order
+  /// that depends on the boxes only. Fast for small query boxes. Thread-safe.
   void overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const;
+  /// Every box index once, in the tree's storage order (along a space-filling curve): queries
+  /// issued near the boxes in this order find their nodes in cache.
+  [[nodiscard]] std::span<const std::uint32_t> storage_order() const;
 
  private:
   struct Impl;
