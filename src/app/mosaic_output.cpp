@@ -82,7 +82,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
     entry["triangles_kept"] = per_source[k];
     summary["acquisitions"].push_back(std::move(entry));
   }
-  summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected},
+  summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected}, {"filled", s.filled},
                        {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
                        {"overlap_terms", s.overlap_terms}, {"seam_terms", s.seam_terms}};
   summary["energy"] = {{"total", s.energy},

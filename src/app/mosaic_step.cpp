@@ -29,7 +29,9 @@ MosaicSelection select(const Config& config, const LoadedAcquisitions& input, co
 }
 
 nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
-  const StitchStats s = stitch(merged, {.reach = config.mosaic.stitch_reach * config.change.distance_threshold,
+  const double reach = config.mosaic.stitch_reach * config.change.distance_threshold;
+  const StitchStats s = stitch(merged, {.snap = reach,
+                                        .reach = reach,
                                         .weld = kWeldInThresholds * config.change.distance_threshold});
   std::cout << fmt::format("stitching: {} strips, {} triangles, open boundary {:.1f} m -> {:.1f} m\n", s.strips,
                            s.triangles_added, s.open_boundary_before, s.open_boundary_after);
@@ -37,6 +39,8 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
           {"open_boundary_after_m", s.open_boundary_after},
           {"strips", s.strips},
           {"triangles_added", s.triangles_added},
+          {"vertices_snapped", s.vertices_snapped},
+          {"edges_split", s.edges_split},
           {"vertices_welded", s.vertices_welded},
           {"rejected", s.rejected},
           {"seconds", s.seconds}};
@@ -49,8 +53,10 @@ void report(const std::filesystem::path& dir, const MergedMesh& merged, const Mo
     std::cout << fmt::format("; energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f})",
                              s.energy, s.quality, s.boundary, s.seam, s.overlap);
   }
-  std::cout << fmt::format("\n  {:.3f} s: energy {:.3f}, solve {:.3f}\n", s.seconds_build + s.seconds_solve,
-                           s.seconds_build, s.seconds_solve);
+  if (s.filled > 0) std::cout << fmt::format("; {} added by the hole fill", s.filled);
+  std::cout << fmt::format("\n  {:.3f} s: energy {:.3f}, solve {:.3f}, fill {:.3f}\n",
+                           s.seconds_build + s.seconds_solve + s.seconds_fill, s.seconds_build, s.seconds_solve,
+                           s.seconds_fill);
 }
 
 }  // namespace
@@ -63,6 +69,7 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
   seconds["mosaic"] = clock.restart();
   seconds["energy"] = selection.stats.seconds_build;
   seconds["solve"] = selection.stats.seconds_solve;
+  seconds["fill"] = selection.stats.seconds_fill;
   // The baseline, like the paper's, is not stitched.
   const nlohmann::json stitched =
       config.mosaic.method == MosaicMethod::energy ? stitch_and_report(config, merged) : nlohmann::json::object();

@@ -223,6 +223,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(real_key(mosaic, "stitch_reach",
       "stitching joins boundaries of pieces from different sources closer than this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.stitch_reach; }, 0.1, 100));
+  keys.push_back(bool_key(mosaic, "fill_holes",
+      "after the energy mosaic, add back kept triangles with nothing selected within distance_threshold (newest first)",
+      [](auto& c) -> auto& { return c.mosaic.fill_holes; }));
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));

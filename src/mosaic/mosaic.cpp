@@ -168,7 +168,9 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   out.stats.seconds_solve = clock.restart();
   out.selected.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
-  account(e, x, out.stats);
+  account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
+  if (params.fill_holes) out.stats.filled = fill_holes(input, out.selected);
+  out.stats.seconds_fill = clock.restart();
   return out;
 }
 

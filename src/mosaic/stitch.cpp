@@ -2,6 +2,7 @@
 #include "citymesh/mosaic/stitch.h"
 
 #include <algorithm>
+#include <array>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
@@ -9,6 +10,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
+#include "snap.h"
 
 namespace citymesh {
 
@@ -55,6 +57,7 @@ struct StitchContext {
   Boundary boundary;
   std::unordered_map<std::uint32_t, std::uint32_t> partner;  ///< boundary vertex -> matched vertex of another source
   std::unordered_set<std::uint32_t> consumed;                 ///< boundary half-edges (by their start) joined
+  std::unordered_set<std::uint64_t> directed;                 ///< every directed edge in use
   StitchStats stats;
 
   [[nodiscard]] std::int32_t source(std::uint32_t v) const {
@@ -105,15 +108,29 @@ std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from
   return run;
 }
 
-/// Adds the strip triangle (a, b, c) unless it is degenerate or faces against `reference`.
+std::uint64_t directed_key(std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; }
+
+std::unordered_set<std::uint64_t> directed_edges(const Mesh& m) {
+  std::unordered_set<std::uint64_t> out;
+  for (const Triangle& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) out.insert(directed_key(t[k], t[(k + 1) % 3]));
+  }
+  return out;
+}
+
+/// Adds the strip triangle (a, b, c) unless it is degenerate, faces against `reference` or
+/// uses a directed edge already in use (which would fold the mesh or break its manifoldness).
 bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std::uint32_t d, const Vec3d& reference) {
   const Mesh& m = c.merged.mesh;
   const Vec3d n = face_normal(m, a, b, d);
   const double len = norm(n);
-  if (!(len > 1e-10) || dot(n, reference) <= 0) {
+  const std::array<std::uint64_t, 3> keys{directed_key(a, b), directed_key(b, d), directed_key(d, a)};
+  if (!(len > 1e-10) || dot(n, reference) <= 0 ||
+      std::any_of(keys.begin(), keys.end(), [&](std::uint64_t k) { return c.directed.contains(k); })) {
     ++c.stats.rejected;
     return false;
   }
+  c.directed.insert(keys.begin(), keys.end());
   c.merged.mesh.triangles.push_back({a, b, d});
   c.merged.mesh.triangle_ids.push_back({});
   c.merged.source_acq.push_back(kNoSource);
@@ -228,8 +245,13 @@ double open_boundary_length(const Mesh& m) {
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
-  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, {}};
-  c.stats.open_boundary_before = open_boundary_length(merged.mesh);
+  const double before = open_boundary_length(merged.mesh);
+  const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(merged, params.snap);
+  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, directed_edges(merged.mesh), {}};
+  c.stats.open_boundary_before = before;
+  c.stats.vertices_snapped = snapped.vertices_merged;
+  c.stats.edges_split = snapped.edges_split;
+  c.stats.rejected = snapped.rejected;
   match_vertices(c);
   // Open chains (broken at pinched vertices) are walked from their head, so that each is
   // one walk; closed loops from their smallest vertex.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The paper's baseline mosaic: add acquisitions in date order, keep what is new.
+// The paper's baseline mosaic (add acquisitions in date order, keep what is new) and the hole
+// fill after the energy mosaic (the same rule, newest first, from the mosaic's selection).
 #include <algorithm>
 #include <numeric>
 
@@ -12,36 +13,65 @@
 
 namespace citymesh {
 
+namespace {
+
+/// Visits the acquisitions in `order`; in each, selects the kept triangles with no selected
+/// triangle within the distance threshold of their centroid (what is selected at the start of
+/// the acquisition: its own triangles never hide each other). Returns how many were added.
+std::uint64_t add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected) {
+  const ChangeResult& change = *input.change;
+  const GlobalTriangles& index = change.index;
+  const double reach = input.distance_threshold;
+  std::uint64_t added = 0;
+  for (const std::size_t a : order) {
+    const MergedMesh kept = merge_selection(input.meshes, index, selected);
+    const MeshProximity near(kept.mesh, reach);
+    const Mesh& mesh = input.meshes[a];
+    const std::size_t base = index.offsets[a];
+    std::vector<std::uint8_t> add(mesh.triangle_count(), 0);
+    parallel_for_blocks(mesh.triangle_count(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        if (change.kept[base + t] == 0 || selected[base + t] != 0) continue;
+        const auto [p, q, r] = mesh.corners(t);
+        add[t] = near.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
+      }
+    });
+    for (std::size_t t = 0; t < add.size(); ++t) {
+      selected[base + t] |= add[t];
+      added += add[t];
+    }
+  }
+  return added;
+}
+
+/// Acquisition indices by date (config order on equal dates).
+std::vector<std::size_t> date_order(const MosaicInput& input) {
+  std::vector<std::size_t> order(input.meshes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
+  return order;
+}
+
+}  // namespace
+
 MosaicSelection select_update_model(const MosaicInput& input) {
   mosaic_detail::check_mosaic_input(input);
   Stopwatch clock;
   const ChangeResult& change = *input.change;
-  const GlobalTriangles& index = change.index;
   MosaicSelection out;
-  out.selected.assign(index.size(), 0);
-  std::vector<std::size_t> order(input.meshes.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
-
-  const double reach = input.distance_threshold;
-  for (const std::size_t a : order) {
-    // What the earlier acquisitions kept, as one mesh (nothing of this one is selected yet).
-    const MergedMesh kept = merge_selection(input.meshes, index, out.selected);
-    const MeshProximity near(kept.mesh, reach);
-    const Mesh& mesh = input.meshes[a];
-    const std::size_t base = index.offsets[a];
-    parallel_for_blocks(mesh.triangle_count(), 4096, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t t = begin; t < end; ++t) {
-        if (change.kept[base + t] == 0) continue;
-        const auto [p, q, r] = mesh.corners(t);
-        out.selected[base + t] = near.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
-      }
-    });
-  }
+  out.selected.assign(change.index.size(), 0);
+  add_uncovered(input, date_order(input), out.selected);
   out.stats.candidates = static_cast<std::uint64_t>(std::count(change.kept.begin(), change.kept.end(), 1));
   out.stats.selected = static_cast<std::uint64_t>(std::count(out.selected.begin(), out.selected.end(), 1));
   out.stats.seconds_solve = clock.seconds();
   return out;
+}
+
+std::uint64_t fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected) {
+  mosaic_detail::check_mosaic_input(input);
+  std::vector<std::size_t> order = date_order(input);
+  std::reverse(order.begin(), order.end());
+  return add_uncovered(input, order, selected);
 }
 
 }  // namespace citymesh

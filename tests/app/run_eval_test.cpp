@@ -64,7 +64,7 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   EXPECT_EQ(b["method"], "update-model");
 
   EXPECT_LE(m["overlap_ratio"].get<double>(), 0.005);
-  EXPECT_GE(m["static_completeness"].get<double>(), 0.99);
+  EXPECT_GE(m["static_completeness"].get<double>(), 0.998);  // 0.9958 without the hole fill
   EXPECT_LE(m["dynamic_residue"].get<double>(), 0.005);
   // Against the baseline: no more overlap, holes, open seams, coarser triangles or residue.
   EXPECT_LT(m["overlap_ratio"].get<double>(), b["overlap_ratio"].get<double>());

@@ -30,9 +30,10 @@ struct MosaicStats {
   double length_unit = 0;  ///< metres: the mean edge length of the candidates
   /// Weighted energy terms of the selection (the quality term is negative).
   double quality = 0, boundary = 0, overlap = 0, seam = 0, energy = 0;
+  std::uint64_t filled = 0;  ///< triangles added by the hole fill
   MinimiseStats solver;  ///< solver.exact: the whole energy was solved by one flipped cut
   GroupMoveStats moves;  ///< otherwise: the group moves (one group per acquisition)
-  double seconds_build = 0, seconds_solve = 0;
+  double seconds_build = 0, seconds_solve = 0, seconds_fill = 0;
 };
 
 struct MosaicSelection {
@@ -52,12 +53,19 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
 
 /// Minimises the mosaic energy: one exact cut when it can be flipped submodular (two meshes),
 /// else group moves per acquisition from an empty selection (sweeps sweeps at
-/// most). Deterministic.
+/// most); then fills holes (fill_holes) when params.fill_holes. Deterministic.
 MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& params);
 
 /// The baseline: acquisitions in date order (config order on equal dates); a kept triangle is
 /// selected unless an already selected triangle of an earlier acquisition lies within the
 /// distance threshold of its centroid.
 MosaicSelection select_update_model(const MosaicInput& input);
+
+/// Hole fill after the energy mosaic: the acquisitions newest first; a kept triangle is added
+/// to `selected` when no selected triangle lies within the distance threshold of its centroid
+/// (the update model's rule, from the mosaic's selection). Where the mosaic's pieces leave a
+/// gap wider than the threshold (a piece's edge falls short of its neighbour's), this puts the
+/// input surface back. Returns the number of triangles added.
+std::uint64_t fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected);
 
 }  // namespace citymesh

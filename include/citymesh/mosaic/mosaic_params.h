@@ -35,6 +35,9 @@ struct MosaicParams {
   /// Stitching joins boundaries of pieces from different sources closer than this factor
   /// times the change step's distance threshold.
   double stitch_reach = 2.0;
+  /// After the energy mosaic, kept triangles with nothing selected within the distance
+  /// threshold are added back (newest acquisition first).
+  bool fill_holes = true;
 };
 
 std::string_view quality_measure_name(QualityMeasure q);

@@ -11,21 +11,27 @@
 namespace citymesh {
 
 struct StitchParams {
+  double snap = 0.1;    ///< metres: boundaries of different sources closer than this share vertices
   double reach = 0.2;   ///< metres: boundaries of different sources closer than this are joined
   double weld = 0.005;  ///< metres: strip corners closer than this become one vertex
 };
 
 struct StitchStats {
   double open_boundary_before = 0, open_boundary_after = 0;  ///< metres of edges used by one triangle
+  std::uint64_t vertices_snapped = 0;  ///< boundary vertices of two sources made one
+  std::uint64_t edges_split = 0;       ///< boundary edges split at vertices of another source
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
   std::uint64_t rejected = 0;  ///< strip triangles refused (flipped against a neighbour or degenerate)
   double seconds = 0;
 };
 
-/// Joins facing boundaries of pieces from different sources of `mesh` with strips of new
-/// triangles (source kNoSource), advancing along both boundaries and taking the shorter
-/// diagonal at each step; a strip triangle is only added when it is not degenerate and faces
-/// the same way as the piece triangles beside it. Deterministic.
+/// Closes the seams between pieces of different sources of `mesh`. Boundaries lying within
+/// `snap` of each other are first made to share vertices (nearby boundary vertices merged at
+/// their midpoint, then boundary edges split at the other side's vertices: the split pieces
+/// keep their provenance); the boundaries still facing each other within `reach` are then
+/// joined with strips of new triangles (source kNoSource), advancing along both boundaries
+/// and taking the shorter diagonal at each step. No operation may flip or degenerate a
+/// triangle or use a directed edge twice. Deterministic.
 StitchStats stitch(MergedMesh& mesh, const StitchParams& params);
 
 /// Total length of the edges used by exactly one triangle.

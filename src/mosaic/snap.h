@@ -1,0 +1,29 @@
+// SPDX-License-Identifier: MIT
+// Snapping (internal to stitching): boundaries of pieces from different sources that lie on
+// top of each other are made to share vertices, so that the seam between them closes
+// without a strip of new triangles (a strip between nearly coincident boundaries is all
+// slivers, and half of them flip).
+#pragma once
+
+#include <cstdint>
+
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh::mosaic_detail {
+
+struct SnapStats {
+  std::uint64_t vertices_merged = 0;  ///< pairs of boundary vertices of different sources made one
+  std::uint64_t edges_split = 0;      ///< boundary edges split at a vertex of another source
+  std::uint64_t vertices_inserted = 0;
+  std::uint64_t rejected = 0;  ///< merges and splits refused (a flip, a degenerate or a non-manifold result)
+};
+
+/// First merges each boundary vertex with the nearest boundary vertex of another source
+/// within `tolerance` (both move to their midpoint), then splits each boundary edge at the
+/// boundary vertices of other sources within `tolerance` of it (the edge's triangle becomes a
+/// fan; the new triangles keep its provenance). An operation is skipped when a triangle would
+/// flip or degenerate, or a directed edge would be used twice (the mesh stays edge-manifold
+/// and consistently oriented). Deterministic: vertices and edges in index order.
+SnapStats snap_boundaries(MergedMesh& merged, double tolerance);
+
+}  // namespace citymesh::mosaic_detail
