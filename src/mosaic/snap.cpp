@@ -12,7 +12,7 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
-std::uint64_t key(std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; }
+constexpr auto key = directed_edge_key;
 
 /// The mesh with its directed edges and vertex-to-triangle incidence kept up to date. The
 /// invariant of every operation: a directed edge is used by at most one triangle, which makes
@@ -64,18 +64,30 @@ bool acceptable(const Vec3d& before, const Vec3d& after) {
   return dot(before, after) > 0 && norm(after) >= 0.05 * norm(before);
 }
 
-/// Every vertex that starts or ends a boundary edge, in increasing order.
-std::vector<std::uint32_t> boundary_vertices(const Topology& topo) {
-  std::vector<std::uint8_t> on(topo.merged.mesh.vertex_count(), 0);
-  for (const Triangle& tri : topo.merged.mesh.triangles) {
+struct DirectedEdge {
+  std::uint32_t from, to, triangle;
+};
+
+std::vector<DirectedEdge> boundary_half_edges(const Topology& topo) {
+  std::vector<DirectedEdge> out;
+  for (std::uint32_t t = 0; t < topo.merged.mesh.triangle_count(); ++t) {
+    const Triangle& tri = topo.triangle(t);
     for (int k = 0; k < 3; ++k) {
-      if (topo.is_boundary(tri[k], tri[(k + 1) % 3])) on[tri[k]] = on[tri[(k + 1) % 3]] = 1;
+      if (topo.is_boundary(tri[k], tri[(k + 1) % 3])) out.push_back({tri[k], tri[(k + 1) % 3], t});
     }
   }
+  return out;
+}
+
+/// Every vertex that starts or ends one of the boundary edges, in increasing order.
+std::vector<std::uint32_t> vertices_of(std::span<const DirectedEdge> edges) {
   std::vector<std::uint32_t> out;
-  for (std::uint32_t v = 0; v < on.size(); ++v) {
-    if (on[v] != 0) out.push_back(v);
+  for (const DirectedEdge& e : edges) {
+    out.push_back(e.from);
+    out.push_back(e.to);
   }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 
@@ -116,7 +128,7 @@ bool try_merge(Topology& topo, std::uint32_t v, std::uint32_t w) {
 
 /// Stage 1: boundary vertices of different sources within the tolerance become one.
 void merge_close_vertices(Topology& topo, double tolerance) {
-  const std::vector<std::uint32_t> vertices = boundary_vertices(topo);
+  const std::vector<std::uint32_t> vertices = vertices_of(boundary_half_edges(topo));
   std::vector<Vec3f> points;
   for (const std::uint32_t v : vertices) points.push_back(topo.merged.mesh.positions[v]);
   const PointKdTree tree(points);
@@ -132,8 +144,9 @@ void merge_close_vertices(Topology& topo, double tolerance) {
       const std::uint32_t w = vertices[j];
       if (done[j] != 0 || topo.source_of_vertex(w) == topo.source_of_vertex(v)) continue;
       const Vec3d d = topo.position(w) - topo.position(v);
-      if (dot(d, d) <= best_d2) {  // near is in index order: ties go to the smaller index
-        if (dot(d, d) < best_d2 || best == UINT32_MAX) best = j;
+      // near is in index order: on equal distances the smaller index stays.
+      if (best == UINT32_MAX ? dot(d, d) <= best_d2 : dot(d, d) < best_d2) {
+        best = j;
         best_d2 = dot(d, d);
       }
     }
@@ -155,22 +168,7 @@ struct Insertion {
   auto operator<=>(const Insertion&) const = default;
 };
 
-struct DirectedEdge {
-  std::uint32_t from, to, triangle;
-};
-
-std::vector<DirectedEdge> boundary_half_edges(const Topology& topo) {
-  std::vector<DirectedEdge> out;
-  for (std::uint32_t t = 0; t < topo.merged.mesh.triangle_count(); ++t) {
-    const Triangle& tri = topo.triangle(t);
-    for (int k = 0; k < 3; ++k) {
-      if (topo.is_boundary(tri[k], tri[(k + 1) % 3])) out.push_back({tri[k], tri[(k + 1) % 3], t});
-    }
-  }
-  return out;
-}
-
-/// The sources of the triangles around v.
+/// True when a triangle around v comes from `source`.
 bool touches_source(const Topology& topo, std::uint32_t v, std::int32_t source) {
   return std::any_of(topo.triangles_of[v].begin(), topo.triangles_of[v].end(),
                      [&](std::uint32_t t) { return topo.merged.source_acq[t] == source; });
@@ -189,7 +187,7 @@ std::vector<Insertion> find_insertions(const Topology& topo, std::span<const Dir
   const BoxTree tree(std::move(boxes));
   std::vector<Insertion> out;
   std::vector<std::uint32_t> hits;
-  for (const std::uint32_t v : boundary_vertices(topo)) {
+  for (const std::uint32_t v : vertices_of(edges)) {
     tree.containing(topo.merged.mesh.positions[v], hits);
     std::sort(hits.begin(), hits.end());
     const Vec3d p = topo.position(v);
@@ -274,7 +272,6 @@ void split_edges_at_vertices(Topology& topo, double tolerance) {
     const DirectedEdge& e = edges[insertions[i].edge];
     if (try_split(topo, e.from, e.to, inserted)) {
       ++topo.stats.edges_split;
-      topo.stats.vertices_inserted += inserted.size();
     } else {
       ++topo.stats.rejected;
     }

@@ -11,10 +11,15 @@
 
 namespace citymesh::mosaic_detail {
 
+/// One directed edge (from -> to) as a hash key; snapping and zippering both refuse to use a
+/// directed edge twice.
+constexpr std::uint64_t directed_edge_key(std::uint32_t from, std::uint32_t to) {
+  return (std::uint64_t{from} << 32) | to;
+}
+
 struct SnapStats {
   std::uint64_t vertices_merged = 0;  ///< pairs of boundary vertices of different sources made one
   std::uint64_t edges_split = 0;      ///< boundary edges split at a vertex of another source
-  std::uint64_t vertices_inserted = 0;
   std::uint64_t rejected = 0;  ///< merges and splits refused (a flip, a degenerate or a non-manifold result)
 };
 

@@ -108,12 +108,12 @@ std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from
   return run;
 }
 
-std::uint64_t directed_key(std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; }
+using mosaic_detail::directed_edge_key;
 
 std::unordered_set<std::uint64_t> directed_edges(const Mesh& m) {
   std::unordered_set<std::uint64_t> out;
   for (const Triangle& t : m.triangles) {
-    for (int k = 0; k < 3; ++k) out.insert(directed_key(t[k], t[(k + 1) % 3]));
+    for (int k = 0; k < 3; ++k) out.insert(directed_edge_key(t[k], t[(k + 1) % 3]));
   }
   return out;
 }
@@ -124,7 +124,7 @@ bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std:
   const Mesh& m = c.merged.mesh;
   const Vec3d n = face_normal(m, a, b, d);
   const double len = norm(n);
-  const std::array<std::uint64_t, 3> keys{directed_key(a, b), directed_key(b, d), directed_key(d, a)};
+  const std::array<std::uint64_t, 3> keys{directed_edge_key(a, b), directed_edge_key(b, d), directed_edge_key(d, a)};
   if (!(len > 1e-10) || dot(n, reference) <= 0 ||
       std::any_of(keys.begin(), keys.end(), [&](std::uint64_t k) { return c.directed.contains(k); })) {
     ++c.stats.rejected;

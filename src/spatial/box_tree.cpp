@@ -5,8 +5,8 @@
 #include "citymesh/spatial/box_tree.h"
 
 #include <algorithm>
-#include <cmath>
 #include <bit>
+#include <cmath>
 #include <iterator>
 #include <limits>
 #include <utility>

@@ -21,7 +21,8 @@ struct StitchStats {
   std::uint64_t vertices_snapped = 0;  ///< boundary vertices of two sources made one
   std::uint64_t edges_split = 0;       ///< boundary edges split at vertices of another source
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
-  std::uint64_t rejected = 0;  ///< strip triangles refused (flipped against a neighbour or degenerate)
+  /// Snaps and strip triangles refused (a flip, a degenerate triangle or a reused directed edge).
+  std::uint64_t rejected = 0;
   double seconds = 0;
 };
 
