@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -18,6 +19,30 @@ std::int32_t cell(double coordinate, double origin, double size) {
   }
   return static_cast<std::int32_t>(c);
 }
+/// Whether the x-y convex hull of `points` meets the rectangle [lo, hi], by separating axes:
+/// the rectangle's two axes and the normal of every segment between two points (the hull's
+/// edges are among them; an extra axis can only find a true separation).
+bool hull_meets_rectangle(std::span<const Vec3d> points, double lo_x, double lo_y, double hi_x, double hi_y) {
+  const auto separated = [&](double nx, double ny) {
+    double pmin = std::numeric_limits<double>::infinity(), pmax = -pmin;
+    for (const Vec3d& p : points) {
+      pmin = std::min(pmin, nx * p.x + ny * p.y);
+      pmax = std::max(pmax, nx * p.x + ny * p.y);
+    }
+    const double c0 = nx * lo_x + ny * lo_y, c1 = nx * hi_x + ny * lo_y, c2 = nx * lo_x + ny * hi_y,
+                 c3 = nx * hi_x + ny * hi_y;
+    return pmax < std::min({c0, c1, c2, c3}) || pmin > std::max({c0, c1, c2, c3});
+  };
+  if (separated(1, 0) || separated(0, 1)) return false;
+  for (std::size_t a = 0; a < points.size(); ++a) {
+    for (std::size_t b = a + 1; b < points.size(); ++b) {
+      const double nx = points[b].y - points[a].y, ny = points[a].x - points[b].x;
+      if ((nx != 0 || ny != 0) && separated(nx, ny)) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 std::string TileKey::name() const { return fmt::format("{}_{}", i, j); }
@@ -37,7 +62,8 @@ Vec3d TileGrid::corner(TileKey key) const {
   return {params_.origin[0] + key.i * params_.tile_size, params_.origin[1] + key.j * params_.tile_size, 0.0};
 }
 
-std::vector<TileKey> TileGrid::halo_tiles(const Box3d& box, TileKey owner_key) const {
+template <class Keep>
+std::vector<TileKey> TileGrid::tiles_near(const Box3d& box, Keep keep) const {
   const double h = params_.halo, s = params_.tile_size;
   // A tile (i, j) grown by h meets the box when [i*s - h, (i+1)*s + h] overlaps [min, max].
   const std::int32_t i0 = cell(box.min.x - h, params_.origin[0], s), i1 = cell(box.max.x + h, params_.origin[0], s);
@@ -45,10 +71,24 @@ std::vector<TileKey> TileGrid::halo_tiles(const Box3d& box, TileKey owner_key) c
   std::vector<TileKey> tiles;
   for (std::int32_t i = i0; i <= i1; ++i) {
     for (std::int32_t j = j0; j <= j1; ++j) {
-      if (TileKey{i, j} != owner_key) tiles.push_back({i, j});
+      if (keep(TileKey{i, j})) tiles.push_back({i, j});
     }
   }
   return tiles;
+}
+
+std::vector<TileKey> TileGrid::halo_tiles(const Box3d& box, TileKey owner_key) const {
+  return tiles_near(box, [&](TileKey k) { return k != owner_key; });
+}
+
+std::vector<TileKey> TileGrid::tiles_crossed(std::span<const Vec3d> points) const {
+  Box3d box;
+  for (const Vec3d& p : points) box.extend(p);
+  const double h = params_.halo, s = params_.tile_size;
+  return tiles_near(box, [&](TileKey k) {
+    const Vec3d c = corner(k);
+    return hull_meets_rectangle(points, c.x - h, c.y - h, c.x + s + h, c.y + s + h);
+  });
 }
 
 }  // namespace citymesh

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <random>
 
 #include "citymesh/core/error.h"
@@ -47,6 +49,75 @@ TEST(TileGrid, HaloTilesEqualBruteForce) {
     }
     ASSERT_EQ(grid.halo_tiles(box, owner), expected) << n;
   }
+}
+
+/// Brute force: two convex sets in the plane meet when a point of one lies in the other or
+/// two of their segments cross. The hull of four points is the union of the four triangles.
+bool point_in_triangle(double px, double py, const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const auto side = [&](const Vec3d& u, const Vec3d& v) { return (v.x - u.x) * (py - u.y) - (v.y - u.y) * (px - u.x); };
+  const double s0 = side(a, b), s1 = side(b, c), s2 = side(c, a);
+  return (s0 >= 0 && s1 >= 0 && s2 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0);
+}
+
+bool segment_meets_rectangle(const Vec3d& a, const Vec3d& b, double x0, double y0, double x1, double y1) {
+  double t0 = 0, t1 = 1;  // Liang-Barsky clipping
+  const double dx = b.x - a.x, dy = b.y - a.y;
+  const double p[4] = {-dx, dx, -dy, dy}, q[4] = {a.x - x0, x1 - a.x, a.y - y0, y1 - a.y};
+  for (int k = 0; k < 4; ++k) {
+    if (p[k] == 0) {
+      if (q[k] < 0) return false;
+    } else if (p[k] < 0) {
+      t0 = std::max(t0, q[k] / p[k]);
+    } else {
+      t1 = std::min(t1, q[k] / p[k]);
+    }
+  }
+  return t0 <= t1;
+}
+
+bool hull_meets_rectangle_brute(const std::array<Vec3d, 4>& pts, double x0, double y0, double x1, double y1) {
+  for (std::size_t a = 0; a < 4; ++a) {
+    for (std::size_t b = a + 1; b < 4; ++b) {
+      if (segment_meets_rectangle(pts[a], pts[b], x0, y0, x1, y1)) return true;
+    }
+  }
+  for (const double cx : {x0, x1}) {
+    for (const double cy : {y0, y1}) {
+      for (std::size_t skip = 0; skip < 4; ++skip) {
+        std::array<Vec3d, 3> t;
+        for (std::size_t k = 0, n = 0; k < 4; ++k) if (k != skip) t[n++] = pts[k];
+        if (point_in_triangle(cx, cy, t[0], t[1], t[2])) return true;
+      }
+    }
+  }
+  return false;
+}
+
+TEST(TileGrid, TilesCrossedByATetrahedronEqualBruteForce) {
+  const TileGrid grid({.tile_size = 10, .halo = 1.5, .origin = {0, 0}});
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-20, 20), near(-1, 1), far(-25, 25);
+  std::size_t strictly_fewer = 0;
+  for (int n = 0; n < 3000; ++n) {
+    // A small triangle and a viewpoint up to 25 m away: long thin slivers, like MLS.
+    const Vec3d a{u(rng), u(rng), 0};
+    const std::array<Vec3d, 4> pts{a, a + Vec3d{near(rng), near(rng), 1}, a + Vec3d{near(rng), near(rng), 0},
+                                   a + Vec3d{far(rng), far(rng), 2}};
+    std::vector<TileKey> expected;
+    std::size_t in_box = 0;
+    for (int i = -8; i <= 8; ++i) {
+      for (int j = -8; j <= 8; ++j) {
+        const double x0 = i * 10 - 1.5, x1 = (i + 1) * 10 + 1.5, y0 = j * 10 - 1.5, y1 = (j + 1) * 10 + 1.5;
+        Box3d box;
+        for (const Vec3d& p : pts) box.extend(p);
+        if (box.min.x <= x1 && box.max.x >= x0 && box.min.y <= y1 && box.max.y >= y0) ++in_box;
+        if (hull_meets_rectangle_brute(pts, x0, y0, x1, y1)) expected.push_back({i, j});
+      }
+    }
+    ASSERT_EQ(grid.tiles_crossed(pts), expected) << n;
+    if (expected.size() < in_box) ++strictly_fewer;
+  }
+  EXPECT_GT(strictly_fewer, 300u);  // the exact test matters: bounding boxes would add tiles
 }
 
 TEST(TileGrid, RefusesBadSizes) {

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <compare>
+#include <span>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -41,8 +42,17 @@ class TileGrid {
   /// Tiles other than `owner` whose halo band (tile grown by `halo`) meets the x-y extent of
   /// `box`, in (i, j) order. A triangle is copied into these tiles as context.
   [[nodiscard]] std::vector<TileKey> halo_tiles(const Box3d& box, TileKey owner) const;
+  /// Every tile whose halo band (tile grown by `halo`) the x-y shadow of the convex hull of
+  /// `points` truly meets (not only its bounding box), in (i, j) order. An empty-space
+  /// tetrahedron (a triangle and its viewpoint) goes to these tiles, so that a conflict is
+  /// found even when the sensor stood in another tile.
+  [[nodiscard]] std::vector<TileKey> tiles_crossed(std::span<const Vec3d> points) const;
 
  private:
+  /// Tiles whose halo band meets the x-y extent of `box` and that `keep` accepts.
+  template <class Keep>
+  std::vector<TileKey> tiles_near(const Box3d& box, Keep keep) const;
+
   TileGridParams params_;
 };
 

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// The tile store's chunk files: one acquisition's triangles in one tile, written by the tiler
+// in blocks (each flush of its buffers appends one) and read back whole by tile processing.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "citymesh/core/mesh.h"
+
+namespace citymesh {
+
+/// Why a triangle is in a tile. Owned: its centroid lies in the tile (exactly one tile owns
+/// each triangle; only the owner writes its result). Halo: it lies within the halo of the tile
+/// (context for consistency and the mosaic). Empty space: only its tetrahedron with the
+/// viewpoint crosses the tile (it can make a triangle of the tile conflict).
+enum class TileRole : std::uint8_t { owned = 0, halo = 1, empty_space = 2 };
+
+/// One acquisition's part of one tile: a mesh in the tile's local frame (origin: the tile's
+/// corner) with sensor positions and, per triangle, its global id, its index in the
+/// acquisition (the order of PlyReader's triangles) and its role; per vertex its index in the
+/// acquisition's file, so that blocks written at different times share vertices again.
+struct TilePiece {
+  Mesh mesh;
+  std::vector<std::uint32_t> vertex_ids;
+  std::vector<std::uint32_t> triangle_index;
+  std::vector<TileRole> roles;
+
+  [[nodiscard]] std::size_t triangle_count() const { return mesh.triangle_count(); }
+  /// Bytes one block of this piece takes on disk (and roughly in memory).
+  [[nodiscard]] std::uint64_t byte_size() const;
+  void clear();
+};
+
+/// Appends `piece` as one checksummed block (magic, version, counts, payload, FNV-1a) to
+/// `file`, creating it. Throws OutputError naming the file.
+void append_tile_block(const std::filesystem::path& file, const TilePiece& piece);
+
+/// Reads every block of `file` into one piece in the frame `origin`: vertices of several blocks
+/// with the same id become one (the first block's copy), triangles keep the order in which
+/// they were written. Global ids get `acquisition`. Throws InputError naming the file and the
+/// block when it is truncated, has another magic or version, a count that does not fit the
+/// file, an index out of range or a checksum that does not match.
+TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin, std::uint32_t acquisition);
+
+}  // namespace citymesh

@@ -1,0 +1,196 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+#include <map>
+#include <random>
+#include <set>
+
+#include "citymesh/core/error.h"
+#include "citymesh/io/ply_writer.h"
+#include "citymesh/tiler/tiler.h"
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+/// A random soup of small triangles over 60 x 60 m at city coordinates, each vertex seen from
+/// a sensor up to 20 m away, with intensities.
+Mesh random_acquisition(std::uint32_t seed, std::size_t triangles) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 60), d(-0.8, 0.8), far(-20, 20);
+  Mesh m;
+  m.origin = {651000, 6860000, 30};
+  for (std::size_t t = 0; t < triangles; ++t) {
+    const Vec3d a{u(rng), u(rng), d(rng)};
+    const Vec3d sensor = a + Vec3d{far(rng), far(rng), 3};
+    const auto v = static_cast<std::uint32_t>(m.positions.size());
+    for (const Vec3d& p : {a, a + Vec3d{d(rng), d(rng), 0.3}, a + Vec3d{d(rng), d(rng), 0}}) {
+      m.positions.push_back(Vec3f(p));
+      m.sensor_positions.push_back(Vec3f(sensor + Vec3d{d(rng), d(rng), 0}));
+      m.intensities.push_back(float(t % 100));
+    }
+    // Every other triangle shares an edge with the previous one, so vertices are shared.
+    if (t % 2 == 1) {
+      m.triangles.push_back({v - 3, v - 2, v});
+    } else {
+      m.triangles.push_back({v, v + 1, v + 2});
+    }
+  }
+  m.triangle_ids.resize(m.triangles.size());
+  return m;
+}
+
+struct Fixture {
+  test::TempDir tmp;
+  std::vector<Mesh> meshes;
+  std::vector<Acquisition> acquisitions;
+  TilerParams params;
+
+  explicit Fixture(std::uint64_t buffer_bytes = 256ull << 20) {
+    for (std::uint32_t a = 0; a < 2; ++a) {
+      meshes.push_back(random_acquisition(10 + a, 3000));
+      const auto path = tmp / ("acq" + std::to_string(a) + ".ply");
+      write_mesh_ply(path, meshes.back());
+      acquisitions.push_back({a, TimePoint{}, path});
+    }
+    params.grid = {.tile_size = 20, .halo = 2, .origin = {651000, 6860000}};
+    params.dir = tmp / "tiles";
+    params.buffer_bytes = buffer_bytes;
+  }
+};
+
+std::array<Vec3d, 3> world_corners(const Mesh& m, std::size_t t) {
+  const Triangle& tri = m.triangles[t];
+  return {m.world_position(tri[0]), m.world_position(tri[1]), m.world_position(tri[2])};
+}
+
+/// Expected role of every (acquisition, triangle) in every tile, by brute force from the grid.
+std::map<std::pair<TileKey, std::pair<std::uint32_t, std::uint32_t>>, TileRole> expected_roles(const Fixture& f) {
+  const TileGrid grid(f.params.grid);
+  std::map<std::pair<TileKey, std::pair<std::uint32_t, std::uint32_t>>, TileRole> roles;
+  for (std::uint32_t a = 0; a < f.meshes.size(); ++a) {
+    const Mesh& m = f.meshes[a];
+    for (std::uint32_t t = 0; t < m.triangle_count(); ++t) {
+      const auto c = world_corners(m, t);
+      Box3d box;
+      for (const Vec3d& p : c) box.extend(p);
+      const TileKey owner = grid.owner((c[0] + c[1] + c[2]) / 3.0);
+      Vec3d view{0, 0, 0};
+      for (const std::uint32_t v : m.triangles[t]) view = view + m.world_sensor_position(v) / 3.0;
+      const std::array<Vec3d, 4> tet{c[0], c[1], c[2], view};
+      for (const TileKey k : grid.tiles_crossed(tet)) roles[{k, {a, t}}] = TileRole::empty_space;
+      for (const TileKey k : grid.halo_tiles(box, owner)) roles[{k, {a, t}}] = TileRole::halo;
+      roles[{owner, {a, t}}] = TileRole::owned;
+    }
+  }
+  return roles;
+}
+
+TEST(Tiler, EveryTriangleIsOwnedOnceAndCopiedWhereBruteForceSays) {
+  Fixture f;
+  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  ASSERT_EQ(store.triangles, (std::vector<std::uint64_t>{3000, 3000}));
+  auto expected = expected_roles(f);
+  std::uint64_t owned = 0;
+  for (const TileContents& tile : store.tiles) {
+    const std::vector<TilePiece> pieces = read_tile(store, tile.key);
+    for (std::uint32_t a = 0; a < pieces.size(); ++a) {
+      const TilePiece& p = pieces[a];
+      std::array<std::uint64_t, 3> per_role{};
+      for (std::size_t t = 0; t < p.triangle_count(); ++t) {
+        const std::uint32_t index = p.triangle_index[t];
+        const auto it = expected.find({tile.key, {a, index}});
+        ASSERT_NE(it, expected.end()) << tile.key.name() << " holds " << a << "/" << index;
+        EXPECT_EQ(it->second, p.roles[t]);
+        expected.erase(it);
+        ++per_role[static_cast<std::size_t>(p.roles[t])];
+        // Local floats plus the tile corner give the input position back.
+        const auto want = world_corners(f.meshes[a], index);
+        for (std::size_t k = 0; k < 3; ++k) {
+          const Vec3d got = p.mesh.world_position(p.mesh.triangles[t][k]);
+          EXPECT_LT(norm(got - want[k]), 1e-5);
+          EXPECT_EQ(p.mesh.intensities[p.mesh.triangles[t][k]], f.meshes[a].intensities[f.meshes[a].triangles[index][k]]);
+        }
+      }
+      EXPECT_EQ(per_role, tile.triangles[a]);
+      owned += per_role[0];
+    }
+  }
+  EXPECT_EQ(owned, 6000u);
+  // Whatever remains expected belongs to tiles that own nothing (not listed: no work there).
+  for (const auto& [key, role] : expected) {
+    const bool listed = std::any_of(store.tiles.begin(), store.tiles.end(),
+                                    [&](const TileContents& t) { return t.key == key.first; });
+    EXPECT_FALSE(listed) << key.first.name();
+  }
+  EXPECT_GT(store.stats.halo_copies, 0u);
+  EXPECT_GT(store.stats.empty_space_copies, 0u);
+}
+
+TEST(Tiler, SmallBuffersWriteManyBlocksThatReadBackTheSame) {
+  Fixture whole, blocks(64 << 10);
+  const TileStore a = tile_acquisitions(whole.acquisitions, whole.params);
+  const TileStore b = tile_acquisitions(blocks.acquisitions, blocks.params);
+  EXPECT_GT(b.stats.blocks, 4 * a.stats.blocks);
+  ASSERT_EQ(a.tiles.size(), b.tiles.size());
+  for (std::size_t k = 0; k < a.tiles.size(); ++k) {
+    const auto pa = read_tile(a, a.tiles[k].key), pb = read_tile(b, b.tiles[k].key);
+    for (std::size_t q = 0; q < pa.size(); ++q) {
+      // Same triangles in the same order with the same corners; shared vertices stay shared.
+      ASSERT_EQ(pa[q].triangle_index, pb[q].triangle_index);
+      ASSERT_EQ(pa[q].mesh.vertex_count(), pb[q].mesh.vertex_count());
+      for (std::size_t t = 0; t < pa[q].triangle_count(); ++t) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          ASSERT_EQ(pa[q].vertex_ids[pa[q].mesh.triangles[t][c]], pb[q].vertex_ids[pb[q].mesh.triangles[t][c]]);
+        }
+      }
+    }
+  }
+}
+
+TEST(Tiler, ManifestRoundTrips) {
+  Fixture f;
+  TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  EXPECT_FALSE(read_tile_manifest(store.dir).has_value());  // unfinished until the manifest is written
+  store.fingerprint = "abc";
+  write_tile_manifest(store);
+  const std::optional<TileStore> back = read_tile_manifest(store.dir);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->fingerprint, "abc");
+  EXPECT_EQ(back->triangles, store.triangles);
+  ASSERT_EQ(back->tiles.size(), store.tiles.size());
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    EXPECT_EQ(back->tiles[k].key, store.tiles[k].key);
+    EXPECT_EQ(back->tiles[k].triangles, store.tiles[k].triangles);
+  }
+}
+
+TEST(Tiler, DamagedChunksAreInputErrorsNamingTheFile) {
+  Fixture f;
+  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  const auto file = tile_chunk_path(store.dir, store.tiles.front().key, 0);
+  const auto size = std::filesystem::file_size(file);
+  const auto expect_error = [&](const std::string& what) {
+    try {
+      (void)read_tile_piece(file, {0, 0, 0}, 0);
+      FAIL() << "no error for " << what;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+    }
+  };
+  {
+    std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp(static_cast<std::streamoff>(size / 2));
+    io.put('\x7f');
+  }
+  expect_error("a flipped byte");
+  std::filesystem::resize_file(file, size - 7);
+  expect_error("a truncated file");
+  std::filesystem::resize_file(file, 20);
+  expect_error("a truncated header");
+}
+
+}  // namespace
+}  // namespace citymesh

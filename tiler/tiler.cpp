@@ -1,0 +1,219 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/tiler/tiler.h"
+
+#include <fmt/format.h>
+
+#include <map>
+#include <unordered_map>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/stopwatch.h"
+
+namespace citymesh {
+
+namespace {
+
+/// One acquisition's vertices, whole: faces refer to any of them.
+struct AcquisitionVertices {
+  std::vector<Vec3d> positions, sensors;
+  std::vector<float> intensities;
+  std::vector<Rgb8> colors;
+
+  void append(const PlyVertexChunk& c) {
+    positions.insert(positions.end(), c.positions.begin(), c.positions.end());
+    sensors.insert(sensors.end(), c.sensor_positions.begin(), c.sensor_positions.end());
+    intensities.insert(intensities.end(), c.intensities.begin(), c.intensities.end());
+    colors.insert(colors.end(), c.colors.begin(), c.colors.end());
+  }
+};
+
+/// The triangles of the current acquisition bound for one tile, not yet on disk.
+struct TileBuffer {
+  TilePiece piece;
+  std::unordered_map<std::uint32_t, std::uint32_t> local;  ///< vertex id -> index in the piece
+};
+
+/// Hash-map overhead per buffered vertex, on top of the block bytes.
+constexpr std::uint64_t kMapBytesPerVertex = 32;
+
+class AcquisitionTiler {
+ public:
+  AcquisitionTiler(const TileGrid& grid, TileStore& store, std::uint32_t acquisition, std::uint64_t buffer_bytes)
+      : grid_(grid), store_(store), acquisition_(acquisition), buffer_bytes_(buffer_bytes) {}
+
+  void run(const std::filesystem::path& file, const PlyReadParams& ply) {
+    PlyReader reader(file, ply);
+    if (reader.vertex_count() > std::uint64_t{UINT32_MAX}) {
+      throw InputError(fmt::format("{}: {} vertices; the tile store numbers them in 32 bits (split the file)",
+                                   file.string(), reader.vertex_count()));
+    }
+    PlyVertexChunk vertices;
+    PlyFaceChunk faces;
+    for (;;) {
+      throw_if_interrupted("tiling");
+      const PlyReader::ChunkKind kind = reader.next(vertices, faces);
+      if (kind == PlyReader::ChunkKind::end) break;
+      if (kind == PlyReader::ChunkKind::vertices) {
+        vertices_.append(vertices);
+        continue;
+      }
+      for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
+        const Triangle& tri = faces.triangles[t];
+        for (const std::uint32_t v : tri) {
+          if (v >= vertices_.positions.size()) {
+            throw InputError(fmt::format("{}: face {} uses vertex {} before the vertices are read (put the vertex "
+                                         "element first)",
+                                         file.string(), faces.faces[t], v));
+          }
+        }
+        add_triangle(tri, {acquisition_, faces.fans[t], faces.faces[t]});
+        if (buffered_ > buffer_bytes_) flush();
+      }
+    }
+    flush();
+    store_.triangles.push_back(next_index_);
+    store_.stats.input_bytes += reader.stats().bytes;
+  }
+
+ private:
+  void add_triangle(const Triangle& tri, const TriangleId& id) {
+    const std::uint32_t index = next_index_++;
+    const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
+                                 vertices_.positions[tri[2]]};
+    const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
+    Box3d box;
+    for (const Vec3d& p : c) box.extend(p);
+    add_to(owner, tri, id, index, TileRole::owned);
+    const std::vector<TileKey> halo = grid_.halo_tiles(box, owner);
+    for (const TileKey k : halo) add_to(k, tri, id, index, TileRole::halo);
+    store_.stats.halo_copies += halo.size();
+    const Vec3d viewpoint =
+        (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
+    const std::array<Vec3d, 4> tetrahedron{c[0], c[1], c[2], viewpoint};
+    for (const TileKey k : grid_.tiles_crossed(tetrahedron)) {
+      if (k == owner || std::binary_search(halo.begin(), halo.end(), k)) continue;
+      add_to(k, tri, id, index, TileRole::empty_space);
+      ++store_.stats.empty_space_copies;
+    }
+  }
+
+  void add_to(TileKey key, const Triangle& tri, const TriangleId& id, std::uint32_t index, TileRole role) {
+    TileBuffer& b = buffers_[key];
+    if (b.piece.mesh.positions.empty() && b.piece.mesh.triangles.empty()) b.piece.mesh.origin = grid_.corner(key);
+    Triangle local{};
+    for (std::size_t k = 0; k < 3; ++k) local[k] = local_vertex(b, tri[k]);
+    b.piece.mesh.triangles.push_back(local);
+    b.piece.mesh.triangle_ids.push_back(id);
+    b.piece.triangle_index.push_back(index);
+    b.piece.roles.push_back(role);
+    buffered_ += 29;
+    ++counts_[key][static_cast<std::size_t>(role)];
+  }
+
+  std::uint32_t local_vertex(TileBuffer& b, std::uint32_t v) {
+    const auto [it, added] = b.local.try_emplace(v, static_cast<std::uint32_t>(b.piece.vertex_ids.size()));
+    if (!added) return it->second;
+    Mesh& m = b.piece.mesh;
+    b.piece.vertex_ids.push_back(v);
+    m.positions.push_back(to_local(vertices_.positions[v], m.origin));
+    m.sensor_positions.push_back(to_local(vertices_.sensors[v], m.origin));
+    if (!vertices_.intensities.empty()) m.intensities.push_back(vertices_.intensities[v]);
+    if (!vertices_.colors.empty()) m.colors.push_back(vertices_.colors[v]);
+    buffered_ += 28 + kMapBytesPerVertex;
+    return it->second;
+  }
+
+  void flush() {
+    for (auto& [key, b] : buffers_) {
+      if (b.piece.triangle_count() == 0) continue;
+      const std::filesystem::path file = tile_chunk_path(store_.dir, key, acquisition_);
+      std::filesystem::create_directories(file.parent_path());
+      append_tile_block(file, b.piece);
+      ++store_.stats.blocks;
+      store_.stats.bytes_written += b.piece.byte_size();
+    }
+    buffers_.clear();
+    buffered_ = 0;
+  }
+
+ public:
+  /// Triangles per tile and role of this acquisition.
+  [[nodiscard]] const std::map<TileKey, std::array<std::uint64_t, 3>>& counts() const { return counts_; }
+
+ private:
+  const TileGrid& grid_;
+  TileStore& store_;
+  std::uint32_t acquisition_;
+  std::uint64_t buffer_bytes_;
+  AcquisitionVertices vertices_;
+  std::map<TileKey, TileBuffer> buffers_;
+  std::uint64_t buffered_ = 0;
+  std::uint32_t next_index_ = 0;
+  std::map<TileKey, std::array<std::uint64_t, 3>> counts_;
+};
+
+}  // namespace
+
+std::uint64_t TileContents::owned() const {
+  std::uint64_t n = 0;
+  for (const auto& a : triangles) n += a[0];
+  return n;
+}
+
+std::uint64_t TileContents::total() const {
+  std::uint64_t n = 0;
+  for (const auto& a : triangles) n += a[0] + a[1] + a[2];
+  return n;
+}
+
+std::filesystem::path tile_chunk_path(const std::filesystem::path& dir, TileKey key, std::uint32_t acquisition) {
+  return dir / key.name() / fmt::format("{}.bin", acquisition);
+}
+
+TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params) {
+  Stopwatch clock;
+  const TileGrid grid(params.grid);
+  TileStore store;
+  store.dir = params.dir;
+  store.grid = params.grid;
+  std::error_code ec;
+  std::filesystem::remove_all(params.dir, ec);
+  std::filesystem::create_directories(params.dir, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", params.dir.string(), ec.message()));
+  std::map<TileKey, std::vector<std::array<std::uint64_t, 3>>> counts;
+  for (const Acquisition& a : acquisitions) {
+    AcquisitionTiler tiler(grid, store, a.index, params.buffer_bytes);
+    tiler.run(a.path, params.ply);
+    for (const auto& [key, roles] : tiler.counts()) {
+      auto& all = counts[key];
+      all.resize(acquisitions.size());
+      all[a.index] = roles;
+    }
+    log::info("tiled {}: {} triangles", a.path.string(), store.triangles.back());
+  }
+  for (auto& [key, per_acquisition] : counts) {
+    TileContents t{key, std::move(per_acquisition)};
+    t.triangles.resize(acquisitions.size());
+    if (t.owned() > 0) store.tiles.push_back(std::move(t));
+  }
+  store.stats.seconds = clock.seconds();
+  return store;
+}
+
+std::vector<TilePiece> read_tile(const TileStore& store, TileKey key) {
+  const TileGrid grid(store.grid);
+  std::vector<TilePiece> pieces(store.triangles.size());
+  for (std::uint32_t a = 0; a < pieces.size(); ++a) {
+    const std::filesystem::path file = tile_chunk_path(store.dir, key, a);
+    if (std::filesystem::exists(file)) {
+      pieces[a] = read_tile_piece(file, grid.corner(key), a);
+    } else {
+      pieces[a].mesh.origin = grid.corner(key);
+    }
+  }
+  return pieces;
+}
+
+}  // namespace citymesh
