@@ -11,6 +11,7 @@
 #include <iterator>
 #include <unordered_map>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 
 namespace citymesh {
@@ -30,12 +31,6 @@ struct BlockHeader {
   std::uint64_t checksum;  ///< FNV-1a of the payload
 };
 static_assert(sizeof(BlockHeader) == 40);
-
-std::uint64_t fnv1a(const char* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ static_cast<unsigned char>(data[i])) * 0x100000001b3ull;
-  return h;
-}
 
 std::uint64_t vertex_bytes(std::uint32_t flags) {
   return 4 + 12 + 12 + ((flags & kHasIntensity) != 0 ? 4 : 0) + ((flags & kHasColor) != 0 ? 3 : 0);
@@ -85,7 +80,7 @@ void TilePiece::clear() {
   roles.clear();
 }
 
-void append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
+std::string encode_tile_block(const TilePiece& piece) {
   const Mesh& m = piece.mesh;
   BlockHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
@@ -112,13 +107,16 @@ void append_tile_block(const std::filesystem::path& file, const TilePiece& piece
   put(payload, piece.triangle_index);
   put(payload, piece.roles);
   h.checksum = fnv1a(payload.data(), payload.size());
+  return std::string(reinterpret_cast<const char*>(&h), sizeof h) + payload;
+}
 
+void append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
+  const std::string block = encode_tile_block(piece);
   // Chunk files only count once the tiler's manifest names them; the sync makes sure the
   // manifest never points at data still in the page cache.
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   bool ok = fd >= 0;
-  ok = ok && ::write(fd, &h, sizeof h) == static_cast<ssize_t>(sizeof h);
-  ok = ok && ::write(fd, payload.data(), payload.size()) == static_cast<ssize_t>(payload.size());
+  ok = ok && ::write(fd, block.data(), block.size()) == static_cast<ssize_t>(block.size());
   ok = ok && ::fsync(fd) == 0;
   const int err = errno;
   if (fd >= 0) ::close(fd);
@@ -129,6 +127,11 @@ TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin
   std::ifstream in(file, std::ios::binary);
   if (!in) throw InputError(fmt::format("{}: cannot open the tile chunk", file.string()));
   const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return decode_tile_blocks(bytes, origin, acquisition, file.string());
+}
+
+TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,
+                             std::string_view source) {
   TilePiece piece;
   piece.mesh.origin = origin;
   std::vector<std::uint32_t> ids;
@@ -142,7 +145,7 @@ TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin
   std::size_t at = 0;
   for (std::size_t block = 0; at < bytes.size(); ++block) {
     const auto fail = [&](std::string_view what) {
-      return InputError(fmt::format("{}: block {} at byte {}: {}", file.string(), block, at, what));
+      return InputError(fmt::format("{}: block {} at byte {}: {}", source, block, at, what));
     };
     BlockHeader h{};
     if (bytes.size() - at < sizeof h) throw fail("truncated header");

@@ -27,18 +27,6 @@ Rgb8 source_color(std::int32_t acquisition) {
 
 namespace {
 
-/// The face index in the input file of every merged triangle (-1 for stitch triangles).
-std::vector<std::int32_t> source_faces(const LoadedAcquisitions& input, const MergedMesh& merged) {
-  std::vector<std::vector<std::int32_t>> per_acquisition(input.meshes.size());
-  for (std::size_t k = 0; k < input.meshes.size(); ++k) per_acquisition[k] = input.source_faces(k);
-  std::vector<std::int32_t> out(merged.source_acq.size(), kNoSource);
-  for (std::size_t t = 0; t < out.size(); ++t) {
-    const std::int32_t a = merged.source_acq[t];
-    if (a >= 0) out[t] = per_acquisition[static_cast<std::size_t>(a)][static_cast<std::size_t>(merged.source_triangle[t])];
-  }
-  return out;
-}
-
 void write_picture(const std::filesystem::path& path, const MergedMesh& merged, double pixel_size) {
   RenderLayer layer{&merged.mesh, {}};
   layer.face_colors.reserve(merged.source_acq.size());
@@ -50,13 +38,24 @@ void write_picture(const std::filesystem::path& path, const MergedMesh& merged, 
 
 }  // namespace
 
+std::vector<std::int32_t> source_faces(const LoadedAcquisitions& input, const MergedMesh& merged) {
+  std::vector<std::vector<std::int32_t>> per_acquisition(input.meshes.size());
+  for (std::size_t k = 0; k < input.meshes.size(); ++k) per_acquisition[k] = input.source_faces(k);
+  std::vector<std::int32_t> out(merged.source_acq.size(), kNoSource);
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    const std::int32_t a = merged.source_acq[t];
+    if (a >= 0) out[t] = per_acquisition[static_cast<std::size_t>(a)][static_cast<std::size_t>(merged.source_triangle[t])];
+  }
+  return out;
+}
+
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
-                          const MosaicStats& s, const MosaicOutputParams& params) {
+                          std::span<const std::int32_t> faces, const MosaicStats& s,
+                          const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
-  const std::vector<std::int32_t> faces = source_faces(input, merged);
   write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
                  {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
-                  {"source_face", std::span<const std::int32_t>(faces)}});
+                  {"source_face", faces}});
   if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
 
   nlohmann::json summary;
@@ -68,7 +67,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                         {"boundary", config.mosaic.boundary_weight},
                         {"overlap", config.mosaic.overlap_weight},
                         {"seam", config.mosaic.seam_weight}};
-  std::vector<std::uint64_t> per_source(input.meshes.size(), 0);
+  std::vector<std::uint64_t> per_source(input.acquisitions.size(), 0);
   std::uint64_t stitched = 0;
   for (const std::int32_t a : merged.source_acq) {
     if (a >= 0) {
@@ -77,7 +76,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
       ++stitched;
     }
   }
-  for (std::size_t k = 0; k < input.meshes.size(); ++k) {
+  for (std::size_t k = 0; k < input.acquisitions.size(); ++k) {
     nlohmann::json entry = acquisition_json(config, input, k);
     entry["triangles_kept"] = per_source[k];
     summary["acquisitions"].push_back(std::move(entry));

@@ -24,9 +24,11 @@ namespace {
 constexpr double kWeldInThresholds = 0.05;
 
 MosaicSelection select(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change) {
-  const MosaicInput in{input.meshes, input.dates, &change, config.change.distance_threshold};
+  const MosaicInput in{input.meshes, input.dates, &change, config.change.distance_threshold, {}};
   return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in) : select_mosaic(in, config.mosaic);
 }
+
+}  // namespace
 
 nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
   const double reach = config.mosaic.stitch_reach * config.change.distance_threshold;
@@ -45,6 +47,8 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
           {"rejected", s.rejected},
           {"seconds", s.seconds}};
 }
+
+namespace {
 
 void report(const std::filesystem::path& dir, const MergedMesh& merged, const MosaicStats& s) {
   std::cout << fmt::format("{}: {} triangles kept of {} candidates", dir.string(), merged.mesh.triangle_count(),
@@ -75,7 +79,7 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
       config.mosaic.method == MosaicMethod::energy ? stitch_and_report(config, merged) : nlohmann::json::object();
   seconds["stitch"] = clock.restart();
   const std::filesystem::path dir = config.project.output / "mosaic";
-  write_mosaic_outputs(config, input, merged, selection.stats,
+  write_mosaic_outputs(config, input, merged, source_faces(input, merged), selection.stats,
                        {.dir = dir,
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,

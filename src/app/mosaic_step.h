@@ -7,6 +7,7 @@
 
 #include "acquisitions.h"
 #include "citymesh/change/detect.h"
+#include "citymesh/mosaic/merged_mesh.h"
 #include "pipeline.h"
 
 namespace citymesh::app {
@@ -15,6 +16,10 @@ namespace citymesh::app {
 /// <output>/mosaic; `seconds` (earlier steps) goes into its summary. Prints a short report.
 void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
                      const PictureOptions& pictures, nlohmann::json seconds);
+
+/// Stitches `merged` with the config's reach and weld, prints a line and returns the figures
+/// for the summary.
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged);
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

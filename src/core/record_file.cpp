@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 
 namespace citymesh {
@@ -15,13 +16,6 @@ namespace {
 
 constexpr std::size_t kMagicSize = 8;
 constexpr std::size_t kFrame = kMagicSize + 2 * sizeof(std::uint64_t);  // magic, count, checksum
-
-std::uint64_t fnv1a(const void* data, std::size_t size) {
-  std::uint64_t h = 0xcbf29ce484222325ull;
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < size; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
-  return h;
-}
 
 }  // namespace
 

@@ -2,6 +2,7 @@
 #include "citymesh/mosaic/mosaic.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
@@ -36,6 +37,9 @@ void mosaic_detail::check_mosaic_input(const MosaicInput& input) {
     throw ProcessingError("mosaic: the change detection result does not match the meshes");
   }
   if (input.dates.size() != input.meshes.size()) throw ProcessingError("mosaic: one date per mesh is needed");
+  if (!input.forced.empty() && input.forced.size() != total) {
+    throw ProcessingError("mosaic: the forced flags do not match the meshes");
+  }
 }
 
 namespace {
@@ -47,6 +51,21 @@ struct TriangleShape {
 TriangleShape shape(const Mesh& m, std::size_t t) {
   const auto [a, b, c] = m.corners(t);
   return {0.5 * doubled_area(a, b, c), std::max({norm(b - a), norm(c - b), norm(a - c)})};
+}
+
+/// Makes x = 0 cost more, for every forced variable, than anything x = 1 can cost it: its
+/// own unary terms plus every pair term it is part of.
+void force_selected(std::span<const std::uint8_t> forced, MosaicEnergy& e) {
+  std::vector<double> at_stake(e.triangle_of.size(), 0.0);
+  for (const auto& p : e.energy.pairs) {
+    const double worst = std::max({std::abs(p.e00), std::abs(p.e01), std::abs(p.e10), std::abs(p.e11)});
+    at_stake[p.i] += worst;
+    at_stake[p.j] += worst;
+  }
+  for (std::size_t v = 0; v < e.triangle_of.size(); ++v) {
+    if (forced[e.triangle_of[v]] == 0) continue;
+    e.energy.unary[v][0] = 1.0 + std::abs(e.energy.unary[v][1]) + 2.0 * at_stake[v];
+  }
 }
 
 }  // namespace
@@ -120,6 +139,7 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
     out.energy.pairs.push_back({variable_of[g], variable_of[u], 0, 0, 0, params.overlap_weight});
   }
   out.stats.overlap_terms = out.energy.pairs.size() - out.stats.seam_terms;
+  if (!input.forced.empty()) force_selected(input.forced, out);
   return out;
 }
 

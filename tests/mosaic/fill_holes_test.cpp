@@ -35,7 +35,7 @@ TEST(FillHoles, AddsNewestTrianglesWhereNothingSelectedIsNear) {
   ChangeResult change;
   change.index.offsets = {0, 200, 264, 328};
   change.kept.assign(328, 1);
-  const MosaicInput input{meshes, dates, &change, 0.1};
+  const MosaicInput input{meshes, dates, &change, 0.1, {}};
   std::vector<std::uint8_t> selected(328, 0);
   std::fill(selected.begin(), selected.begin() + 200, 1);
   const std::uint64_t added = fill_holes(input, selected);
@@ -63,8 +63,43 @@ TEST(FillHoles, NeverAddsWhatTheChangeStepDropped) {
   change.kept.assign(16, 1);
   std::fill(change.kept.begin() + 8, change.kept.end(), 0);
   std::vector<std::uint8_t> selected(16, 0);
-  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1}, selected), 8u);
+  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, selected), 8u);
   for (std::size_t g = 0; g < 16; ++g) EXPECT_EQ(selected[g], g < 8 ? 1 : 0);
+}
+
+TEST(ForcedTriangles, AreSelectedAndTheRestAdaptsToThem) {
+  // Two grids over the same square, the coarse one overlapping the fine one pair by pair.
+  // Free, the mosaic keeps one of them; with the coarse one's left half forced (a neighbouring
+  // tile's decision), it keeps that half and takes the fine grid only where nothing is forced.
+  const std::vector<Mesh> meshes{grid(0, 4, 4, 0.25f, 0), grid(0, 4, 4, 0.25f, 0.01f)};
+  const std::vector<TimePoint> dates{TimePoint(std::chrono::days(1)), TimePoint(std::chrono::days(40))};
+  ChangeResult change;
+  change.index.offsets = {0, 32, 64};
+  change.kept.assign(64, 1);
+  for (std::uint32_t t = 0; t < 32; ++t) change.consistent_pairs.emplace_back(t, 32 + t);
+  MosaicParams params;
+  params.fill_holes = false;
+  // Free, one grid wins whole; the other one's left half is then forced.
+  const MosaicSelection free = select_mosaic({meshes, dates, &change, 0.1, {}}, params);
+  const std::uint32_t loser = free.selected[0] != 0 ? 1 : 0, winner = 1 - loser;
+  std::vector<std::uint8_t> forced(64, 0);
+  for (std::uint32_t t = 0; t < 32; ++t) {
+    EXPECT_EQ(free.selected[32 * winner + t], 1);
+    const auto [a, b, c] = meshes[loser].corners(t);
+    if ((a.x + b.x + c.x) / 3.0 < 0.5) forced[32 * loser + t] = 1;
+  }
+  const MosaicSelection s = select_mosaic({meshes, dates, &change, 0.1, forced}, params);
+  std::size_t forced_count = 0;
+  for (std::uint32_t t = 0; t < 32; ++t) {
+    if (forced[32 * loser + t] != 0) {
+      ++forced_count;
+      EXPECT_EQ(s.selected[32 * loser + t], 1) << t;
+      EXPECT_EQ(s.selected[32 * winner + t], 0) << t << ": its overlapping partner is forced";
+    } else {
+      EXPECT_EQ(s.selected[t] + s.selected[32 + t], 1) << t << ": exactly one of the pair";
+    }
+  }
+  EXPECT_EQ(forced_count, 16u);
 }
 
 }  // namespace

@@ -43,7 +43,7 @@ void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& chang
     const std::vector<TimePoint> dates(scene.dates.begin() + static_cast<std::ptrdiff_t>(k),
                                        scene.dates.begin() + static_cast<std::ptrdiff_t>(k + 2));
     const ChangeResult change = detect_changes({two, dates}, change_params);
-    const MosaicEnergy e = build_mosaic_energy({two, dates, &change, change_params.distance_threshold}, params);
+    const MosaicEnergy e = build_mosaic_energy({two, dates, &change, change_params.distance_threshold, {}}, params);
     const auto flips = submodular_flips(e.energy);
     if (!flips) continue;
     const CutGraph graph = cut_graph(flipped(e.energy, *flips), /*doubled=*/false);
@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", length, scene.meshes.size(), scene.triangles);
   const ChangeParams change_params;
   const ChangeResult change = detect_changes({scene.meshes, scene.dates}, change_params);
-  const MosaicInput input{scene.meshes, scene.dates, &change, change_params.distance_threshold};
+  const MosaicInput input{scene.meshes, scene.dates, &change, change_params.distance_threshold, {}};
   Stopwatch clock;
   const MosaicSelection energy = select_mosaic(input, params);
   const double wall = clock.seconds();

@@ -53,6 +53,7 @@ struct RunParams {
 struct OutputParams {
   bool tiles_3d = true;
   bool ply = false;
+  bool labels = true;  ///< run: the change step's labelled PLYs (<output>/detect)
   double draco_tolerance = 0.001;  ///< metres
 };
 

@@ -22,6 +22,9 @@ struct MosaicInput {
   std::span<const TimePoint> dates;
   const ChangeResult* change = nullptr;
   double distance_threshold = 0.10;  ///< the change step's, for the update model
+  /// Per global triangle, 1 when it must be selected (a decision already taken elsewhere: a
+  /// neighbouring tile's); empty: none. Forced triangles must be kept.
+  std::span<const std::uint8_t> forced;
 };
 
 struct MosaicStats {

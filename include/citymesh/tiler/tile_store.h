@@ -5,6 +5,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
+#include <string_view>
 #include <vector>
 
 #include "citymesh/core/mesh.h"
@@ -32,6 +34,16 @@ struct TilePiece {
   [[nodiscard]] std::uint64_t byte_size() const;
   void clear();
 };
+
+/// `piece` as one checksummed block: header (magic, version, attribute flags, counts, FNV-1a
+/// of the payload) and payload (vertex ids, positions, sensor positions, attributes, triangles,
+/// faces, fans, triangle indices, roles).
+std::string encode_tile_block(const TilePiece& piece);
+
+/// The blocks in `bytes` merged into one piece (see read_tile_piece); `source` names them in
+/// errors.
+TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,
+                             std::string_view source);
 
 /// Appends `piece` as one checksummed block (magic, version, counts, payload, FNV-1a) to
 /// `file`, creating it. Throws OutputError naming the file.

@@ -1,0 +1,101 @@
+// SPDX-License-Identifier: MIT
+// Which config a work folder was made with, so that a re-run resumes only compatible work.
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
+#include "run_state.h"
+#include "tiled_run.h"
+
+namespace citymesh::app {
+
+namespace {
+
+bool affects_results(const std::string& section) {
+  return section == "input" || section == "change" || section == "mosaic" || section == "tiling" ||
+         section.starts_with("acquisition[");
+}
+
+std::string trim(std::string s) {
+  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
+  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
+std::map<std::string, std::string> result_keys(const Config& config) {
+  std::map<std::string, std::string> keys;
+  std::istringstream in(effective_config_toml(config));
+  std::string line, section;
+  int acquisition = -1;
+  while (std::getline(in, line)) {
+    line = trim(line);
+    if (line.empty() || line[0] == '#') continue;
+    if (line == "[[acquisition]]") {
+      section = fmt::format("acquisition[{}]", ++acquisition);
+    } else if (line[0] == '[') {
+      section = line.substr(1, line.size() - 2);
+    } else if (const auto eq = line.find('='); eq != std::string::npos && affects_results(section)) {
+      keys[section + "." + trim(line.substr(0, eq))] = trim(line.substr(eq + 1));
+    }
+  }
+  for (std::size_t k = 0; k < config.acquisitions.size(); ++k) {
+    const auto& path = config.acquisitions[k].path;
+    std::error_code ec;
+    const auto size = std::filesystem::file_size(path, ec);
+    const auto time = std::filesystem::last_write_time(path, ec).time_since_epoch().count();
+    keys[fmt::format("acquisition[{}].file", k)] = fmt::format("{} bytes, modified {}", size, time);
+  }
+  return keys;
+}
+
+std::uint64_t fingerprint(const std::map<std::string, std::string>& keys, bool tiling_only) {
+  // The formats' versions are part of it: work made by an older build is redone, not misread.
+  std::string text = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
+  for (const auto& [k, v] : keys) {
+    if (tiling_only && !(k.starts_with("input.") || k.starts_with("tiling.") || k.starts_with("acquisition["))) {
+      continue;
+    }
+    text += k + "=" + v + "\n";
+  }
+  return fnv1a(text.data(), text.size());
+}
+
+void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
+  const std::filesystem::path file = work / kRunConfigFile;
+  std::ifstream in(file);
+  if (in) {
+    std::map<std::string, std::string> before;
+    try {
+      before = nlohmann::json::parse(in).at("keys").get<std::map<std::string, std::string>>();
+    } catch (const nlohmann::json::exception& e) {
+      if (!force) throw InputError(fmt::format("{}: malformed ({}); run with --force to start over", file.string(), e.what()));
+    }
+    std::vector<std::string> changed;
+    for (const auto& [k, v] : keys) {
+      const auto it = before.find(k);
+      if (it == before.end()) {
+        changed.push_back(fmt::format("{} (new: {})", k, v));
+      } else if (it->second != v) {
+        changed.push_back(fmt::format("{} ({} -> {})", k, it->second, v));
+      }
+    }
+    for (const auto& [k, v] : before) {
+      if (!keys.contains(k)) changed.push_back(fmt::format("{} (gone)", k));
+    }
+    if (!changed.empty() && !force) {
+      throw ConfigError(fmt::format("{}: the work there was done with another config; changed: {}. Run with --force to "
+                                    "discard it, or choose another [project] work folder",
+                                    work.string(), fmt::join(changed, "; ")));
+    }
+  }
+  std::filesystem::create_directories(work);
+  write_file_atomically(file, nlohmann::json{{"keys", keys}}.dump(1) + "\n");
+}
+
+}  // namespace citymesh::app

@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// Putting the tiles' results together: the merged mesh of every tile's selected owned
+// triangles, and (when asked) the change step's labels of every input triangle.
+#pragma once
+
+#include <optional>
+#include <vector>
+
+#include "citymesh/change/detect.h"
+#include "citymesh/mosaic/merged_mesh.h"
+#include "tile_job.h"
+
+namespace citymesh::app {
+
+class TileAssembly {
+ public:
+  /// `labels`: also gather the per-triangle labels and consistent pairs of every acquisition.
+  TileAssembly(const TileStore& store, bool labels);
+
+  /// Takes one tile's result (any order: the output does not depend on it).
+  void add(TileResult result);
+
+  /// The selected triangles sorted by (acquisition, triangle index), vertices shared within an
+  /// acquisition across tiles; per triangle its face in the input file.
+  struct Merged {
+    MergedMesh mesh;
+    std::vector<std::int32_t> faces;
+  };
+  [[nodiscard]] Merged merged() const;
+
+  /// The labels as the change step gives them for the whole input (consistent pairs sorted,
+  /// unique; statistics: triangle and pair counts). Only with `labels`.
+  [[nodiscard]] ChangeResult change() const;
+
+  [[nodiscard]] std::uint64_t owned() const { return owned_; }
+  [[nodiscard]] std::uint64_t candidates() const { return candidates_; }
+
+ private:
+  const TileStore& store_;
+  bool labels_;
+  GlobalTriangles index_;
+  std::vector<TilePiece> pieces_;
+  std::optional<ChangeResult> change_;
+  std::uint64_t owned_ = 0, candidates_ = 0;
+};
+
+}  // namespace citymesh::app

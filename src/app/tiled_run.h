@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+// `citymesh run` on the tile store: tile the acquisitions (or reuse the store), process the
+// tiles in parallel within the memory budget (reusing finished ones), then assemble, stitch
+// across tiles and write the outputs.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+
+#include "citymesh/config/config.h"
+#include "pipeline.h"
+
+namespace citymesh::app {
+
+struct TiledRunOptions {
+  bool force = false;  ///< discard work done with another config instead of refusing
+  PictureOptions pictures;
+};
+
+/// Runs every step tile by tile; see docs/tiling.md. Throws ConfigError when the work folder
+/// holds work made with a different result-affecting config and `force` is not set.
+void run_tiled(const Config& config, const TiledRunOptions& options);
+
+/// The config keys that change results (input, change, mosaic, tiling, the acquisitions and
+/// their files' sizes and modification times), flattened as "section.key" -> TOML value.
+std::map<std::string, std::string> result_keys(const Config& config);
+
+}  // namespace citymesh::app

@@ -1,0 +1,122 @@
+// SPDX-License-Identifier: MIT
+// citymesh run on the tile store, through the binary: tiled equals untiled, every triangle is
+// owned once, runs are deterministic whatever the thread count, killed runs resume to the
+// same bytes, and a changed config is refused without --force.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
+
+/// Every result file of a run (PLYs, pair lists), by name: what must not change. Summaries
+/// and the run report hold timings and are left out.
+std::map<std::string, std::string> result_bytes(const std::filesystem::path& output) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(output)) {
+    const auto ext = e.path().extension();
+    if (ext == ".ply" || ext == ".bin") files[std::filesystem::relative(e.path(), output).string()] = test::read_text(e.path());
+  }
+  return files;
+}
+
+std::string run_args(const std::string& sim, const std::string& name, const std::string& extra) {
+  return fmt::format("run {}/config.toml --no-pictures --set project.output={} --set project.work=work-{} {}", sim,
+                     name, name, extra);
+}
+
+TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {}", sim)).exit_code, 0);
+  for (const auto& [name, size] : {std::pair{"one", 1000}, std::pair{"many", 10}}) {
+    const auto run = test::run_citymesh(run_args(sim, name, fmt::format("--set tiling.tile_size={}", size)));
+    ASSERT_EQ(run.exit_code, 0) << run.err;
+    const auto eval = test::run_citymesh(fmt::format("eval {}/{} --truth {}", sim, name, sim));
+    ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  }
+  const nlohmann::json one = read_json(dir / "sim/one/run.json"), many = read_json(dir / "sim/many/run.json");
+  EXPECT_EQ(one["tiles"], 1);
+  EXPECT_GE(many["tiles"].get<int>(), 9);
+  // Every input triangle is owned by exactly one tile: the labels cover the input once.
+  std::uint64_t input = 0;
+  const nlohmann::json detect = read_json(dir / "sim/many/detect/summary.json");
+  for (const auto& a : detect["acquisitions"]) input += a["triangles"].get<std::uint64_t>();
+  EXPECT_EQ(many["input_triangles"].get<std::uint64_t>(), input);
+  EXPECT_GT(many["tiling"]["halo_copies"].get<std::uint64_t>(), 0u);
+
+  const nlohmann::json a = read_json(dir / "sim/one/eval.json"), b = read_json(dir / "sim/many/eval.json");
+  for (const char* key : {"static_completeness", "dynamic_removed_overall", "dynamic_residue"}) {
+    EXPECT_NEAR(a[key].get<double>(), b[key].get<double>(), 0.001) << key;
+  }
+  // Overlap and gaps along tile borders would show here: both within 0.1 percentage points.
+  for (const char* key : {"overlap_ratio", "hole_ratio", "static_completeness", "dynamic_residue"}) {
+    EXPECT_NEAR(a["mosaic"][key].get<double>(), b["mosaic"][key].get<double>(), 0.001) << key;
+  }
+}
+
+TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 40", sim)).exit_code, 0);
+  const std::string tiles = "--set tiling.tile_size=8";
+  ASSERT_EQ(test::run_citymesh(run_args(sim, "t1", tiles + " --threads 1")).exit_code, 0);
+  ASSERT_EQ(test::run_citymesh(run_args(sim, "t2", tiles + " --threads 2")).exit_code, 0);
+  const auto reference = result_bytes(dir / "sim/t1");
+  ASSERT_GE(reference.size(), 7u);  // labelled PLYs, pairs, mosaic
+  EXPECT_TRUE(result_bytes(dir / "sim/t2") == reference) << "1 and 2 threads differ";
+  EXPECT_GE(read_json(dir / "sim/t1/run.json")["tiles"].get<int>(), 9);
+
+  // Killed (SIGKILL) at several moments, then run to the end: the same bytes.
+  for (const double seconds : {0.3, 0.8, 1.5, 2.5}) {
+    const std::string cmd =
+        fmt::format("timeout -s KILL {} {} {} >/dev/null 2>&1", seconds, CITYMESH_BINARY, run_args(sim, "k", tiles));
+    (void)std::system(cmd.c_str());
+  }
+  const auto resumed = test::run_citymesh(run_args(sim, "k", tiles));
+  ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+  EXPECT_TRUE(result_bytes(dir / "sim/k") == reference) << "a killed and resumed run differs";
+  // A re-run reuses every tile.
+  const auto again = test::run_citymesh(run_args(sim, "k", tiles));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const nlohmann::json report = read_json(dir / "sim/k/run.json");
+  EXPECT_EQ(report["reused_tiles"], report["tiles"]);
+}
+
+TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  ASSERT_EQ(test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10")).exit_code, 0);
+  const auto reference = result_bytes(dir / "sim/c");
+
+  const auto changed = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2"));
+  EXPECT_EQ(changed.exit_code, 1);
+  EXPECT_NE(changed.err.find("change.distance_threshold (0.1 -> 0.2)"), std::string::npos) << changed.err;
+  EXPECT_NE(changed.err.find("--force"), std::string::npos) << changed.err;
+  // Settings that do not change results (threads, memory, pictures) resume freely.
+  EXPECT_EQ(test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --threads 1 --memory 512MiB")).exit_code, 0);
+
+  // A damaged tile result is processed again, to the same bytes.
+  const std::filesystem::path results = dir / ("sim/work-c/results");
+  const auto first = std::filesystem::directory_iterator(results)->path();
+  test::write_text(first, test::read_text(first).substr(0, 100));
+  const auto redone = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
+  ASSERT_EQ(redone.exit_code, 0) << redone.err;
+  EXPECT_NE(redone.err.find("processed again"), std::string::npos) << redone.err;
+  EXPECT_TRUE(result_bytes(dir / "sim/c") == reference);
+
+  const auto forced = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2 --force"));
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
+}
+
+}  // namespace
+}  // namespace citymesh
