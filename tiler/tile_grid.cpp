@@ -85,6 +85,9 @@ std::vector<TileKey> TileGrid::tiles_crossed(std::span<const Vec3d> points) cons
   Box3d box;
   for (const Vec3d& p : points) box.extend(p);
   const double h = params_.halo, s = params_.tile_size;
+  const TileKey lo = owner(box.min - Vec3d{h, h, 0}), hi = owner(box.max + Vec3d{h, h, 0});
+  // The shape grown by the halo inside one tile (the common case): no exact test needed.
+  if (lo == hi) return {lo};
   return tiles_near(box, [&](TileKey k) {
     const Vec3d c = corner(k);
     return hull_meets_rectangle(points, c.x - h, c.y - h, c.x + s + h, c.y + s + h);

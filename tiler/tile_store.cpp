@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/uio.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -41,11 +42,6 @@ std::uint32_t flags_of(const Mesh& m) {
   return (m.intensities.empty() ? 0 : kHasIntensity) | (m.colors.empty() ? 0 : kHasColor);
 }
 
-template <class T>
-void put(std::string& out, const std::vector<T>& values) {
-  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
-
 /// Reads consecutive arrays out of one block's payload.
 class PayloadReader {
  public:
@@ -80,47 +76,85 @@ void TilePiece::clear() {
   roles.clear();
 }
 
-std::string encode_tile_block(const TilePiece& piece) {
-  const Mesh& m = piece.mesh;
-  BlockHeader h{};
-  std::memcpy(h.magic, kMagic, sizeof kMagic);
-  h.version = kVersion;
-  h.flags = flags_of(m);
-  h.vertices = m.vertex_count();
-  h.triangles = m.triangle_count();
-  std::string payload;
-  payload.reserve(piece.byte_size());
-  put(payload, piece.vertex_ids);
-  put(payload, m.positions);
-  put(payload, m.sensor_positions);
-  if ((h.flags & kHasIntensity) != 0) put(payload, m.intensities);
-  if ((h.flags & kHasColor) != 0) put(payload, m.colors);
-  put(payload, m.triangles);
-  std::vector<std::uint64_t> faces(m.triangle_count());
-  std::vector<std::uint32_t> fans(m.triangle_count());
-  for (std::size_t t = 0; t < faces.size(); ++t) {
-    faces[t] = m.triangle_ids[t].face;
-    fans[t] = m.triangle_ids[t].fan;
+namespace {
+
+template <class T>
+std::string_view bytes_of(const std::vector<T>& values) {
+  return {reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)};
+}
+
+/// One block as consecutive byte ranges: the header, then the payload arrays in file order.
+struct BlockParts {
+  BlockHeader header{};
+  std::vector<std::uint64_t> faces;
+  std::vector<std::uint32_t> fans;
+  std::vector<std::string_view> parts;
+
+  explicit BlockParts(const TilePiece& piece) {
+    const Mesh& m = piece.mesh;
+    std::memcpy(header.magic, kMagic, sizeof kMagic);
+    header.version = kVersion;
+    header.flags = flags_of(m);
+    header.vertices = m.vertex_count();
+    header.triangles = m.triangle_count();
+    faces.resize(m.triangle_count());
+    fans.resize(m.triangle_count());
+    for (std::size_t t = 0; t < faces.size(); ++t) {
+      faces[t] = m.triangle_ids[t].face;
+      fans[t] = m.triangle_ids[t].fan;
+    }
+    parts = {bytes_of(piece.vertex_ids), bytes_of(m.positions), bytes_of(m.sensor_positions)};
+    if ((header.flags & kHasIntensity) != 0) parts.push_back(bytes_of(m.intensities));
+    if ((header.flags & kHasColor) != 0) parts.push_back(bytes_of(m.colors));
+    for (const std::string_view part : {bytes_of(m.triangles), bytes_of(faces), bytes_of(fans),
+                                        bytes_of(piece.triangle_index), bytes_of(piece.roles)}) {
+      parts.push_back(part);
+    }
+    header.checksum = fnv1a(nullptr, 0);
+    for (const std::string_view part : parts) header.checksum = fnv1a(part.data(), part.size(), header.checksum);
+    parts.insert(parts.begin(), std::string_view(reinterpret_cast<const char*>(&header), sizeof header));
   }
-  put(payload, faces);
-  put(payload, fans);
-  put(payload, piece.triangle_index);
-  put(payload, piece.roles);
-  h.checksum = fnv1a(payload.data(), payload.size());
-  return std::string(reinterpret_cast<const char*>(&h), sizeof h) + payload;
+  BlockParts(const BlockParts&) = delete;
+  BlockParts& operator=(const BlockParts&) = delete;
+};
+
+}  // namespace
+
+std::string encode_tile_block(const TilePiece& piece) {
+  const BlockParts block(piece);
+  std::string out;
+  out.reserve(piece.byte_size());
+  for (const std::string_view part : block.parts) out += part;
+  return out;
 }
 
 void append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
-  const std::string block = encode_tile_block(piece);
-  // Chunk files only count once the tiler's manifest names them; the sync makes sure the
-  // manifest never points at data still in the page cache.
+  const BlockParts block(piece);
+  std::vector<iovec> io;
+  std::size_t total = 0;
+  for (const std::string_view part : block.parts) {
+    io.push_back({const_cast<char*>(part.data()), part.size()});
+    total += part.size();
+  }
+  // No fsync here: sync_tile_files() makes the store durable once, before the manifest names it.
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   bool ok = fd >= 0;
-  ok = ok && ::write(fd, block.data(), block.size()) == static_cast<ssize_t>(block.size());
-  ok = ok && ::fsync(fd) == 0;
+  ok = ok && ::writev(fd, io.data(), static_cast<int>(io.size())) == static_cast<ssize_t>(total);
   const int err = errno;
   if (fd >= 0) ::close(fd);
   if (!ok) throw OutputError(fmt::format("{}: cannot append a tile block: {}", file.string(), std::strerror(err)));
+}
+
+void sync_tile_files(const std::filesystem::path& dir) {
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, ec)) {
+    const int fd = ::open(entry.path().c_str(), O_RDONLY | O_CLOEXEC);
+    const bool ok = fd >= 0 && ::fsync(fd) == 0;
+    const int err = errno;
+    if (fd >= 0) ::close(fd);
+    if (!ok) throw OutputError(fmt::format("{}: cannot sync: {}", entry.path().string(), std::strerror(err)));
+  }
+  if (ec) throw OutputError(fmt::format("{}: cannot list the tile store: {}", dir.string(), ec.message()));
 }
 
 TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin, std::uint32_t acquisition) {

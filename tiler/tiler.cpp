@@ -32,6 +32,7 @@ struct AcquisitionVertices {
 /// The triangles of the current acquisition bound for one tile, not yet on disk.
 struct TileBuffer {
   TilePiece piece;
+  std::array<std::uint64_t, 3> counts{};  ///< triangles per role since the last flush
   std::unordered_map<std::uint32_t, std::uint32_t> local;  ///< vertex id -> index in the piece
 };
 
@@ -100,7 +101,12 @@ class AcquisitionTiler {
   }
 
   void add_to(TileKey key, const Triangle& tri, const TriangleId& id, std::uint32_t index, TileRole role) {
-    TileBuffer& b = buffers_[key];
+    // Consecutive triangles mostly go to the same tile: skip the map lookup then.
+    if (last_ == nullptr || key != last_key_) {
+      last_ = &buffers_[key];
+      last_key_ = key;
+    }
+    TileBuffer& b = *last_;
     if (b.piece.mesh.positions.empty() && b.piece.mesh.triangles.empty()) b.piece.mesh.origin = grid_.corner(key);
     Triangle local{};
     for (std::size_t k = 0; k < 3; ++k) local[k] = local_vertex(b, tri[k]);
@@ -109,7 +115,7 @@ class AcquisitionTiler {
     b.piece.triangle_index.push_back(index);
     b.piece.roles.push_back(role);
     buffered_ += 29;
-    ++counts_[key][static_cast<std::size_t>(role)];
+    ++b.counts[static_cast<std::size_t>(role)];
   }
 
   std::uint32_t local_vertex(TileBuffer& b, std::uint32_t v) {
@@ -127,6 +133,7 @@ class AcquisitionTiler {
 
   void flush() {
     for (auto& [key, b] : buffers_) {
+      for (std::size_t r = 0; r < 3; ++r) counts_[key][r] += b.counts[r];
       if (b.piece.triangle_count() == 0) continue;
       const std::filesystem::path file = tile_chunk_path(store_.dir, key, acquisition_);
       std::filesystem::create_directories(file.parent_path());
@@ -135,6 +142,7 @@ class AcquisitionTiler {
       store_.stats.bytes_written += b.piece.byte_size();
     }
     buffers_.clear();
+    last_ = nullptr;
     buffered_ = 0;
   }
 
@@ -149,6 +157,8 @@ class AcquisitionTiler {
   std::uint64_t buffer_bytes_;
   AcquisitionVertices vertices_;
   std::map<TileKey, TileBuffer> buffers_;
+  TileBuffer* last_ = nullptr;  ///< the buffer of last_key_ (map nodes do not move)
+  TileKey last_key_;
   std::uint64_t buffered_ = 0;
   std::uint32_t next_index_ = 0;
   std::map<TileKey, std::array<std::uint64_t, 3>> counts_;
@@ -198,6 +208,7 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
     t.triangles.resize(acquisitions.size());
     if (t.owned() > 0) store.tiles.push_back(std::move(t));
   }
+  sync_tile_files(params.dir);
   store.stats.seconds = clock.seconds();
   return store;
 }

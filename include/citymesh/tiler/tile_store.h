@@ -45,9 +45,12 @@ std::string encode_tile_block(const TilePiece& piece);
 TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,
                              std::string_view source);
 
-/// Appends `piece` as one checksummed block (magic, version, counts, payload, FNV-1a) to
-/// `file`, creating it. Throws OutputError naming the file.
+/// Appends `piece` as one checksummed block to `file`, creating it (not synced: see
+/// sync_tile_files). Throws OutputError naming the file.
 void append_tile_block(const std::filesystem::path& file, const TilePiece& piece);
+
+/// fsyncs every file under `dir` (and the folders): the tile store is durable once this returns.
+void sync_tile_files(const std::filesystem::path& dir);
 
 /// Reads every block of `file` into one piece in the frame `origin`: vertices of several blocks
 /// with the same id become one (the first block's copy), triangles keep the order in which
