@@ -9,6 +9,7 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "run_state.h"
 #include "tiled_run.h"
 
@@ -79,10 +80,15 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     std::vector<std::string> changed;
     for (const auto& [k, v] : keys) {
       const auto it = before.find(k);
-      if (it == before.end()) {
-        changed.push_back(fmt::format("{} (new: {})", k, v));
-      } else if (it->second != v) {
-        changed.push_back(fmt::format("{} ({} -> {})", k, it->second, v));
+      const std::string what = it == before.end() ? fmt::format("{} (new: {})", k, v)
+                               : it->second != v  ? fmt::format("{} ({} -> {})", k, it->second, v)
+                                                  : std::string();
+      if (what.empty()) continue;
+      // A rewritten input file is not a config change: its tiles are simply redone.
+      if (k.ends_with(".file")) {
+        log::warn("{} changed since the last run ({}): its work is redone", k, what);
+      } else {
+        changed.push_back(what);
       }
     }
     for (const auto& [k, v] : before) {

@@ -113,6 +113,16 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   EXPECT_NE(redone.err.find("processed again"), std::string::npos) << redone.err;
   EXPECT_TRUE(result_bytes(dir / "sim/c") == reference);
 
+  // A rewritten input file (same bytes, new modification time) is redone, not refused.
+  const std::string input = test::read_text(dir / "sim/acq_0.ply");
+  std::filesystem::remove(dir / "sim/acq_0.ply");
+  test::write_text(dir / "sim/acq_0.ply", input);
+  const auto rewritten = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
+  ASSERT_EQ(rewritten.exit_code, 0) << rewritten.err;
+  EXPECT_NE(rewritten.err.find("acquisition[0].file changed"), std::string::npos) << rewritten.err;
+  EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
+  EXPECT_TRUE(result_bytes(dir / "sim/c") == reference);
+
   const auto forced = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2 --force"));
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
