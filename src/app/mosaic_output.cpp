@@ -4,6 +4,7 @@
 #include <array>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/render/render.h"
 
@@ -38,24 +39,25 @@ void write_picture(const std::filesystem::path& path, const MergedMesh& merged, 
 
 }  // namespace
 
-std::vector<std::int32_t> source_faces(const LoadedAcquisitions& input, const MergedMesh& merged) {
-  std::vector<std::vector<std::int32_t>> per_acquisition(input.meshes.size());
-  for (std::size_t k = 0; k < input.meshes.size(); ++k) per_acquisition[k] = input.source_faces(k);
+std::vector<std::int32_t> source_faces(const MergedMesh& merged) {
+  const Mesh& m = merged.mesh;
+  if (m.triangle_ids.size() != m.triangle_count()) {
+    throw ProcessingError("mosaic output: the merged mesh lost its triangle ids");
+  }
   std::vector<std::int32_t> out(merged.source_acq.size(), kNoSource);
   for (std::size_t t = 0; t < out.size(); ++t) {
-    const std::int32_t a = merged.source_acq[t];
-    if (a >= 0) out[t] = per_acquisition[static_cast<std::size_t>(a)][static_cast<std::size_t>(merged.source_triangle[t])];
+    if (merged.source_acq[t] != kNoSource) out[t] = static_cast<std::int32_t>(m.triangle_ids[t].face);
   }
   return out;
 }
 
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
-                          std::span<const std::int32_t> faces, const MosaicStats& s,
-                          const MosaicOutputParams& params) {
+                          const MosaicStats& s, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
+  const std::vector<std::int32_t> faces = source_faces(merged);
   write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
                  {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
-                  {"source_face", faces}});
+                  {"source_face", std::span<const std::int32_t>(faces)}});
   if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
 
   nlohmann::json summary;

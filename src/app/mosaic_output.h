@@ -25,15 +25,11 @@ struct MosaicOutputParams {
   nlohmann::json stitch;   ///< stitching figures, for the summary
 };
 
-/// Writes <dir>/mosaic.ply, mosaic.png and summary.json (last), each atomically. `faces`: per
-/// merged triangle, its face index in the input file (-1 for stitch triangles); `input` needs
-/// only its acquisitions and dates.
+/// Writes <dir>/mosaic.ply, mosaic.png and summary.json (last), each atomically. `input` needs
+/// only its acquisitions and dates; each face's source_face comes from the merged mesh's
+/// triangle ids (merging, snapping and stitching keep them).
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
-                          std::span<const std::int32_t> faces, const MosaicStats& stats,
-                          const MosaicOutputParams& params);
-
-/// The face index in the input file of every merged triangle (-1 for stitch triangles).
-std::vector<std::int32_t> source_faces(const LoadedAcquisitions& input, const MergedMesh& merged);
+                          const MosaicStats& stats, const MosaicOutputParams& params);
 
 /// Colour of a source acquisition in the pictures (stitch triangles: magenta).
 Rgb8 source_color(std::int32_t acquisition);

@@ -79,7 +79,7 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
       config.mosaic.method == MosaicMethod::energy ? stitch_and_report(config, merged) : nlohmann::json::object();
   seconds["stitch"] = clock.restart();
   const std::filesystem::path dir = config.project.output / "mosaic";
-  write_mosaic_outputs(config, input, merged, source_faces(input, merged), selection.stats,
+  write_mosaic_outputs(config, input, merged, selection.stats,
                        {.dir = dir,
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,

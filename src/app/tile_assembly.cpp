@@ -60,7 +60,7 @@ void TileAssembly::add(TileResult result) {
   }
 }
 
-TileAssembly::Merged TileAssembly::merged() const {
+MergedMesh TileAssembly::merged() const {
   // (acquisition, triangle index, piece, triangle in piece): the output order is the input's.
   std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> order;
   bool intensities = true, colors = true;
@@ -73,8 +73,8 @@ TileAssembly::Merged TileAssembly::merged() const {
     }
   }
   std::sort(order.begin(), order.end());
-  Merged out;
-  Mesh& m = out.mesh.mesh;
+  MergedMesh out;
+  Mesh& m = out.mesh;
   if (!order.empty()) {
     const TilePiece& first = pieces_[std::get<2>(order.front())];
     m.origin = whole_metre_origin(first.mesh.world_position(first.mesh.triangles[std::get<3>(order.front())][0]));
@@ -97,9 +97,8 @@ TileAssembly::Merged TileAssembly::merged() const {
     }
     m.triangles.push_back(tri);
     m.triangle_ids.push_back(piece.mesh.triangle_ids[t]);
-    out.mesh.source_acq.push_back(static_cast<std::int32_t>(a));
-    out.mesh.source_triangle.push_back(static_cast<std::int32_t>(index));
-    out.faces.push_back(static_cast<std::int32_t>(piece.mesh.triangle_ids[t].face));
+    out.source_acq.push_back(static_cast<std::int32_t>(a));
+    out.source_triangle.push_back(static_cast<std::int32_t>(index));
   }
   return out;
 }

@@ -20,13 +20,9 @@ class TileAssembly {
   /// Takes one tile's result (any order: the output does not depend on it).
   void add(TileResult result);
 
-  /// The selected triangles sorted by (acquisition, triangle index), vertices shared within an
-  /// acquisition across tiles; per triangle its face in the input file.
-  struct Merged {
-    MergedMesh mesh;
-    std::vector<std::int32_t> faces;
-  };
-  [[nodiscard]] Merged merged() const;
+  /// The selected triangles sorted by (acquisition, triangle index), with their global ids;
+  /// vertices shared within an acquisition across tiles.
+  [[nodiscard]] MergedMesh merged() const;
 
   /// The labels as the change step gives them for the whole input (consistent pairs sorted,
   /// unique; statistics: triangle and pair counts). Only with `labels`.

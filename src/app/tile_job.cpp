@@ -38,10 +38,6 @@ MosaicSelection select(const Config& config, const std::vector<Mesh>& meshes, co
                                                             : select_mosaic(in, config.mosaic);
 }
 
-bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
-  return std::pair{x.acquisition, x.index} < std::pair{y.acquisition, y.index};
-}
-
 /// The selected owned triangles of one piece, with only the vertices they use.
 TilePiece selected_part(const TilePiece& piece, std::span<const std::uint8_t> selected) {
   TilePiece out;
@@ -72,6 +68,10 @@ TilePiece selected_part(const TilePiece& piece, std::span<const std::uint8_t> se
 }
 
 }  // namespace
+
+bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
+  return std::pair{x.acquisition, x.index} < std::pair{y.acquisition, y.index};
+}
 
 int tile_phase(TileKey key) { return (key.i & 1) * 2 + (key.j & 1); }
 

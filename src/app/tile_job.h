@@ -25,6 +25,9 @@ struct OwnedLabel {
 };
 static_assert(sizeof(OwnedLabel) == 32);
 
+/// The order of labels in a tile result: by acquisition, then triangle index.
+bool by_triangle(const OwnedLabel& x, const OwnedLabel& y);
+
 /// A consistent pair with at least one owned member, as (acquisition, index) twice.
 struct LabelPair {
   std::uint32_t a_acquisition = 0, a_index = 0, b_acquisition = 0, b_index = 0;

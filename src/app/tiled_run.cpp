@@ -7,7 +7,6 @@
 #include <condition_variable>
 #include <iostream>
 #include <mutex>
-#include <unordered_map>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
@@ -80,10 +79,6 @@ class Progress {
   Stopwatch clock_, since_line_;
 };
 
-std::uint64_t source_key(std::int32_t acquisition, std::int32_t triangle) {
-  return (std::uint64_t(std::uint32_t(acquisition)) << 32) | std::uint32_t(triangle);
-}
-
 std::filesystem::path result_path(const Config& config, TileKey key) {
   return config.project.work / "results" / (key.name() + ".bin");
 }
@@ -129,9 +124,7 @@ std::vector<OwnedLabel> settled_labels(const Config& config, const TileStore& st
       labels.insert(labels.end(), r->labels.begin(), r->labels.end());
     }
   }
-  std::sort(labels.begin(), labels.end(), [](const OwnedLabel& x, const OwnedLabel& y) {
-    return std::pair{x.acquisition, x.index} < std::pair{y.acquisition, y.index};
-  });
+  std::sort(labels.begin(), labels.end(), by_triangle);
   return labels;
 }
 
@@ -230,32 +223,21 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
     if (!r) throw ProcessingError(fmt::format("{}: the tile result vanished", result_path(config, tile.key).string()));
     assembly.add(std::move(*r));
   }
-  TileAssembly::Merged merged = assembly.merged();
-  // Stitching splits triangles (keeping their source) and adds its own: faces are looked up
-  // again afterwards by source.
-  std::unordered_map<std::uint64_t, std::int32_t> face_of;
-  for (std::size_t t = 0; t < merged.faces.size(); ++t) {
-    face_of[source_key(merged.mesh.source_acq[t], merged.mesh.source_triangle[t])] = merged.faces[t];
-  }
+  MergedMesh merged = assembly.merged();
+  const std::uint64_t selected = merged.mesh.triangle_count();
   seconds["assembly"] = clock.restart();
   if (config.output.labels) write_labels(config, assembly, options.pictures);
   seconds["labels"] = clock.restart();
   // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
   // like seams inside a tile.
   const nlohmann::json stitched = config.mosaic.method == MosaicMethod::energy
-                                      ? stitch_and_report(config, merged.mesh)
+                                      ? stitch_and_report(config, merged)
                                       : nlohmann::json::object();
   seconds["stitch"] = clock.restart();
   MosaicStats stats;
   stats.candidates = assembly.candidates();
-  stats.selected = merged.faces.size();
-  std::vector<std::int32_t> faces(merged.mesh.source_acq.size(), kNoSource);
-  for (std::size_t t = 0; t < faces.size(); ++t) {
-    if (merged.mesh.source_acq[t] != kNoSource) {
-      faces[t] = face_of.at(source_key(merged.mesh.source_acq[t], merged.mesh.source_triangle[t]));
-    }
-  }
-  write_mosaic_outputs(config, describe_acquisitions(config), merged.mesh, faces, stats,
+  stats.selected = selected;
+  write_mosaic_outputs(config, describe_acquisitions(config), merged, stats,
                        {.dir = config.project.output / "mosaic",
                         .pixel_size = options.pictures.pixel_size,
                         .pictures = options.pictures.pictures,
@@ -268,7 +250,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
   report["tiles"] = store.tiles.size();
   report["reused_tiles"] = times.reused;
   report["input_triangles"] = assembly.owned();
-  report["output_triangles"] = merged.mesh.mesh.triangle_count();
+  report["output_triangles"] = merged.mesh.triangle_count();
   report["threads"] = available_threads();
   report["memory_budget"] = format_byte_size(config.run.memory);
   report["peak_rss_bytes"] = peak_resident_bytes();
@@ -282,7 +264,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
   std::cout << fmt::format("run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
                            "({:.2f} M triangles/s), peak memory {:.0f} MiB\n",
-                           store.tiles.size(), times.reused, assembly.owned(), merged.mesh.mesh.triangle_count(),
+                           store.tiles.size(), times.reused, assembly.owned(), merged.mesh.triangle_count(),
                            wall, static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6,
                            static_cast<double>(peak_resident_bytes()) / (1 << 20));
 }
