@@ -24,3 +24,6 @@ if(NOT TARGET GeographicLib::GeographicLib)
   target_include_directories(GeographicLib::GeographicLib SYSTEM INTERFACE ${GeographicLib_INCLUDE_DIRS})
   target_link_libraries(GeographicLib::GeographicLib INTERFACE ${GeographicLib_LIBRARIES})
 endif()
+
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)

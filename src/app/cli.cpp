@@ -22,6 +22,8 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   commands.push_back(make_mosaic_command());
   commands.push_back(make_run_command());
   commands.push_back(make_eval_command());
+  commands.push_back(make_check_command());
+  commands.push_back(make_view_command());
   return commands;
 }
 

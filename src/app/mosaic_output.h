@@ -31,6 +31,10 @@ struct MosaicOutputParams {
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
                           const MosaicStats& stats, const MosaicOutputParams& params);
 
+/// Per triangle of the merged mesh: its face index in its source acquisition's file
+/// (kNoSource for stitch triangles).
+std::vector<std::int32_t> source_faces(const MergedMesh& merged);
+
 /// Colour of a source acquisition in the pictures (stitch triangles: magenta).
 Rgb8 source_color(std::int32_t acquisition);
 

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "mosaic_step.h"
 
+#include "tileset_output.h"
+
 #include <fmt/format.h>
 
 #include <iostream>
@@ -86,6 +88,7 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
                         .seconds = std::move(seconds),
                         .stitch = stitched});
   report(dir, merged, selection.stats);
+  write_tileset_outputs(config, merged);
 }
 
 ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAcquisitions& input) {

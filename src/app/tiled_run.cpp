@@ -23,6 +23,7 @@
 #include "run_state.h"
 #include "tile_assembly.h"
 #include "tile_job.h"
+#include "tileset_output.h"
 
 namespace citymesh::app {
 
@@ -244,6 +245,8 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
                         .seconds = seconds,
                         .stitch = stitched});
   seconds["outputs"] = clock.restart();
+  const nlohmann::json exported = write_tileset_outputs(config, merged);
+  seconds["export"] = clock.restart();
 
   const double wall = total.seconds();
   nlohmann::json report;
@@ -260,6 +263,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
   report["tiling"] = {{"halo_copies", store.stats.halo_copies},
                       {"empty_space_copies", store.stats.empty_space_copies},
                       {"bytes_written", store.stats.bytes_written}};
+  report["export"] = exported;
   report["per_tile"] = times.per_tile;
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
   std::cout << fmt::format("run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "

@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <stdio.h>  // renameat2
+
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -63,6 +65,20 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
   AtomicFile file(path);
   file.write(content);
   file.commit();
+}
+
+void replace_directory_atomically(const std::filesystem::path& staged, const std::filesystem::path& target) {
+  fsync_directory(staged);
+  std::error_code ec;
+  if (!std::filesystem::exists(target, ec)) {
+    if (std::rename(staged.c_str(), target.c_str()) != 0) fail(target, "rename the staged folder onto");
+  } else {
+    if (::renameat2(AT_FDCWD, staged.c_str(), AT_FDCWD, target.c_str(), RENAME_EXCHANGE) != 0) {
+      fail(target, "swap in the staged folder");
+    }
+    std::filesystem::remove_all(staged, ec);  // now the old content
+  }
+  fsync_directory(target.parent_path());
 }
 
 }  // namespace citymesh

@@ -206,6 +206,33 @@ Vec3d Crs::from_ecef(const Vec3d& ecef) const {
   return from_geodetic(g);
 }
 
+EnuFrame::EnuFrame(const Geodetic& origin) : origin_(origin) {
+  std::vector<double> m(9);
+  gl::Geocentric::WGS84().Forward(origin.lat, origin.lon, origin.height, origin_ecef_.x, origin_ecef_.y,
+                                  origin_ecef_.z, m);
+  std::copy(m.begin(), m.end(), rotation_.begin());
+}
+
+Vec3d EnuFrame::to_ecef(const Vec3d& enu) const {
+  const auto& r = rotation_;
+  return {origin_ecef_.x + r[0] * enu.x + r[1] * enu.y + r[2] * enu.z,
+          origin_ecef_.y + r[3] * enu.x + r[4] * enu.y + r[5] * enu.z,
+          origin_ecef_.z + r[6] * enu.x + r[7] * enu.y + r[8] * enu.z};
+}
+
+Vec3d EnuFrame::from_ecef(const Vec3d& ecef) const {
+  const auto& r = rotation_;
+  const Vec3d d = ecef - origin_ecef_;
+  return {r[0] * d.x + r[3] * d.y + r[6] * d.z, r[1] * d.x + r[4] * d.y + r[7] * d.z,
+          r[2] * d.x + r[5] * d.y + r[8] * d.z};
+}
+
+std::array<double, 16> EnuFrame::to_ecef_matrix() const {
+  const auto& r = rotation_;
+  return {r[0], r[3], r[6], 0, r[1], r[4], r[7], 0, r[2], r[5], r[8], 0,
+          origin_ecef_.x, origin_ecef_.y, origin_ecef_.z, 1};
+}
+
 VerticalDatum parse_vertical_datum(std::string_view kind, double geoid_undulation) {
   if (!std::isfinite(geoid_undulation) || std::abs(geoid_undulation) > 150) {
     throw ConfigError(fmt::format("geoid_undulation {} m is not a plausible undulation (|N| <= 150 m)",

@@ -45,4 +45,22 @@ void write_png(const std::filesystem::path& path, const Image& image) {
   write_file_atomically(path, encoded);
 }
 
+Image read_png(const std::filesystem::path& path) {
+  png_image png{};
+  png.version = PNG_IMAGE_VERSION;
+  if (png_image_begin_read_from_file(&png, path.c_str()) == 0) {
+    throw InputError(fmt::format("{}: cannot read as PNG: {}", path.string(), png.message));
+  }
+  png.format = PNG_FORMAT_RGB;
+  Image image;
+  image.width = png.width;
+  image.height = png.height;
+  image.pixels.resize(std::size_t(png.width) * png.height);
+  if (png_image_finish_read(&png, nullptr, image.pixels.data(), 0, nullptr) == 0) {
+    png_image_free(&png);
+    throw InputError(fmt::format("{}: cannot decode the PNG: {}", path.string(), png.message));
+  }
+  return image;
+}
+
 }  // namespace citymesh

@@ -36,4 +36,9 @@ class AtomicFile {
 /// Writes `content` to `path` atomically.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
+/// Puts the finished folder `staged` in place of `target` in one step (the old `target`, if
+/// any, is swapped out and removed), then fsyncs their parent: readers see the old folder or
+/// the complete new one, never a mix. Throws OutputError naming the folders.
+void replace_directory_atomically(const std::filesystem::path& staged, const std::filesystem::path& target);
+
 }  // namespace citymesh

@@ -3,6 +3,7 @@
 // (GeographicLib behind this header).
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -57,6 +58,23 @@ class Crs {
  private:
   explicit Crs(std::shared_ptr<const Impl> impl) : impl_(std::move(impl)) {}
   std::shared_ptr<const Impl> impl_;
+};
+
+/// A local east-north-up frame tangent to the WGS 84 ellipsoid at a point (the frame of 3D
+/// Tiles content): conversions to and from ECEF as doubles.
+class EnuFrame {
+ public:
+  explicit EnuFrame(const Geodetic& origin);
+  [[nodiscard]] Vec3d to_ecef(const Vec3d& enu) const;
+  [[nodiscard]] Vec3d from_ecef(const Vec3d& ecef) const;
+  /// The 4x4 ENU -> ECEF transform, column-major (a 3D Tiles `transform`).
+  [[nodiscard]] std::array<double, 16> to_ecef_matrix() const;
+  [[nodiscard]] const Geodetic& origin() const { return origin_; }
+
+ private:
+  Geodetic origin_;
+  Vec3d origin_ecef_;
+  std::array<double, 9> rotation_{};  ///< row-major; ECEF = rotation * ENU + origin
 };
 
 /// Parses "ellipsoidal" or "orthometric" (with its undulation); throws ConfigError otherwise.

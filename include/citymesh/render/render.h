@@ -38,6 +38,10 @@ Image render_orthographic(std::span<const RenderLayer> layers, const ViewParams&
 /// Writes an 8-bit RGB PNG atomically. Throws OutputError naming the file.
 void write_png(const std::filesystem::path& path, const Image& image);
 
+/// Reads a PNG of any colour type as 8-bit RGB (alpha dropped). Throws InputError naming the
+/// file when it cannot be read or decoded.
+Image read_png(const std::filesystem::path& path);
+
 /// A distinct, stable colour for small integers (classes, epochs).
 Rgb8 palette_color(std::uint32_t index);
 

@@ -1,0 +1,59 @@
+// SPDX-License-Identifier: MIT
+// The level-of-detail tree of a tileset: leaves are the grid tiles of the output; each parent
+// merges its (up to four) children and simplifies them with locked borders.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "citymesh/core/mesh.h"
+#include "citymesh/tiler/tile_grid.h"
+#include "citymesh/tiles3d/simplify.h"
+
+namespace citymesh {
+
+/// The vertex buffer every tile draws from: positions in the tileset's local frame, one source
+/// acquisition (feature id) per vertex, and the input's intensity or colour when it has them.
+struct TilesetVertices {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint16_t> feature_ids;
+  std::vector<float> intensities;  ///< empty or one per vertex
+  std::vector<Rgb8> colors;        ///< empty or one per vertex
+};
+
+/// A tile's mesh: the global vertices it uses (ascending) and its triangles in local indices.
+struct TileMesh {
+  std::vector<std::uint32_t> vertices;
+  std::vector<Triangle> triangles;
+};
+
+struct TileNode {
+  int level = 0;  ///< 0: leaves; a level-l tile covers 2^l x 2^l grid tiles
+  TileKey key;    ///< grid key at its level: leaf keys shifted right by `level`
+  TileMesh mesh;
+  double geometric_error = 0.0;  ///< metres; 0 on leaves, > 0 on parents
+  Box3d box;                     ///< local frame: its content and its children's
+  std::vector<std::uint32_t> children;
+  /// "t<level>_<i>_<j>": the stem of its files.
+  [[nodiscard]] std::string name() const;
+};
+
+struct TileTree {
+  std::vector<TileNode> nodes;  ///< leaves first, then level by level; the root is last
+  [[nodiscard]] const TileNode& root() const { return nodes.back(); }
+};
+
+struct TileTreeParams {
+  SimplifyParams simplify;
+  double min_geometric_error = 0.001;  ///< metres: a parent's error is never below this
+};
+
+/// Builds the tree from the triangles (global vertex indices) and each triangle's leaf key.
+/// The result depends only on the input, never on the thread count. An empty input gives an
+/// empty tree.
+TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
+                         std::span<const TileKey> leaf_keys, const TileTreeParams& params);
+
+}  // namespace citymesh

@@ -1,0 +1,113 @@
+// SPDX-License-Identifier: MIT
+#include "tileset_output.h"
+
+#include <fmt/format.h>
+
+#include <iostream>
+#include <map>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/stopwatch.h"
+#include "citymesh/io/ply_writer.h"
+#include "citymesh/tiles3d/export.h"
+#include "mosaic_output.h"
+
+namespace citymesh::app {
+
+namespace {
+
+TileGridParams grid_params(const Config& config) {
+  return {.tile_size = config.tiling.tile_size, .halo = config.tiling.halo, .origin = config.tiling.origin};
+}
+
+nlohmann::json write_3d_tiles(const Config& config, const MergedMesh& merged) {
+  TilesetExportParams params;
+  params.dir = config.project.output / "tiles";
+  params.grid = grid_params(config);
+  params.tolerance = config.output.draco_tolerance;
+  for (const AcquisitionEntry& a : config.acquisitions) params.acquisitions.push_back({a.name, format_iso8601(a.time)});
+  const Crs crs = config.crs();
+  const TilesetExportStats s = export_tileset({merged.mesh, merged.source_acq, crs}, params);
+  std::cout << fmt::format("3D Tiles: {} tiles ({} leaves, {} levels) of {} triangles, {:.1f} bytes per leaf triangle, "
+                           "{}-bit positions ({:.2f} mm step), {:.2f} s -> {}\n",
+                           s.tiles, s.leaves, s.levels, s.leaf_triangles,
+                           static_cast<double>(s.glb_bytes) / static_cast<double>(std::max<std::uint64_t>(s.all_triangles, 1)),
+                           s.position_bits, s.quantization_step * 1e3, s.seconds, (params.dir / "tileset.json").string());
+  return {{"tiles", s.tiles},
+          {"leaves", s.leaves},
+          {"levels", s.levels},
+          {"json_files", s.json_files},
+          {"leaf_triangles", s.leaf_triangles},
+          {"all_triangles", s.all_triangles},
+          {"glb_bytes", s.glb_bytes},
+          {"position_bits", s.position_bits},
+          {"quantization_step_m", s.quantization_step},
+          {"origin", {{"lat", s.origin.lat}, {"lon", s.origin.lon}, {"height", s.origin.height}}},
+          {"seconds", s.seconds}};
+}
+
+/// The triangles `keep` of `mesh`, with only the vertices they use.
+Mesh sub_mesh(const Mesh& mesh, std::span<const std::uint32_t> keep) {
+  Mesh out;
+  out.origin = mesh.origin;
+  std::map<std::uint32_t, std::uint32_t> remap;
+  auto vertex = [&](std::uint32_t v) {
+    const auto [it, added] = remap.try_emplace(v, static_cast<std::uint32_t>(out.positions.size()));
+    if (added) {
+      out.positions.push_back(mesh.positions[v]);
+      if (mesh.has_sensor_positions()) out.sensor_positions.push_back(mesh.sensor_positions[v]);
+      if (!mesh.times.empty()) out.times.push_back(mesh.times[v]);
+      if (!mesh.intensities.empty()) out.intensities.push_back(mesh.intensities[v]);
+      if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
+    }
+    return it->second;
+  };
+  for (const std::uint32_t t : keep) {
+    const Triangle& tri = mesh.triangles[t];
+    out.triangles.push_back({vertex(tri[0]), vertex(tri[1]), vertex(tri[2])});
+    out.triangle_ids.push_back(mesh.triangle_ids[t]);
+  }
+  return out;
+}
+
+nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
+  Stopwatch clock;
+  const std::vector<TileKey> keys = leaf_keys(merged.mesh, TileGrid(grid_params(config)));
+  std::map<TileKey, std::vector<std::uint32_t>> tiles;
+  for (std::size_t t = 0; t < keys.size(); ++t) tiles[keys[t]].push_back(static_cast<std::uint32_t>(t));
+  const std::vector<std::int32_t> faces = source_faces(merged);
+  const std::filesystem::path dir = config.project.output / "ply";
+  std::filesystem::path staged = dir;
+  staged += ".partial";
+  std::filesystem::remove_all(staged);
+  for (const auto& [key, triangles] : tiles) {
+    std::vector<std::int32_t> acq, face;
+    for (const std::uint32_t t : triangles) {
+      acq.push_back(merged.source_acq[t]);
+      face.push_back(faces[t]);
+    }
+    write_mesh_ply(staged / (key.name() + ".ply"), sub_mesh(merged.mesh, triangles),
+                   {{kSourceAcqProperty, std::span<const std::int32_t>(acq)},
+                    {"source_face", std::span<const std::int32_t>(face)}});
+  }
+  replace_directory_atomically(staged, dir);
+  std::cout << fmt::format("provenance PLY: {} tiles -> {}\n", tiles.size(), dir.string());
+  return {{"files", tiles.size()}, {"seconds", clock.seconds()}};
+}
+
+}  // namespace
+
+nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged) {
+  nlohmann::json report = nlohmann::json::object();
+  if (merged.mesh.triangle_count() == 0) {
+    if (config.output.tiles_3d || config.output.ply) log::warn("the output has no triangles: no tileset written");
+    return report;
+  }
+  if (config.output.tiles_3d) report["tiles_3d"] = write_3d_tiles(config, merged);
+  if (config.output.ply) report["ply"] = write_tile_plys(config, merged);
+  return report;
+}
+
+}  // namespace citymesh::app

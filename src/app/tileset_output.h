@@ -1,0 +1,17 @@
+// SPDX-License-Identifier: MIT
+// What `citymesh run` and `citymesh mosaic` write for viewers and analysis: the 3D Tiles
+// tileset (<output>/tiles) and, when [output] ply asks, one provenance PLY per tile
+// (<output>/ply/<i>_<j>.ply, DESIGN §3).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "citymesh/config/config.h"
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh::app {
+
+/// Writes what [output] asks for; returns figures for the run report ({} when nothing).
+nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged);
+
+}  // namespace citymesh::app

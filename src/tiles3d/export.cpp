@@ -1,0 +1,197 @@
+// SPDX-License-Identifier: MIT
+#include "citymesh/tiles3d/export.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/stopwatch.h"
+#include "tileset_json.h"
+
+namespace citymesh {
+
+namespace {
+
+/// Origin of the local frame: the centre of the output's x-y extent at its lowest z, in whole
+/// metres so that it reads well and does not depend on float rounding.
+Vec3d frame_origin(const Mesh& mesh) {
+  Box3d box;
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) box.extend(mesh.world_position(v));
+  return {std::round((box.min.x + box.max.x) / 2), std::round((box.min.y + box.max.y) / 2), std::round(box.min.z)};
+}
+
+std::vector<Vec3f> local_positions(const Mesh& mesh, const Crs& crs, const EnuFrame& frame) {
+  std::vector<Vec3f> out(mesh.vertex_count());
+  parallel_for_blocks(out.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) out[v] = Vec3f(frame.from_ecef(crs.to_ecef(mesh.world_position(v))));
+  });
+  return out;
+}
+
+/// One vertex per (input vertex, source acquisition) pair, so that every vertex has one
+/// feature id; triangles re-indexed onto the split vertices.
+struct SplitMesh {
+  TilesetVertices vertices;
+  std::vector<Triangle> triangles;
+};
+
+std::uint16_t feature_of(std::int32_t source) {
+  return source < 0 ? kNullFeatureId : static_cast<std::uint16_t>(source);
+}
+
+SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source_acq, std::span<const Vec3f> local) {
+  auto key = [](std::uint32_t v, std::uint16_t f) { return (std::uint64_t{v} << 16) | f; };
+  std::vector<std::uint64_t> keys;
+  keys.reserve(mesh.triangle_count() * 3);
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (const std::uint32_t v : mesh.triangles[t]) keys.push_back(key(v, feature_of(source_acq[t])));
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  SplitMesh out;
+  TilesetVertices& vx = out.vertices;
+  for (const std::uint64_t k : keys) {
+    const auto v = static_cast<std::uint32_t>(k >> 16);
+    vx.positions.push_back(local[v]);
+    vx.feature_ids.push_back(static_cast<std::uint16_t>(k & 0xFFFF));
+    if (!mesh.intensities.empty()) vx.intensities.push_back(mesh.intensities[v]);
+    if (!mesh.colors.empty()) vx.colors.push_back(mesh.colors[v]);
+  }
+  auto index = [&](std::uint32_t v, std::int32_t source) {
+    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), key(v, feature_of(source))) -
+                                      keys.begin());
+  };
+  out.triangles.reserve(mesh.triangle_count());
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    out.triangles.push_back({index(tri[0], source_acq[t]), index(tri[1], source_acq[t]), index(tri[2], source_acq[t])});
+  }
+  return out;
+}
+
+/// The Draco lattice covering every vertex, with bits for the tolerance.
+DracoEncodeParams shared_lattice(std::span<const Vec3f> positions, const TilesetExportParams& params) {
+  Box3d box;
+  for (const Vec3f& p : positions) box.extend(Vec3d(p));
+  // Whole metres, one metre of margin: exact in float, the same whatever the tile.
+  const Vec3d lo{std::floor(box.min.x) - 1, std::floor(box.min.y) - 1, std::floor(box.min.z) - 1};
+  const double range = std::ceil(std::max({box.max.x - lo.x, box.max.y - lo.y, box.max.z - lo.z})) + 1;
+  // Rounding moves a position by at most half a step: step = range / (2^bits - 1) <= 2 tolerance.
+  const double levels = range / (2 * params.tolerance);
+  const int bits = std::max(1, static_cast<int>(std::ceil(std::log2(levels + 1))));
+  if (bits > 30) {
+    throw ConfigError(fmt::format("output.draco_tolerance {} m is too fine for an output {} m across "
+                                  "(Draco quantizes to at most 30 bits)", params.tolerance, range));
+  }
+  DracoEncodeParams draco;
+  draco.position_bits = bits;
+  draco.speed = params.draco_speed;
+  draco.lattice = DracoLattice{{static_cast<float>(lo.x), static_cast<float>(lo.y), static_cast<float>(lo.z)},
+                               static_cast<float>(range)};
+  return draco;
+}
+
+/// The tile's own vertex attributes, gathered from the shared buffer.
+struct TileAttributes {
+  std::vector<Vec3f> positions;
+  std::vector<std::uint16_t> feature_ids;
+  std::vector<float> intensities;
+  std::vector<Rgb8> colors;
+};
+
+TileAttributes gather(const TilesetVertices& all, const TileMesh& mesh) {
+  TileAttributes a;
+  for (const std::uint32_t v : mesh.vertices) {
+    a.positions.push_back(all.positions[v]);
+    a.feature_ids.push_back(all.feature_ids[v]);
+    if (!all.intensities.empty()) a.intensities.push_back(all.intensities[v]);
+    if (!all.colors.empty()) a.colors.push_back(all.colors[v]);
+  }
+  return a;
+}
+
+std::filesystem::path staging_dir(const std::filesystem::path& dir) {
+  std::filesystem::path staged = dir;
+  staged += ".partial";
+  return staged;
+}
+
+}  // namespace
+
+std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid) {
+  std::vector<TileKey> keys(mesh.triangle_count());
+  for (std::size_t t = 0; t < keys.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    const Vec3d centroid =
+        (mesh.world_position(tri[0]) + mesh.world_position(tri[1]) + mesh.world_position(tri[2])) * (1.0 / 3.0);
+    keys[t] = grid.owner(centroid);
+  }
+  return keys;
+}
+
+TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params) {
+  Stopwatch clock;
+  const Mesh& mesh = source.mesh;
+  if (mesh.triangle_count() == 0) throw ProcessingError("3D Tiles: the output has no triangles to export");
+  if (source.source_acq.size() != mesh.triangle_count()) {
+    throw ProcessingError("3D Tiles: one source acquisition per triangle is needed");
+  }
+  TilesetExportStats stats;
+  stats.origin = source.crs.to_geodetic(frame_origin(mesh));
+  const EnuFrame frame(stats.origin);
+  const std::vector<Vec3f> local = local_positions(mesh, source.crs, frame);
+  const SplitMesh split = split_by_source(mesh, source.source_acq, local);
+  const TileTree tree = build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
+                                        params.tree);
+  GlbParams glb{.draco = params.draco, .draco_params = shared_lattice(split.vertices.positions, params),
+                .acquisitions = params.acquisitions};
+  const double step = static_cast<double>(glb.draco_params.lattice->range) /
+                      static_cast<double>((std::uint64_t{1} << glb.draco_params.position_bits) - 1);
+
+  const std::filesystem::path staged = staging_dir(params.dir);
+  std::error_code ec;
+  std::filesystem::remove_all(staged, ec);
+  std::filesystem::create_directories(staged, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create the folder: {}", staged.string(), ec.message()));
+  std::vector<std::uint64_t> bytes(tree.nodes.size(), 0);
+  parallel_for_blocks(tree.nodes.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t n = begin; n < end; ++n) {
+      const TileNode& node = tree.nodes[n];
+      if (node.mesh.triangles.empty()) continue;
+      const TileAttributes a = gather(split.vertices, node.mesh);
+      const std::vector<std::uint8_t> content =
+          write_glb({a.positions, node.mesh.triangles, a.feature_ids, a.intensities, a.colors}, glb);
+      write_file_atomically(staged / (node.name() + ".glb"),
+                            {reinterpret_cast<const char*>(content.data()), content.size()});
+      bytes[n] = content.size();
+    }
+  });
+  const auto files = tileset_json_files(tree, {.transform = frame.to_ecef_matrix(),
+                                               .max_tiles_per_file = params.max_tiles_per_file,
+                                               .box_margin = step,
+                                               .min_half_extent = 0.01});
+  for (const auto& [name, text] : files) write_file_atomically(staged / name, text);
+  replace_directory_atomically(staged, params.dir);
+
+  stats.tiles = tree.nodes.size();
+  stats.json_files = files.size();
+  stats.levels = static_cast<std::size_t>(tree.root().level) + 1;
+  for (const TileNode& node : tree.nodes) {
+    stats.all_triangles += node.mesh.triangles.size();
+    if (node.level == 0) {
+      ++stats.leaves;
+      stats.leaf_triangles += node.mesh.triangles.size();
+    }
+  }
+  for (const std::uint64_t b : bytes) stats.glb_bytes += b;
+  stats.position_bits = glb.draco_params.position_bits;
+  stats.quantization_step = step;
+  stats.seconds = clock.seconds();
+  return stats;
+}
+
+}  // namespace citymesh

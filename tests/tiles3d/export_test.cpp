@@ -1,0 +1,232 @@
+// SPDX-License-Identifier: MIT
+// 3D Tiles export against ground truth: every triangle in the leaves, borders bit-identical,
+// the globe placement against PROJ, external tilesets, determinism, and `check` failures.
+// Reference ECEF position computed with PROJ 9.1.1 (Debian proj-bin):
+//   echo "651070 6860700 50" | cs2cs -f %.6f EPSG:2154 EPSG:4978
+//   -> 4202017.855690 171215.722181 4779232.622308
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <set>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/encode/glb.h"
+#include "citymesh/tiles3d/check.h"
+#include "citymesh/tiles3d/export.h"
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+constexpr Vec3d kKnownPoint{651070, 6860700, 50};
+constexpr Vec3d kKnownEcef{4202017.855690, 171215.722181, 4779232.622308};
+constexpr int kSide = 120;  // metres, one vertex per metre
+
+/// A gently wavy 120 m square in Lambert-93 whose vertex (70, 100) is kKnownPoint; three
+/// source acquisitions in bands of columns, and one row of stitch triangles.
+struct Scene {
+  Mesh mesh;
+  std::vector<std::int32_t> source;
+};
+
+Scene scene() {
+  Scene s;
+  s.mesh.origin = {651000, 6860600, 50};
+  for (int i = 0; i <= kSide; ++i) {
+    for (int j = 0; j <= kSide; ++j) {
+      const double z = 0.2 * std::sin(0.3 * (i - 70)) * std::sin(0.2 * j);
+      s.mesh.positions.push_back({float(i), float(j), float(z)});
+    }
+  }
+  for (int i = 0; i < kSide; ++i) {
+    for (int j = 0; j < kSide; ++j) {
+      const auto a = static_cast<std::uint32_t>(i * (kSide + 1) + j), n = static_cast<std::uint32_t>(kSide + 1);
+      const std::int32_t source = j == 60 ? -1 : i / 40;
+      s.mesh.triangles.push_back({a, a + n, a + 1});
+      s.mesh.triangles.push_back({a + 1, a + n, a + n + 1});
+      s.source.insert(s.source.end(), {source, source});
+    }
+  }
+  s.mesh.triangle_ids.resize(s.mesh.triangles.size());
+  return s;
+}
+
+const Crs& lambert93() {
+  static const Crs crs = Crs::parse("EPSG:2154", {VerticalDatum::Kind::ellipsoidal, 0.0});
+  return crs;
+}
+
+TilesetExportParams params(const std::filesystem::path& dir) {
+  TilesetExportParams p;
+  p.dir = dir;
+  p.grid = {.tile_size = 25.0, .halo = 1.0, .origin = {0.0, 0.0}};
+  p.acquisitions = {{"a", "2026-01-01T00:00:00Z"}, {"b", "2026-02-01T00:00:00Z"}, {"c", "2026-03-01T00:00:00Z"}};
+  return p;
+}
+
+nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
+
+DecodedMesh decode(const std::filesystem::path& path) {
+  const std::string bytes = test::read_text(path);
+  const std::vector<std::uint8_t> data(bytes.begin(), bytes.end());
+  return read_glb_mesh(parse_glb(data, path.string()), path.string());
+}
+
+TEST(TilesetExport, EveryTriangleIsInExactlyOneLeafAndTheTilesetChecksOut) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  const TilesetExportStats stats = export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  EXPECT_EQ(stats.leaves, 25u);  // 120 m from a multiple of 25 m: 5 x 5 grid tiles
+  EXPECT_EQ(stats.leaf_triangles, s.mesh.triangle_count());
+  EXPECT_GE(stats.levels, 4u);
+  EXPECT_LE(stats.quantization_step / 2, 0.001);
+  const TilesetCheckReport r = check_tileset(tmp / "tiles");
+  for (const std::string& e : r.errors) ADD_FAILURE() << e;
+  EXPECT_EQ(r.leaf_triangles, s.mesh.triangle_count());
+  EXPECT_EQ(r.tiles, stats.tiles);
+  EXPECT_EQ(r.glb_files, stats.tiles);
+  const nlohmann::json tileset = read_json(tmp / "tiles" / "tileset.json");
+  EXPECT_EQ(tileset["asset"]["version"], "1.1");
+  EXPECT_EQ(tileset["root"]["refine"], "REPLACE");
+  EXPECT_GT(tileset["root"]["geometricError"].get<double>(), 0.0);
+  // Parents are simplified: the root holds far fewer triangles than the leaves together.
+  EXPECT_LT(stats.all_triangles, 2 * stats.leaf_triangles);
+}
+
+TEST(TilesetExport, NeighbouringLeavesDecodeSharedVerticesBitIdentically) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  // Leaves t0_26040_274424 (x 651000..651025) and t0_26041_274424 (651025..651050) meet at
+  // x = 651025: every vertex on that line used by both must decode to the same floats.
+  const DecodedMesh a = decode(tmp / "tiles" / "t0_26040_274424.glb");
+  const DecodedMesh b = decode(tmp / "tiles" / "t0_26041_274424.glb");
+  auto key = [](const Vec3f& p) { return std::array<float, 3>{p.x, p.y, p.z}; };
+  std::set<std::array<float, 3>> in_b;
+  for (const Vec3f& p : b.positions) in_b.insert(key(p));
+  std::set<std::array<float, 3>> shared;
+  for (const Vec3f& p : a.positions) {
+    if (in_b.count(key(p))) shared.insert(key(p));
+  }
+  // Column x = 25 (and, through triangles whose centroid falls in either tile, x = 24 or
+  // 26 in places): at least the 26 vertices of the border column, rows 0..25.
+  EXPECT_GE(shared.size(), 26u);
+}
+
+TEST(TilesetExport, RootTransformPutsAKnownPointWhereProjDoes) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  const nlohmann::json tileset = read_json(tmp / "tiles" / "tileset.json");
+  const std::vector<double> m = tileset["root"]["transform"].get<std::vector<double>>();
+  ASSERT_EQ(m.size(), 16u);
+  // kKnownPoint is vertex (70, 100): tile (651070 / 25, 6860700 / 25) = (26042, 274428), or
+  // its neighbour below when the triangles around it have their centroids there.
+  double best = 1e9;
+  for (const char* name : {"t0_26042_274428.glb", "t0_26042_274427.glb", "t0_26041_274428.glb", "t0_26041_274427.glb"}) {
+    const DecodedMesh d = decode(tmp / "tiles" / name);
+    for (const Vec3f& p : d.positions) {
+      const Vec3d l(p);
+      const Vec3d ecef{m[0] * l.x + m[4] * l.y + m[8] * l.z + m[12], m[1] * l.x + m[5] * l.y + m[9] * l.z + m[13],
+                       m[2] * l.x + m[6] * l.y + m[10] * l.z + m[14]};
+      best = std::min(best, norm(ecef - kKnownEcef));
+    }
+  }
+  EXPECT_LT(best, 0.01);  // vertices are 1 m apart: only the known point can be this close
+}
+
+std::map<std::string, std::string> folder_bytes(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> out;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) out[e.path().filename().string()] = test::read_text(e.path());
+  return out;
+}
+
+TEST(TilesetExport, LargeTreesAreSplitIntoExternalTilesets) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  TilesetExportParams p = params(tmp / "tiles");
+  p.max_tiles_per_file = 5;
+  const TilesetExportStats stats = export_tileset({s.mesh, s.source, lambert93()}, p);
+  EXPECT_GT(stats.json_files, 1u);
+  const TilesetCheckReport r = check_tileset(tmp / "tiles");
+  for (const std::string& e : r.errors) ADD_FAILURE() << e;
+  EXPECT_EQ(r.json_files, stats.json_files);
+  EXPECT_EQ(r.leaf_triangles, s.mesh.triangle_count());
+  for (const auto& [name, text] : folder_bytes(tmp / "tiles")) {
+    if (!name.ends_with(".json")) continue;
+    const nlohmann::json j = nlohmann::json::parse(text);
+    std::size_t tiles = 0;
+    std::function<void(const nlohmann::json&)> count = [&](const nlohmann::json& t) {
+      ++tiles;
+      for (const auto& c : t.value("children", nlohmann::json::array())) count(c);
+    };
+    count(j["root"]);
+    EXPECT_LE(tiles, 5u) << name;
+  }
+}
+
+TEST(TilesetExport, SameBytesOnOneAndTwoThreads) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  {
+    const ThreadLimit one(1);
+    export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "one"));
+  }
+  {
+    const ThreadLimit two(2);
+    export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "two"));
+  }
+  const auto a = folder_bytes(tmp / "one"), b = folder_bytes(tmp / "two");
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b);
+}
+
+TEST(TilesetExport, ReExportReplacesTheWholeFolder) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  test::write_text(tmp / "tiles" / "stale.glb", "old");
+  export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  EXPECT_FALSE(std::filesystem::exists(tmp / "tiles" / "stale.glb"));
+  EXPECT_FALSE(std::filesystem::exists(tmp / "tiles.partial"));
+  EXPECT_TRUE(std::filesystem::exists(tmp / "tiles" / "tileset.json"));
+}
+
+TEST(TilesetExport, ToleranceTooFineForTheExtentIsAConfigError) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  TilesetExportParams p = params(tmp / "tiles");
+  p.tolerance = 1e-8;
+  EXPECT_THROW(export_tileset({s.mesh, s.source, lambert93()}, p), ConfigError);
+}
+
+bool any_error_mentions(const TilesetCheckReport& r, const std::string& text) {
+  for (const std::string& e : r.errors)
+    if (e.find(text) != std::string::npos) return true;
+  return false;
+}
+
+TEST(TilesetCheck, FindsTruncatedMissingAndInconsistentContent) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  const std::filesystem::path dir = tmp / "tiles";
+  const std::string glb = test::read_text(dir / "t0_26040_274424.glb");
+  test::write_text(dir / "t0_26040_274424.glb", glb.substr(0, glb.size() / 2));
+  std::filesystem::remove(dir / "t0_26044_274428.glb");
+  nlohmann::json tileset = read_json(dir / "tileset.json");
+  tileset["root"]["children"][0]["geometricError"] = 1e6;
+  test::write_text(dir / "tileset.json", tileset.dump());
+  const TilesetCheckReport r = check_tileset(dir);
+  EXPECT_TRUE(any_error_mentions(r, "t0_26040_274424.glb: not a valid glb"));
+  EXPECT_TRUE(any_error_mentions(r, "t0_26044_274428.glb: missing"));
+  EXPECT_TRUE(any_error_mentions(r, "exceeds its parent's"));
+  EXPECT_THROW(check_tileset(tmp / "nowhere"), InputError);
+}
+
+}  // namespace
+}  // namespace citymesh

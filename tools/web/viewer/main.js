@@ -1,0 +1,118 @@
+// SPDX-License-Identifier: MIT
+// citymesh viewer: streams /tiles/tileset.json (3D Tiles 1.1, Draco glb) with three.js and
+// 3d-tiles-renderer, places the street at the origin (east-north-up, y up), and colours every
+// triangle by its source acquisition (feature id _FEATURE_ID_0; stitch triangles magenta).
+// URL parameters: ?error=16 (screen-space error target, pixels), ?color=none (plain grey).
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
+import { TilesRenderer } from '3d-tiles-renderer';
+import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
+
+// The palette of citymesh's pictures (src/app/mosaic_output.cpp source_color).
+const PALETTE = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [140, 86, 75],
+  [23, 190, 207], [188, 189, 34], [127, 127, 127], [148, 103, 189], [0, 80, 40]];
+const STITCH = [230, 0, 230];
+const NULL_FEATURE = 65535;
+
+const params = new URLSearchParams(location.search);
+const status = document.getElementById('status');
+const legend = document.getElementById('legend');
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+renderer.setSize(window.innerWidth, window.innerHeight);
+renderer.setClearColor(0x1b2330);
+document.body.appendChild(renderer.domElement);
+
+const scene = new THREE.Scene();
+scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.6);
+sun.position.set(-0.4, 1.0, 0.6);
+scene.add(sun);
+
+const camera = new THREE.PerspectiveCamera(55, window.innerWidth / window.innerHeight, 0.1, 20000);
+const controls = new OrbitControls(camera, renderer.domElement);
+
+const tiles = new TilesRenderer('/tiles/tileset.json');
+const draco = new DRACOLoader().setDecoderPath('/node_modules/three/examples/jsm/libs/draco/gltf/');
+tiles.registerPlugin(new GLTFExtensionsPlugin({ dracoLoader: draco }));
+tiles.errorTarget = Number(params.get('error') ?? 16);
+tiles.setCamera(camera);
+tiles.setResolutionFromRenderer(camera, renderer);
+scene.add(tiles.group);
+
+const seen = new Set();
+let models = 0;
+
+// The root transform maps the tileset's east-north-up frame to ECEF: undo it, then turn z-up
+// into three.js's y-up, so that the street sits at the origin.
+tiles.addEventListener('load-root-tileset', ({ tileset }) => {
+  const root = tileset.root;
+  const enuToEcef = new THREE.Matrix4().fromArray(root.transform ?? new THREE.Matrix4().elements);
+  const toView = new THREE.Matrix4().makeRotationX(-Math.PI / 2).multiply(enuToEcef.invert());
+  toView.decompose(tiles.group.position, tiles.group.quaternion, tiles.group.scale);
+  tiles.group.updateMatrixWorld(true);
+  const b = root.boundingVolume.box;
+  const centre = new THREE.Vector3(b[0], b[2], -b[1]);
+  const size = Math.max(Math.hypot(b[3], b[4], b[5]), Math.hypot(b[6], b[7], b[8]), 10);
+  camera.position.copy(centre).add(new THREE.Vector3(-0.35 * size, 0.9 * size, 1.1 * size));
+  controls.target.copy(centre);
+  controls.update();
+});
+
+function colourByAcquisition(mesh) {
+  const geometry = mesh.geometry;
+  const ids = geometry.getAttribute('_feature_id_0');
+  if (!geometry.getAttribute('normal')) geometry.computeVertexNormals();
+  const material = new THREE.MeshLambertMaterial({ side: THREE.DoubleSide, color: 0xb8bcc4 });
+  if (ids && params.get('color') !== 'none') {
+    const colours = new Float32Array(ids.count * 3);
+    for (let v = 0; v < ids.count; v++) {
+      const id = ids.getX(v);
+      if (id !== NULL_FEATURE) seen.add(id);
+      const rgb = id === NULL_FEATURE ? STITCH : PALETTE[id % PALETTE.length];
+      colours.set(rgb.map((c) => c / 255), v * 3);
+    }
+    geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+    material.vertexColors = true;
+    material.color.set(0xffffff);
+  }
+  mesh.material = material;
+}
+
+tiles.addEventListener('load-model', ({ scene: model }) => {
+  models++;
+  model.traverse((o) => { if (o.isMesh) colourByAcquisition(o); });
+  legend.innerHTML = [...seen].sort((a, b) => a - b)
+    .map((id) => `<span style="background: rgb(${PALETTE[id % PALETTE.length].join(',')})"></span>acquisition ${id}`)
+    .join('') + `<span style="background: rgb(${STITCH.join(',')})"></span>stitch`;
+});
+tiles.addEventListener('load-error', ({ url, error }) => {
+  status.textContent = `cannot load ${url}: ${error}`;
+});
+
+window.addEventListener('resize', () => {
+  camera.aspect = window.innerWidth / window.innerHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(window.innerWidth, window.innerHeight);
+  tiles.setResolutionFromRenderer(camera, renderer);
+});
+
+let lastFrame = 0;
+function tick() {
+  lastFrame = performance.now();
+  controls.update();
+  camera.updateMatrixWorld();
+  tiles.update();
+  renderer.render(scene, camera);
+  const visible = tiles.visibleTiles ? tiles.visibleTiles.size : 0;
+  const s = tiles.stats;
+  // For tests and scripts: nothing left to fetch or parse, and something on screen.
+  const settled = visible > 0 && s.queued === 0 && s.downloading === 0 && s.parsing === 0;
+  document.body.dataset.settled = String(settled);
+  if (!status.textContent.startsWith('cannot')) status.textContent = `citymesh · ${models} tiles loaded, ${visible} drawn`;
+}
+renderer.setAnimationLoop(tick);
+// Background tabs and headless browsers get few animation frames: keep streaming anyway.
+setInterval(() => { if (performance.now() - lastFrame > 250) tick(); }, 250);
