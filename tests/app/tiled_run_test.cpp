@@ -16,13 +16,14 @@ namespace {
 
 nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
 
-/// Every result file of a run (PLYs, pair lists), by name: what must not change. Summaries
-/// and the run report hold timings and are left out.
+/// Every result file of a run (PLYs, pair lists, 3D Tiles), by name: what must not change.
+/// Summaries and the run report hold timings and are left out.
 std::map<std::string, std::string> result_bytes(const std::filesystem::path& output) {
   std::map<std::string, std::string> files;
   for (const auto& e : std::filesystem::recursive_directory_iterator(output)) {
     const auto ext = e.path().extension();
-    if (ext == ".ply" || ext == ".bin") files[std::filesystem::relative(e.path(), output).string()] = test::read_text(e.path());
+    const bool tileset = ext == ".json" && e.path().parent_path().filename() == "tiles";
+    if (ext == ".ply" || ext == ".bin" || ext == ".glb" || tileset) files[std::filesystem::relative(e.path(), output).string()] = test::read_text(e.path());
   }
   return files;
 }
@@ -126,6 +127,44 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   const auto forced = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2 --force"));
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
+}
+
+/// The face count a PLY header declares.
+std::size_t ply_faces(const std::filesystem::path& ply) {
+  const std::string text = test::read_text(ply);
+  const auto at = text.find("element face ");
+  return at == std::string::npos ? 0 : std::stoul(text.substr(at + 13));
+}
+
+TEST(TiledRun, ProvenancePlyPerTileAndTilesetCheck) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const auto run = test::run_citymesh(run_args(sim, "p", "--set tiling.tile_size=10 --set output.ply=true"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  // Every output triangle is in exactly one tile's provenance PLY.
+  std::size_t faces = 0, files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "sim/p/ply")) {
+    faces += ply_faces(e.path());
+    ++files;
+  }
+  EXPECT_GT(files, 1u);
+  EXPECT_EQ(faces, ply_faces(dir / "sim/p/mosaic/mosaic.ply"));
+  EXPECT_NE(test::read_text(dir / "sim/p/ply" / std::filesystem::directory_iterator(dir / "sim/p/ply")->path().filename())
+                .find("property int source_face"),
+            std::string::npos);
+
+  const auto ok = test::run_citymesh(fmt::format("check {}/p", sim));
+  EXPECT_EQ(ok.exit_code, 0) << ok.out << ok.err;
+  EXPECT_NE(ok.out.find("ok"), std::string::npos);
+  std::filesystem::path glb;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "sim/p/tiles"))
+    if (e.path().extension() == ".glb") glb = e.path();
+  test::write_text(glb, "glTF but not really");
+  const auto broken = test::run_citymesh(fmt::format("check {}/p", sim));
+  EXPECT_EQ(broken.exit_code, 2);
+  EXPECT_NE(broken.out.find(glb.filename().string() + ": not a valid glb"), std::string::npos) << broken.out;
+  EXPECT_EQ(test::run_citymesh(fmt::format("check {}/nothing", sim)).exit_code, 2);
 }
 
 }  // namespace
