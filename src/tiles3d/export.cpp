@@ -40,6 +40,9 @@ struct SplitMesh {
 };
 
 std::uint16_t feature_of(std::int32_t source) {
+  if (source >= kNullFeatureId) {
+    throw ProcessingError(fmt::format("3D Tiles: acquisition {} does not fit a 16-bit feature id", source));
+  }
   return source < 0 ? kNullFeatureId : static_cast<std::uint16_t>(source);
 }
 

@@ -165,6 +165,9 @@ TEST(TiledRun, ProvenancePlyPerTileAndTilesetCheck) {
   EXPECT_EQ(broken.exit_code, 2);
   EXPECT_NE(broken.out.find(glb.filename().string() + ": not a valid glb"), std::string::npos) << broken.out;
   EXPECT_EQ(test::run_citymesh(fmt::format("check {}/nothing", sim)).exit_code, 2);
+  const auto no_tileset = test::run_citymesh(fmt::format("view {}/nothing --port 0", sim));
+  EXPECT_EQ(no_tileset.exit_code, 2);
+  EXPECT_NE(no_tileset.err.find("no tileset.json"), std::string::npos) << no_tileset.err;
 }
 
 }  // namespace
