@@ -8,18 +8,11 @@
 #include "citymesh/core/error.h"
 #include "citymesh/tiles3d/check.h"
 #include "command.h"
+#include "tileset_output.h"
 
 namespace citymesh::app {
 
 namespace {
-
-/// The tileset a user means: <output>/tiles/tileset.json, a folder holding tileset.json, or
-/// the file itself.
-std::filesystem::path tileset_of(const std::filesystem::path& given) {
-  if (std::filesystem::is_regular_file(given / "tiles" / "tileset.json")) return given / "tiles" / "tileset.json";
-  if (std::filesystem::is_directory(given)) return given / "tileset.json";
-  return given;
-}
 
 class CheckCommand final : public Command {
  public:
@@ -36,7 +29,7 @@ class CheckCommand final : public Command {
   }
 
   void run() override {
-    const std::filesystem::path tileset = tileset_of(output_);
+    const std::filesystem::path tileset = find_tileset(output_);
     const TilesetCheckReport r = check_tileset(tileset, {.max_json_bytes = max_json_kb_ * 1024, .box_tolerance = 0.01});
     std::cout << fmt::format("{}: {} tiles ({} levels), {} glb ({:.1f} MiB), {} tileset files ({:.1f} kB), "
                              "{} triangles in the leaves, {} in all contents\n",

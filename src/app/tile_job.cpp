@@ -52,10 +52,7 @@ TilePiece selected_part(const TilePiece& piece, std::span<const std::uint8_t> se
       const auto [it, added] = local.try_emplace(v, static_cast<std::uint32_t>(out.vertex_ids.size()));
       if (added) {
         out.vertex_ids.push_back(piece.vertex_ids[v]);
-        out.mesh.positions.push_back(m.positions[v]);
-        out.mesh.sensor_positions.push_back(m.sensor_positions[v]);
-        if (!m.intensities.empty()) out.mesh.intensities.push_back(m.intensities[v]);
-        if (!m.colors.empty()) out.mesh.colors.push_back(m.colors[v]);
+        append_vertex(m, v, out.mesh);
       }
       tri[c] = it->second;
     }

@@ -55,13 +55,7 @@ Mesh sub_mesh(const Mesh& mesh, std::span<const std::uint32_t> keep) {
   std::map<std::uint32_t, std::uint32_t> remap;
   auto vertex = [&](std::uint32_t v) {
     const auto [it, added] = remap.try_emplace(v, static_cast<std::uint32_t>(out.positions.size()));
-    if (added) {
-      out.positions.push_back(mesh.positions[v]);
-      if (mesh.has_sensor_positions()) out.sensor_positions.push_back(mesh.sensor_positions[v]);
-      if (!mesh.times.empty()) out.times.push_back(mesh.times[v]);
-      if (!mesh.intensities.empty()) out.intensities.push_back(mesh.intensities[v]);
-      if (!mesh.colors.empty()) out.colors.push_back(mesh.colors[v]);
-    }
+    if (added) append_vertex(mesh, v, out);
     return it->second;
   };
   for (const std::uint32_t t : keep) {
@@ -98,6 +92,14 @@ nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
 }
 
 }  // namespace
+
+std::filesystem::path find_tileset(const std::filesystem::path& given) {
+  for (const std::filesystem::path& candidate : {given / "tiles" / "tileset.json", given / "tileset.json", given}) {
+    if (std::filesystem::is_regular_file(candidate)) return candidate;
+  }
+  throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
+                               given.string()));
+}
 
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged) {
   nlohmann::json report = nlohmann::json::object();

@@ -4,12 +4,17 @@
 // (<output>/ply/<i>_<j>.ply, DESIGN §3).
 #pragma once
 
+#include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/config/config.h"
 #include "citymesh/mosaic/merged_mesh.h"
 
 namespace citymesh::app {
+
+/// The tileset a user names on the command line: <given>/tiles/tileset.json (a run's output
+/// folder), <given>/tileset.json, or the file itself. Throws InputError when there is none.
+std::filesystem::path find_tileset(const std::filesystem::path& given);
 
 /// Writes what [output] asks for; returns figures for the run report ({} when nothing).
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged);

@@ -14,6 +14,7 @@
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "command.h"
+#include "tileset_output.h"
 
 namespace citymesh::app {
 
@@ -21,13 +22,6 @@ namespace {
 
 /// Where tools/setup installs the viewer page and its npm packages.
 constexpr const char* kDefaultViewerDir = CITYMESH_SOURCE_DIR "/tools/web";
-
-std::filesystem::path tiles_of(const std::filesystem::path& given) {
-  if (std::filesystem::is_regular_file(given / "tiles" / "tileset.json")) return given / "tiles";
-  if (std::filesystem::is_regular_file(given / "tileset.json")) return given;
-  throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
-                               given.string()));
-}
 
 void require_viewer(const std::filesystem::path& viewer) {
   for (const char* needed : {"viewer/index.html", "node_modules/three/build/three.module.js",
@@ -54,7 +48,8 @@ class ViewCommand final : public Command {
   }
 
   void run() override {
-    const std::filesystem::path tiles = tiles_of(output_), viewer = viewer_;
+    const std::filesystem::path tileset = find_tileset(output_), viewer = viewer_;
+    const std::filesystem::path tiles = tileset.has_parent_path() ? tileset.parent_path() : ".";
     require_viewer(viewer);
     httplib::Server server;
     server.set_file_extension_and_mimetype_mapping("glb", "model/gltf-binary");

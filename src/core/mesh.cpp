@@ -39,4 +39,12 @@ double doubled_area(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return norm(cross(b - a, c - a));
 }
 
+void append_vertex(const Mesh& from, std::uint32_t v, Mesh& to) {
+  to.positions.push_back(from.positions[v]);
+  if (!from.sensor_positions.empty()) to.sensor_positions.push_back(from.sensor_positions[v]);
+  if (!from.times.empty()) to.times.push_back(from.times[v]);
+  if (!from.intensities.empty()) to.intensities.push_back(from.intensities[v]);
+  if (!from.colors.empty()) to.colors.push_back(from.colors[v]);
+}
+
 }  // namespace citymesh

@@ -5,15 +5,6 @@ namespace citymesh {
 
 namespace {
 
-/// Appends vertex v of `from` to `to`, with every per-vertex attribute `to` carries.
-void copy_vertex(const Mesh& from, std::uint32_t v, Mesh& to) {
-  to.positions.push_back(from.positions[v]);
-  if (!from.sensor_positions.empty()) to.sensor_positions.push_back(from.sensor_positions[v]);
-  if (!from.times.empty()) to.times.push_back(from.times[v]);
-  if (!from.intensities.empty()) to.intensities.push_back(from.intensities[v]);
-  if (!from.colors.empty()) to.colors.push_back(from.colors[v]);
-}
-
 /// An attribute is kept only when every input has it.
 void drop_partial_attributes(std::span<const Mesh> meshes, Mesh& out) {
   for (const Mesh& m : meshes) {
@@ -39,7 +30,7 @@ MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& 
       for (std::uint32_t& v : tri) {
         if (new_index[v] == UINT32_MAX) {
           new_index[v] = static_cast<std::uint32_t>(out.mesh.positions.size());
-          copy_vertex(m, v, out.mesh);
+          append_vertex(m, v, out.mesh);
         }
         v = new_index[v];
       }

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 #include "citymesh/core/error.h"
@@ -78,7 +79,7 @@ class Checker {
     if (!tileset.contains("root") || !tileset["root"].is_object()) return error(name, "", "no root tile");
     const json& root = tileset["root"];
     if (!root.contains("refine")) error(name, "root", "no refine (required on the root tile)");
-    tile(name, "root", root, parent_error, depth, std::nullopt);
+    tile(name, "root", root, parent_error, depth);
   }
 
  private:
@@ -86,8 +87,7 @@ class Checker {
     report_.errors.push_back(where.empty() ? fmt::format("{}: {}", file, what) : fmt::format("{}: {}: {}", file, where, what));
   }
 
-  void tile(const std::string& file, const std::string& where, const json& t, double parent_error, int depth,
-            std::optional<Bounds> /*unused*/) {
+  void tile(const std::string& file, const std::string& where, const json& t, double parent_error, int depth) {
     ++report_.tiles;
     report_.levels = std::max(report_.levels, static_cast<std::size_t>(depth) + 1);
     if (depth > 64) return error(file, where, "tree deeper than 64 levels");
@@ -122,7 +122,7 @@ class Checker {
     if (external && !children.empty()) error(file, where, "a tile with an external tileset has children");
     if (t.contains("content")) content(file, where, content_uri, ge, depth, bounds, children.empty());
     for (std::size_t c = 0; c < children.size(); ++c) {
-      tile(file, fmt::format("{}.children[{}]", where, c), children[c], ge, depth + 1, bounds);
+      tile(file, fmt::format("{}.children[{}]", where, c), children[c], ge, depth + 1);
     }
   }
 

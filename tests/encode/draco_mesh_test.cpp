@@ -6,6 +6,7 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/encode/draco_mesh.h"
+#include "grid_triangles.h"
 
 namespace citymesh {
 namespace {
@@ -21,13 +22,7 @@ Grid grid(int n, int first_column) {
   for (int c = first_column; c <= first_column + n; ++c)
     for (int j = 0; j <= n; ++j)
       g.positions.push_back({0.37f * float(c), 0.41f * float(j), 0.05f * std::sin(float(c + j))});
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const auto a = static_cast<std::uint32_t>(i * (n + 1) + j), s = static_cast<std::uint32_t>(n + 1);
-      g.triangles.push_back({a, a + s, a + 1});
-      g.triangles.push_back({a + 1, a + s, a + s + 1});
-    }
-  }
+  g.triangles = test::grid_triangles(n);
   return g;
 }
 

@@ -7,6 +7,7 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/encode/glb.h"
+#include "grid_triangles.h"
 
 namespace citymesh {
 namespace {
@@ -30,13 +31,7 @@ Tile tile(int n) {
       t.colors.push_back({static_cast<std::uint8_t>(i * 7), static_cast<std::uint8_t>(j * 5), 200});
     }
   }
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
-      const auto a = static_cast<std::uint32_t>(i * (n + 1) + j), s = static_cast<std::uint32_t>(n + 1);
-      t.triangles.push_back({a, a + s, a + 1});
-      t.triangles.push_back({a + 1, a + s, a + s + 1});
-    }
-  }
+  t.triangles = test::grid_triangles(n);
   return t;
 }
 

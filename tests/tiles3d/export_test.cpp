@@ -18,6 +18,7 @@
 #include "citymesh/encode/glb.h"
 #include "citymesh/tiles3d/check.h"
 #include "citymesh/tiles3d/export.h"
+#include "grid_triangles.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -43,13 +44,11 @@ Scene scene() {
       s.mesh.positions.push_back({float(i), float(j), float(z)});
     }
   }
+  s.mesh.triangles = test::grid_triangles(kSide);
   for (int i = 0; i < kSide; ++i) {
     for (int j = 0; j < kSide; ++j) {
-      const auto a = static_cast<std::uint32_t>(i * (kSide + 1) + j), n = static_cast<std::uint32_t>(kSide + 1);
       const std::int32_t source = j == 60 ? -1 : i / 40;
-      s.mesh.triangles.push_back({a, a + n, a + 1});
-      s.mesh.triangles.push_back({a + 1, a + n, a + n + 1});
-      s.source.insert(s.source.end(), {source, source});
+      s.source.insert(s.source.end(), {source, source});  // the cell's two triangles
     }
   }
   s.mesh.triangle_ids.resize(s.mesh.triangles.size());

@@ -77,6 +77,10 @@ struct Mesh {
   void check_invariants() const;
 };
 
+/// Appends vertex v of `from` to `to` with every per-vertex attribute `from` carries; both
+/// meshes share one origin.
+void append_vertex(const Mesh& from, std::uint32_t v, Mesh& to);
+
 /// Converts an absolute position to floats relative to `origin`.
 inline Vec3f to_local(const Vec3d& p, const Vec3d& origin) { return Vec3f(p - origin); }
 
