@@ -73,8 +73,7 @@ nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   for (std::size_t t = 0; t < keys.size(); ++t) tiles[keys[t]].push_back(static_cast<std::uint32_t>(t));
   const std::vector<std::int32_t> faces = source_faces(merged);
   const std::filesystem::path dir = config.project.output / "ply";
-  std::filesystem::path staged = dir;
-  staged += ".partial";
+  const std::filesystem::path staged = staging_directory(dir);
   std::filesystem::remove_all(staged);
   for (const auto& [key, triangles] : tiles) {
     std::vector<std::int32_t> acq, face;

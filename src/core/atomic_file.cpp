@@ -67,6 +67,12 @@ void write_file_atomically(const std::filesystem::path& path, std::string_view c
   file.commit();
 }
 
+std::filesystem::path staging_directory(const std::filesystem::path& target) {
+  std::filesystem::path staged = target;
+  staged += ".partial";
+  return staged;
+}
+
 void replace_directory_atomically(const std::filesystem::path& staged, const std::filesystem::path& target) {
   fsync_directory(staged);
   std::error_code ec;

@@ -117,12 +117,6 @@ TileAttributes gather(const TilesetVertices& all, const TileMesh& mesh) {
   return a;
 }
 
-std::filesystem::path staging_dir(const std::filesystem::path& dir) {
-  std::filesystem::path staged = dir;
-  staged += ".partial";
-  return staged;
-}
-
 }  // namespace
 
 std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid) {
@@ -155,7 +149,7 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   const double step = static_cast<double>(glb.draco_params.lattice->range) /
                       static_cast<double>((std::uint64_t{1} << glb.draco_params.position_bits) - 1);
 
-  const std::filesystem::path staged = staging_dir(params.dir);
+  const std::filesystem::path staged = staging_directory(params.dir);
   std::error_code ec;
   std::filesystem::remove_all(staged, ec);
   std::filesystem::create_directories(staged, ec);

@@ -36,6 +36,9 @@ class AtomicFile {
 /// Writes `content` to `path` atomically.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
+/// Where a folder replaced with replace_directory_atomically is built: "<target>.partial".
+std::filesystem::path staging_directory(const std::filesystem::path& target);
+
 /// Puts the finished folder `staged` in place of `target` in one step (the old `target`, if
 /// any, is swapped out and removed), then fsyncs their parent: readers see the old folder or
 /// the complete new one, never a mix. Throws OutputError naming the folders.
