@@ -2,19 +2,135 @@
 // The tile store's manifest: written last, so a store without one is unfinished.
 #include <fmt/format.h>
 
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <regex>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/tiler/tiler.h"
+#include "store_files.h"
 
 namespace citymesh {
 
 namespace {
 constexpr int kManifestVersion = 1;
 constexpr const char* kManifestFile = "manifest.json";
+constexpr const char* kSummaryFile = "summary.json";
+constexpr int kSummaryVersion = 1;
+
+nlohmann::json stats_json(const TilingStats& s) {
+  return {{"input_bytes", s.input_bytes}, {"halo_copies", s.halo_copies}, {"empty_space_copies", s.empty_space_copies},
+          {"blocks", s.blocks},           {"bytes_written", s.bytes_written}, {"seconds", s.seconds}};
+}
+
+TilingStats stats_from_json(const nlohmann::json& s) {
+  return {s.at("input_bytes").get<std::uint64_t>(),  s.at("halo_copies").get<std::uint64_t>(),
+          s.at("empty_space_copies").get<std::uint64_t>(), s.at("blocks").get<std::uint64_t>(),
+          s.at("bytes_written").get<std::uint64_t>(), s.at("seconds").get<double>()};
+}
+
+/// The summary in `folder` when it is finished and made with `fingerprint`.
+std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folder, const std::string& fingerprint) {
+  std::ifstream in(folder / kSummaryFile);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    if (j.at("version").get<int>() != kSummaryVersion || j.at("fingerprint").get<std::string>() != fingerprint) {
+      return std::nullopt;
+    }
+    AcquisitionTiling t;
+    t.fingerprint = fingerprint;
+    t.triangles = j.at("triangles").get<std::uint64_t>();
+    t.stats = stats_from_json(j.at("stats"));
+    for (const auto& row : j.at("tiles")) {
+      const auto v = row.get<std::array<std::int64_t, 5>>();
+      t.counts[{static_cast<std::int32_t>(v[0]), static_cast<std::int32_t>(v[1])}] = {
+          static_cast<std::uint64_t>(v[2]), static_cast<std::uint64_t>(v[3]), static_cast<std::uint64_t>(v[4])};
+    }
+    return t;
+  } catch (const nlohmann::json::exception& e) {
+    // Written atomically, so only a damaged file gets here: the acquisition is tiled again.
+    log::warn("{}: unreadable ({}): tiled again", (folder / kSummaryFile).string(), e.what());
+    return std::nullopt;
+  }
+}
+
+/// Whether the manifest in `dir` is readable and made with `fingerprint`.
+bool manifest_made_with(const std::filesystem::path& dir, const std::string& fingerprint) {
+  try {
+    const std::optional<TileStore> store = read_tile_manifest(dir);
+    return store && store->fingerprint == fingerprint;
+  } catch (const InputError&) {
+    return false;
+  }
+}
+
 }  // namespace
+
+void write_acquisition_tiling(const std::filesystem::path& dir, const AcquisitionTiling& tiling) {
+  nlohmann::json tiles = nlohmann::json::array();
+  for (const auto& [key, c] : tiling.counts) tiles.push_back({key.i, key.j, c[0], c[1], c[2]});
+  const nlohmann::json j{{"version", kSummaryVersion}, {"fingerprint", tiling.fingerprint},
+                         {"triangles", tiling.triangles}, {"stats", stats_json(tiling.stats)},
+                         {"tiles", std::move(tiles)}};
+  write_file_atomically(dir / kSummaryFile, j.dump() + "\n");
+}
+
+std::optional<AcquisitionTiling> read_acquisition_tiling(const std::filesystem::path& dir, std::uint32_t acquisition,
+                                                         const std::string& fingerprint) {
+  return read_summary(acquisition_tiles_path(dir, acquisition), fingerprint);
+}
+
+std::optional<AcquisitionTiling> publish_acquisition_tiling(const std::filesystem::path& staged,
+                                                            const std::filesystem::path& target,
+                                                            const std::string& fingerprint) {
+  if (std::rename(staged.c_str(), target.c_str()) == 0) {
+    sync_directory(target.parent_path());
+    return std::nullopt;
+  }
+  if (errno != EEXIST && errno != ENOTEMPTY) {
+    throw OutputError(fmt::format("{}: cannot rename the tiled acquisition into place: {}", target.string(),
+                                  std::strerror(errno)));
+  }
+  if (std::optional<AcquisitionTiling> first = read_summary(target, fingerprint)) {
+    std::error_code ec;
+    std::filesystem::remove_all(staged, ec);
+    return first;
+  }
+  replace_directory_atomically(staged, target);
+  return std::nullopt;
+}
+
+void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions, const std::string& fingerprint,
+                      bool staging) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", dir.string(), ec.message()));
+  static const std::regex acquisition_folder("a([0-9]{1,9})");
+  std::vector<std::filesystem::path> stale;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = entry.path().filename().string();
+    std::smatch m;
+    if (name == kStagingFolder) {
+      if (staging) stale.push_back(entry.path());
+    } else if (std::regex_match(name, m, acquisition_folder) && std::stoull(m[1].str()) < acquisitions) {
+      if (!read_summary(entry.path(), fingerprint)) stale.push_back(entry.path());
+    } else if (name == kManifestFile) {
+      if (!manifest_made_with(dir, fingerprint)) stale.push_back(entry.path());
+    } else {
+      stale.push_back(entry.path());  // a store of an older layout, or a dropped acquisition
+    }
+  }
+  for (const auto& path : stale) {
+    std::filesystem::remove_all(path, ec);
+    if (ec) throw OutputError(fmt::format("{}: cannot remove stale tiling work: {}", path.string(), ec.message()));
+  }
+}
 
 void write_tile_manifest(const TileStore& store) {
   nlohmann::json j;
@@ -22,12 +138,7 @@ void write_tile_manifest(const TileStore& store) {
   j["fingerprint"] = store.fingerprint;
   j["grid"] = {{"tile_size", store.grid.tile_size}, {"halo", store.grid.halo}, {"origin", store.grid.origin}};
   j["triangles"] = store.triangles;
-  j["stats"] = {{"input_bytes", store.stats.input_bytes},
-                {"halo_copies", store.stats.halo_copies},
-                {"empty_space_copies", store.stats.empty_space_copies},
-                {"blocks", store.stats.blocks},
-                {"bytes_written", store.stats.bytes_written},
-                {"seconds", store.stats.seconds}};
+  j["stats"] = stats_json(store.stats);
   nlohmann::json tiles = nlohmann::json::array();
   for (const TileContents& t : store.tiles) tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}});
   j["tiles"] = std::move(tiles);
@@ -52,10 +163,7 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
     store.grid.halo = j.at("grid").at("halo").get<double>();
     store.grid.origin = j.at("grid").at("origin").get<std::array<double, 2>>();
     store.triangles = j.at("triangles").get<std::vector<std::uint64_t>>();
-    const auto& s = j.at("stats");
-    store.stats = {s.at("input_bytes").get<std::uint64_t>(),  s.at("halo_copies").get<std::uint64_t>(),
-                   s.at("empty_space_copies").get<std::uint64_t>(), s.at("blocks").get<std::uint64_t>(),
-                   s.at("bytes_written").get<std::uint64_t>(), s.at("seconds").get<double>()};
+    store.stats = stats_from_json(j.at("stats"));
     for (const auto& t : j.at("tiles")) {
       TileContents c{{t.at("i").get<std::int32_t>(), t.at("j").get<std::int32_t>()},
                      t.at("triangles").get<std::vector<std::array<std::uint64_t, 3>>>()};

@@ -6,10 +6,12 @@
 #include <map>
 #include <unordered_map>
 
+#include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/stopwatch.h"
+#include "store_files.h"
 
 namespace citymesh {
 
@@ -36,13 +38,16 @@ struct TileBuffer {
   std::unordered_map<std::uint32_t, std::uint32_t> local;  ///< vertex id -> index in the piece
 };
 
+std::string chunk_name(TileKey key);
+
 /// Hash-map overhead per buffered vertex, on top of the block bytes.
 constexpr std::uint64_t kMapBytesPerVertex = 32;
 
 class AcquisitionTiler {
  public:
-  AcquisitionTiler(const TileGrid& grid, TileStore& store, std::uint32_t acquisition, std::uint64_t buffer_bytes)
-      : grid_(grid), store_(store), acquisition_(acquisition), buffer_bytes_(buffer_bytes) {}
+  AcquisitionTiler(const TileGrid& grid, std::filesystem::path dir, AcquisitionTiling& out, std::uint32_t acquisition,
+                   std::uint64_t buffer_bytes)
+      : grid_(grid), dir_(std::move(dir)), out_(out), acquisition_(acquisition), buffer_bytes_(buffer_bytes) {}
 
   void run(const std::filesystem::path& file, const PlyReadParams& ply) {
     PlyReader reader(file, ply);
@@ -74,8 +79,8 @@ class AcquisitionTiler {
       }
     }
     flush();
-    store_.triangles.push_back(next_index_);
-    store_.stats.input_bytes += reader.stats().bytes;
+    out_.triangles = next_index_;
+    out_.stats.input_bytes += reader.stats().bytes;
   }
 
  private:
@@ -89,14 +94,14 @@ class AcquisitionTiler {
     add_to(owner, tri, id, index, TileRole::owned);
     const std::vector<TileKey> halo = grid_.halo_tiles(box, owner);
     for (const TileKey k : halo) add_to(k, tri, id, index, TileRole::halo);
-    store_.stats.halo_copies += halo.size();
+    out_.stats.halo_copies += halo.size();
     const Vec3d viewpoint =
         (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
     const std::array<Vec3d, 4> tetrahedron{c[0], c[1], c[2], viewpoint};
     for (const TileKey k : grid_.tiles_crossed(tetrahedron)) {
       if (k == owner || std::binary_search(halo.begin(), halo.end(), k)) continue;
       add_to(k, tri, id, index, TileRole::empty_space);
-      ++store_.stats.empty_space_copies;
+      ++out_.stats.empty_space_copies;
     }
   }
 
@@ -133,26 +138,22 @@ class AcquisitionTiler {
 
   void flush() {
     for (auto& [key, b] : buffers_) {
-      for (std::size_t r = 0; r < 3; ++r) counts_[key][r] += b.counts[r];
+      for (std::size_t r = 0; r < 3; ++r) out_.counts[key][r] += b.counts[r];
       if (b.piece.triangle_count() == 0) continue;
-      const std::filesystem::path file = tile_chunk_path(store_.dir, key, acquisition_);
+      const std::filesystem::path file = dir_ / chunk_name(key);
       std::filesystem::create_directories(file.parent_path());
       append_tile_block(file, b.piece);
-      ++store_.stats.blocks;
-      store_.stats.bytes_written += b.piece.byte_size();
+      ++out_.stats.blocks;
+      out_.stats.bytes_written += b.piece.byte_size();
     }
     buffers_.clear();
     last_ = nullptr;
     buffered_ = 0;
   }
 
- public:
-  /// Triangles per tile and role of this acquisition.
-  [[nodiscard]] const std::map<TileKey, std::array<std::uint64_t, 3>>& counts() const { return counts_; }
-
- private:
   const TileGrid& grid_;
-  TileStore& store_;
+  std::filesystem::path dir_;
+  AcquisitionTiling& out_;
   std::uint32_t acquisition_;
   std::uint64_t buffer_bytes_;
   AcquisitionVertices vertices_;
@@ -161,8 +162,9 @@ class AcquisitionTiler {
   TileKey last_key_;
   std::uint64_t buffered_ = 0;
   std::uint32_t next_index_ = 0;
-  std::map<TileKey, std::array<std::uint64_t, 3>> counts_;
 };
+
+std::string chunk_name(TileKey key) { return key.name() + ".bin"; }
 
 }  // namespace
 
@@ -178,39 +180,77 @@ std::uint64_t TileContents::total() const {
   return n;
 }
 
+std::filesystem::path acquisition_tiles_path(const std::filesystem::path& dir, std::uint32_t acquisition) {
+  return dir / fmt::format("a{}", acquisition);
+}
+
 std::filesystem::path tile_chunk_path(const std::filesystem::path& dir, TileKey key, std::uint32_t acquisition) {
-  return dir / key.name() / fmt::format("{}.bin", acquisition);
+  return acquisition_tiles_path(dir, acquisition) / chunk_name(key);
+}
+
+AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerParams& params,
+                                   const std::string& fingerprint) {
+  Stopwatch clock;
+  const TileGrid grid(params.grid);
+  const std::filesystem::path target = acquisition_tiles_path(params.dir, acquisition.index);
+  // Unique per process: processes of a cluster may tile the same acquisition at once.
+  const std::filesystem::path staged =
+      params.dir / kStagingFolder / fmt::format("a{}.{}", acquisition.index, process_tag());
+  std::error_code ec;
+  std::filesystem::remove_all(staged, ec);
+  std::filesystem::create_directories(staged, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create a tiling folder: {}", staged.string(), ec.message()));
+  AcquisitionTiling out;
+  out.fingerprint = fingerprint;
+  AcquisitionTiler tiler(grid, staged, out, acquisition.index, params.buffer_bytes);
+  tiler.run(acquisition.path, params.ply);
+  out.stats.seconds = clock.seconds();
+  write_acquisition_tiling(staged, out);
+  sync_tile_files(staged);
+  if (std::optional<AcquisitionTiling> first = publish_acquisition_tiling(staged, target, fingerprint)) return *first;
+  log::info("tiled {}: {} triangles in {:.2f} s", acquisition.path.string(), out.triangles, out.stats.seconds);
+  return out;
+}
+
+TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridParams& grid,
+                              std::span<const AcquisitionTiling> parts, std::string fingerprint) {
+  TileStore store;
+  store.dir = dir;
+  store.grid = grid;
+  store.fingerprint = std::move(fingerprint);
+  std::map<TileKey, std::vector<std::array<std::uint64_t, 3>>> counts;
+  for (std::size_t a = 0; a < parts.size(); ++a) {
+    const AcquisitionTiling& part = parts[a];
+    store.triangles.push_back(part.triangles);
+    const TilingStats& s = part.stats;
+    store.stats.input_bytes += s.input_bytes;
+    store.stats.halo_copies += s.halo_copies;
+    store.stats.empty_space_copies += s.empty_space_copies;
+    store.stats.blocks += s.blocks;
+    store.stats.bytes_written += s.bytes_written;
+    store.stats.seconds += s.seconds;
+    for (const auto& [key, roles] : part.counts) {
+      auto& all = counts[key];
+      all.resize(parts.size());
+      all[a] = roles;
+    }
+  }
+  for (auto& [key, per_acquisition] : counts) {
+    TileContents t{key, std::move(per_acquisition)};
+    t.triangles.resize(parts.size());
+    if (t.owned() > 0) store.tiles.push_back(std::move(t));
+  }
+  return store;
 }
 
 TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params) {
-  Stopwatch clock;
-  const TileGrid grid(params.grid);
-  TileStore store;
-  store.dir = params.dir;
-  store.grid = params.grid;
   std::error_code ec;
   std::filesystem::remove_all(params.dir, ec);
   std::filesystem::create_directories(params.dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", params.dir.string(), ec.message()));
-  std::map<TileKey, std::vector<std::array<std::uint64_t, 3>>> counts;
-  for (const Acquisition& a : acquisitions) {
-    AcquisitionTiler tiler(grid, store, a.index, params.buffer_bytes);
-    tiler.run(a.path, params.ply);
-    for (const auto& [key, roles] : tiler.counts()) {
-      auto& all = counts[key];
-      all.resize(acquisitions.size());
-      all[a.index] = roles;
-    }
-    log::info("tiled {}: {} triangles", a.path.string(), store.triangles.back());
-  }
-  for (auto& [key, per_acquisition] : counts) {
-    TileContents t{key, std::move(per_acquisition)};
-    t.triangles.resize(acquisitions.size());
-    if (t.owned() > 0) store.tiles.push_back(std::move(t));
-  }
-  sync_tile_files(params.dir);
-  store.stats.seconds = clock.seconds();
-  return store;
+  std::vector<AcquisitionTiling> parts;
+  for (const Acquisition& a : acquisitions) parts.push_back(tile_acquisition(a, params, ""));
+  return assemble_tile_store(params.dir, params.grid, parts, "");
 }
 
 std::vector<TilePiece> read_tile(const TileStore& store, TileKey key) {

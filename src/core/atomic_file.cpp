@@ -21,17 +21,24 @@ namespace {
   throw OutputError(fmt::format("{}: cannot {}: {}", path.string(), action, std::strerror(errno)));
 }
 
-void fsync_directory(const std::filesystem::path& dir) {
+}  // namespace
+
+void sync_directory(const std::filesystem::path& dir) {
   const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY);
-  if (fd < 0) return;  // best effort: some filesystems refuse directory handles
+  if (fd < 0) return;
   ::fsync(fd);
   ::close(fd);
 }
-}  // namespace
+
+std::string process_tag() {
+  char host[256] = {};
+  if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
+  return fmt::format("{}.{}", host, ::getpid());
+}
 
 AtomicFile::AtomicFile(std::filesystem::path final_path) : final_path_(std::move(final_path)) {
   temp_path_ = final_path_;
-  temp_path_ += fmt::format(".tmp.{}", ::getpid());
+  temp_path_ += ".tmp." + process_tag();
   std::error_code ec;
   if (final_path_.has_parent_path()) std::filesystem::create_directories(final_path_.parent_path(), ec);
   file_ = std::fopen(temp_path_.c_str(), "wb");
@@ -58,7 +65,7 @@ void AtomicFile::commit() {
   if (closed != 0) fail(temp_path_, "close");
   if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0) fail(final_path_, "rename into place");
   committed_ = true;
-  fsync_directory(final_path_.parent_path());
+  sync_directory(final_path_.parent_path());
 }
 
 void write_file_atomically(const std::filesystem::path& path, std::string_view content) {
@@ -74,7 +81,7 @@ std::filesystem::path staging_directory(const std::filesystem::path& target) {
 }
 
 void replace_directory_atomically(const std::filesystem::path& staged, const std::filesystem::path& target) {
-  fsync_directory(staged);
+  sync_directory(staged);
   std::error_code ec;
   if (!std::filesystem::exists(target, ec)) {
     if (std::rename(staged.c_str(), target.c_str()) != 0) fail(target, "rename the staged folder onto");
@@ -84,7 +91,7 @@ void replace_directory_atomically(const std::filesystem::path& staged, const std
     }
     std::filesystem::remove_all(staged, ec);  // now the old content
   }
-  fsync_directory(target.parent_path());
+  sync_directory(target.parent_path());
 }
 
 }  // namespace citymesh

@@ -192,5 +192,64 @@ TEST(Tiler, DamagedChunksAreInputErrorsNamingTheFile) {
   expect_error("a truncated header");
 }
 
+/// Every file under `dir` by relative path, with its bytes.
+std::map<std::string, std::string> folder_bytes(const std::filesystem::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(dir)) {
+    if (!e.is_regular_file()) continue;
+    std::ifstream in(e.path(), std::ios::binary);
+    files[std::filesystem::relative(e.path(), dir).string()] =
+        std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  return files;
+}
+
+TEST(Tiler, AcquisitionsTiledSeparatelyOrTwiceGiveTheSameStore) {
+  Fixture f;
+  const TileStore whole = tile_acquisitions(f.acquisitions, f.params);
+  const auto reference = folder_bytes(f.params.dir);
+  // As the ranks of a cluster do: acquisitions in another order, one of them twice (two
+  // processes racing: the second finds the first's copy and keeps it), then assembled.
+  std::filesystem::remove_all(f.params.dir);
+  const AcquisitionTiling b = tile_acquisition(f.acquisitions[1], f.params, "fp");
+  const AcquisitionTiling a = tile_acquisition(f.acquisitions[0], f.params, "fp");
+  const AcquisitionTiling again = tile_acquisition(f.acquisitions[0], f.params, "fp");
+  EXPECT_EQ(again.counts, a.counts);
+  EXPECT_TRUE(std::filesystem::is_empty(f.params.dir / "staging")) << "a losing copy was left behind";
+  const std::vector<AcquisitionTiling> parts{*read_acquisition_tiling(f.params.dir, 0, "fp"),
+                                             *read_acquisition_tiling(f.params.dir, 1, "fp")};
+  const TileStore assembled = assemble_tile_store(f.params.dir, f.params.grid, parts, "fp");
+  EXPECT_EQ(assembled.triangles, whole.triangles);
+  ASSERT_EQ(assembled.tiles.size(), whole.tiles.size());
+  for (std::size_t k = 0; k < whole.tiles.size(); ++k) {
+    EXPECT_EQ(assembled.tiles[k].key, whole.tiles[k].key);
+    EXPECT_EQ(assembled.tiles[k].triangles, whole.tiles[k].triangles);
+  }
+  auto files = folder_bytes(f.params.dir);
+  auto expected = reference;
+  for (auto* m : {&files, &expected}) std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
+  EXPECT_TRUE(files == expected) << "chunk files differ from a store tiled in one go";
+  EXPECT_EQ(b.triangles, 3000u);
+}
+
+TEST(Tiler, PruneKeepsOnlyWhatTheFingerprintOwns) {
+  Fixture f;
+  std::filesystem::remove_all(f.params.dir);
+  (void)tile_acquisition(f.acquisitions[0], f.params, "old");
+  (void)tile_acquisition(f.acquisitions[1], f.params, "new");
+  std::filesystem::create_directories(f.params.dir / "3_4");           // an older layout
+  std::filesystem::create_directories(f.params.dir / "a7");            // beyond the acquisitions
+  std::filesystem::create_directories(f.params.dir / "staging/a0.x.1");  // another process's work
+  prune_tile_store(f.params.dir, 2, "new", false);
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a0"));
+  EXPECT_TRUE(read_acquisition_tiling(f.params.dir, 1, "new").has_value());
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "3_4"));
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a7"));
+  EXPECT_TRUE(std::filesystem::exists(f.params.dir / "staging/a0.x.1")) << "staging kept when others may tile";
+  prune_tile_store(f.params.dir, 2, "new", true);
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "staging"));
+  EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 1, "other").has_value());
+}
+
 }  // namespace
 }  // namespace citymesh

@@ -6,13 +6,15 @@
 #include <cstddef>
 #include <cstdio>
 #include <filesystem>
+#include <string>
 #include <string_view>
 
 namespace citymesh {
 
 class AtomicFile {
  public:
-  /// Opens "<final>.tmp.<pid>" for writing. Throws OutputError naming the file.
+  /// Opens "<final>.tmp.<host>.<pid>" for writing (unique across the machines of a cluster
+  /// sharing the folder). Throws OutputError naming the file.
   explicit AtomicFile(std::filesystem::path final_path);
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -33,8 +35,16 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// "<host>.<pid>": names this process's temporary files and folders uniquely among the
+/// processes of every machine sharing a folder.
+std::string process_tag();
+
 /// Writes `content` to `path` atomically.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
+
+/// fsyncs a folder, so that names renamed into it survive a crash (best effort: some
+/// filesystems refuse folder handles).
+void sync_directory(const std::filesystem::path& dir);
 
 /// Where a folder replaced with replace_directory_atomically is built: "<target>.partial".
 std::filesystem::path staging_directory(const std::filesystem::path& target);

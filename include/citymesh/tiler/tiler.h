@@ -1,11 +1,13 @@
 // SPDX-License-Identifier: MIT
 // The tiler: streams each acquisition once, with bounded buffers, onto the tile grid and
-// writes the tile store (chunk files per tile and acquisition, then a manifest).
+// writes the tile store: a folder per acquisition (a chunk file per tile and a summary), then
+// a manifest. Acquisitions are tiled independently, so the processes of a cluster share them.
 #pragma once
 
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <span>
 #include <string>
@@ -21,7 +23,7 @@ namespace citymesh {
 struct TilerParams {
   TileGridParams grid;
   PlyReadParams ply;
-  std::filesystem::path dir;                ///< the tile store folder; emptied first
+  std::filesystem::path dir;                ///< the tile store folder
   std::uint64_t buffer_bytes = 256ull << 20;  ///< buffered triangles are flushed past this
 };
 
@@ -47,14 +49,48 @@ struct TileStore {
   std::string fingerprint;  ///< what the caller says the store was made from
 };
 
-/// Streams every acquisition once and writes <dir>/<tile>/<acquisition>.bin; each triangle goes
+/// What tiling one acquisition gave (its <dir>/a<k>/summary.json).
+struct AcquisitionTiling {
+  std::uint64_t triangles = 0;                             ///< the acquisition's triangles
+  std::map<TileKey, std::array<std::uint64_t, 3>> counts;  ///< per tile: triangles per role
+  TilingStats stats;
+  std::string fingerprint;  ///< what the caller says the tiling was made from
+};
+
+/// Streams one acquisition once and writes <dir>/a<k>/<tile>.bin; each triangle goes
 /// to the tile owning its centroid, as halo to the tiles within `halo`, and as empty space to
 /// the other tiles its tetrahedron with the viewpoint (the barycentre of its vertices' sensor
 /// positions) crosses. Vertices of one acquisition are held whole (positions, sensor positions
-/// and attributes: ~60 bytes each); triangles are buffered up to `buffer_bytes`. Throws
-/// InputError naming the file on malformed input, OutputError when the store cannot be written.
+/// and attributes: ~60 bytes each); triangles are buffered up to `buffer_bytes`. The folder is
+/// built under <dir>/staging/ with a name unique to this process and renamed into place with
+/// its summary, so it counts as finished only whole. Processes sharing `dir` may tile the same
+/// acquisition at once: the first to finish wins and the others keep its copy (the tiler is
+/// deterministic, so the bytes are the same). Throws InputError naming the file on malformed
+/// input, OutputError when the store cannot be written.
+AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerParams& params,
+                                   const std::string& fingerprint);
+
+/// The finished tiling of acquisition `k` in `dir` made with `fingerprint`, or nothing.
+std::optional<AcquisitionTiling> read_acquisition_tiling(const std::filesystem::path& dir, std::uint32_t acquisition,
+                                                         const std::string& fingerprint);
+
+/// The store made of every acquisition's tiling (`parts[k]`: acquisition k).
+TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridParams& grid,
+                              std::span<const AcquisitionTiling> parts, std::string fingerprint);
+
+/// Removes from `dir` what a store of `acquisitions` made with `fingerprint` does not use: the
+/// manifest, acquisition folders of another fingerprint or beyond the count, older layouts;
+/// with `staging` also unfinished staging folders (only when no other process can be tiling
+/// into `dir`).
+void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions, const std::string& fingerprint,
+                      bool staging);
+
+/// Empties `params.dir`, tiles every acquisition in turn and assembles the store (without a
+/// fingerprint or manifest).
 TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params);
 
+/// The folder of one acquisition in the store.
+std::filesystem::path acquisition_tiles_path(const std::filesystem::path& dir, std::uint32_t acquisition);
 /// The chunk file of one acquisition in one tile (it may not exist: nothing of it there).
 std::filesystem::path tile_chunk_path(const std::filesystem::path& dir, TileKey key, std::uint32_t acquisition);
 
