@@ -27,3 +27,11 @@ endif()
 
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+
+# Optional: OpenMPI (libopenmpi-dev) for runs across machines; tools/setup installs it.
+# Only the C API is used (cluster_mpi.cpp), through the C++ compiler wrapper's flags.
+set(MPI_CXX_SKIP_MPICXX ON)
+find_package(MPI COMPONENTS CXX)
+if(NOT MPI_CXX_FOUND)
+  message(STATUS "MPI not found: citymesh runs in one process (install libopenmpi-dev for mpirun)")
+endif()

@@ -21,6 +21,7 @@ std::vector<std::unique_ptr<Command>> make_commands() {
   commands.push_back(make_detect_command());
   commands.push_back(make_mosaic_command());
   commands.push_back(make_run_command());
+  commands.push_back(make_merge_command());
   commands.push_back(make_eval_command());
   commands.push_back(make_check_command());
   commands.push_back(make_view_command());

@@ -32,6 +32,7 @@ std::unique_ptr<Command> make_detect_command();
 std::unique_ptr<Command> make_eval_command();
 std::unique_ptr<Command> make_run_command();
 std::unique_ptr<Command> make_mosaic_command();
+std::unique_ptr<Command> make_merge_command();
 std::unique_ptr<Command> make_check_command();
 std::unique_ptr<Command> make_view_command();
 

@@ -6,9 +6,13 @@
 #include <optional>
 
 #include "citymesh/config/config.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "command.h"
 #include "pipeline.h"
+#include "cluster.h"
+#include "tile_plan.h"
 #include "tiled_run.h"
 
 namespace citymesh::app {
@@ -26,26 +30,45 @@ class RunCommand final : public Command {
     options_.declare(app);
     app.add_option("--memory", memory_, "memory budget for tiles in flight, e.g. 2GiB (default: [run] memory)");
     app.add_flag("--force", force_, "discard work in the work folder made with another config instead of refusing");
+    app.add_option("--subset", subset_,
+                   "process only part i of N of the tiles (and the tiles of other parts they wait for), e.g. "
+                   "--subset 2/8 in a job array; then citymesh merge CONFIG writes the outputs");
     app.footer(
         "Tiles the acquisitions into <work>/tiles ([tiling]), processes the tiles in parallel within\n"
         "the memory budget (<work>/results; finished tiles are reused when the command is run again),\n"
         "then writes <output>/detect (as citymesh detect; [output] labels), <output>/mosaic:\n"
         "mosaic.ply (per-face source_acq and source_face), mosaic.png and summary.json, and\n"
-        "<output>/run.json. --set mosaic.method=update-model runs the paper's baseline. Example:\n"
+        "<output>/run.json. --set mosaic.method=update-model runs the paper's baseline.\n"
+        "Started by mpirun or srun (MPI), the ranks share the work folder: they tile the acquisitions\n"
+        "and process the tiles together, rank 0 writes the outputs (docs/cluster.md). Example:\n"
         "  citymesh simulate --out sim && citymesh run sim/config.toml && citymesh eval sim/out --truth sim");
   }
 
   void run() override {
     // --memory is [run] memory given on the command line: same checks, same messages.
     if (memory_) options_.overrides.push_back(fmt::format("run.memory=\"{}\"", *memory_));
-    const Config config = options_.load();
-    const ThreadLimit limit(options_.threads.value_or(config.run.threads));
-    run_tiled(config, {.force = force_, .pictures = options_.pictures()});
+    std::optional<Subset> subset;
+    if (subset_) subset = Subset::parse(*subset_);
+    const std::unique_ptr<Cluster> cluster = join_cluster();
+    if (subset && cluster->size() > 1) throw UsageError("--subset is for runs without MPI; under mpirun the ranks share the tiles");
+    try {
+      const Config config = options_.load();
+      const ThreadLimit limit(options_.threads.value_or(config.run.threads));
+      run_tiled(config, {.force = force_, .pictures = options_.pictures(), .subset = subset}, *cluster);
+    } catch (const Error& e) {
+      // The other ranks may be waiting for this one: end them all, with this error's code.
+      if (cluster->size() > 1) {
+        log::error("run (rank {} of {}): {} error: {}", cluster->rank(), cluster->size(), e.kind(), e.what());
+        cluster->abort(static_cast<int>(e.exit_code()));
+      }
+      throw;
+    }
   }
 
  private:
   PipelineOptions options_;
   std::optional<std::string> memory_;
+  std::optional<std::string> subset_;
   bool force_ = false;
 };
 

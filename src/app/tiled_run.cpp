@@ -2,6 +2,7 @@
 #include "tiled_run.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <condition_variable>
@@ -23,160 +24,12 @@
 #include "run_state.h"
 #include "tile_assembly.h"
 #include "tile_job.h"
+#include "run_stages.h"
 #include "tileset_output.h"
 
 namespace citymesh::app {
 
 namespace {
-
-/// Estimated peak bytes of a tile in flight per triangle it holds (all roles): meshes, change
-/// step (~180 B) and mosaic, measured on the default street (docs/tiling.md).
-constexpr std::uint64_t kBytesPerTileTriangle = 900;
-
-/// Bounds the estimated bytes of the tiles in flight. A tile larger than the whole budget
-/// still runs, alone.
-class MemoryGate {
- public:
-  explicit MemoryGate(std::uint64_t budget) : budget_(budget) {}
-  void acquire(std::uint64_t bytes) {
-    std::unique_lock lock(mutex_);
-    freed_.wait(lock, [&] { return in_use_ == 0 || in_use_ + bytes <= budget_; });
-    in_use_ += bytes;
-  }
-  void release(std::uint64_t bytes) {
-    {
-      const std::lock_guard lock(mutex_);
-      in_use_ -= bytes;
-    }
-    freed_.notify_all();
-  }
-
- private:
-  std::mutex mutex_;
-  std::condition_variable freed_;
-  std::uint64_t budget_, in_use_ = 0;
-};
-
-/// Progress lines on stderr: tiles done, input triangles per second, ETA, memory.
-class Progress {
- public:
-  Progress(std::size_t tiles, std::uint64_t triangles) : tiles_(tiles), triangles_(triangles) {}
-  void done(std::uint64_t owned) {
-    const std::lock_guard lock(mutex_);
-    ++done_;
-    triangles_done_ += owned;
-    if (done_ < tiles_ && since_line_.seconds() < 1.0) return;
-    since_line_.restart();
-    const double rate = static_cast<double>(triangles_done_) / std::max(clock_.seconds(), 1e-9);
-    const double eta = rate > 0 ? static_cast<double>(triangles_ - triangles_done_) / rate : 0.0;
-    log::info("tiles {}/{}, {:.2f} M triangles/s, ETA {:.0f} s, memory {:.0f} MiB", done_, tiles_, rate / 1e6, eta,
-              static_cast<double>(resident_bytes()) / (1 << 20));
-  }
-
- private:
-  std::mutex mutex_;
-  std::size_t tiles_, done_ = 0;
-  std::uint64_t triangles_, triangles_done_ = 0;
-  Stopwatch clock_, since_line_;
-};
-
-std::filesystem::path result_path(const Config& config, TileKey key) {
-  return config.project.work / "results" / (key.name() + ".bin");
-}
-
-TileStore tile_or_reuse(const Config& config, std::uint64_t tiling_fingerprint) {
-  const std::filesystem::path dir = config.project.work / "tiles";
-  const std::string wanted = fmt::format("{:016x}", tiling_fingerprint);
-  if (std::optional<TileStore> store = read_tile_manifest(dir); store && store->fingerprint == wanted) {
-    log::info("{}: reusing the tile store ({} tiles)", dir.string(), store->tiles.size());
-    return *store;
-  }
-  TilerParams params;
-  params.grid = {config.tiling.tile_size, config.tiling.halo, config.tiling.origin};
-  params.ply = config.ply_read_params();
-  params.dir = dir;
-  params.buffer_bytes = std::max<std::uint64_t>(config.run.memory / 4, 16ull << 20);
-  TileStore store = tile_acquisitions(config.acquisition_list(), params);
-  store.fingerprint = wanted;
-  write_tile_manifest(store);
-  log::info("tiled {} acquisitions into {} tiles in {:.2f} s", store.triangles.size(), store.tiles.size(),
-            store.stats.seconds);
-  return store;
-}
-
-struct TileTimes {
-  std::vector<nlohmann::json> per_tile;
-  std::size_t reused = 0;
-};
-
-/// The labels of the neighbours of `key` processed in earlier phases, sorted.
-std::vector<OwnedLabel> settled_labels(const Config& config, const TileStore& store, TileKey key,
-                                       std::uint64_t fingerprint) {
-  std::vector<OwnedLabel> labels;
-  for (std::int32_t di = -1; di <= 1; ++di) {
-    for (std::int32_t dj = -1; dj <= 1; ++dj) {
-      const TileKey n{key.i + di, key.j + dj};
-      if (tile_phase(n) >= tile_phase(key)) continue;
-      const auto it = std::lower_bound(store.tiles.begin(), store.tiles.end(), n,
-                                       [](const TileContents& t, TileKey k) { return t.key < k; });
-      if (it == store.tiles.end() || it->key != n) continue;
-      std::optional<TileResult> r = read_tile_result(result_path(config, n), fingerprint, store);
-      if (!r) throw ProcessingError(fmt::format("{}: missing, needed by tile {}", result_path(config, n).string(), key.name()));
-      labels.insert(labels.end(), r->labels.begin(), r->labels.end());
-    }
-  }
-  std::sort(labels.begin(), labels.end(), by_triangle);
-  return labels;
-}
-
-/// Processes every tile without a finished result, phase by phase (tiles of one phase never
-/// touch), largest first within a phase, within the memory budget.
-TileTimes process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint) {
-  std::uint64_t input = 0;
-  for (const TileContents& t : store.tiles) input += t.owned();
-  TileTimes times;
-  times.per_tile.resize(store.tiles.size());
-  MemoryGate gate(config.run.memory);
-  Progress progress(store.tiles.size(), input);
-  std::mutex mutex;
-  for (int phase = 0; phase < kTilePhases; ++phase) {
-    std::vector<std::size_t> order;
-    for (std::size_t k = 0; k < store.tiles.size(); ++k) {
-      if (tile_phase(store.tiles[k].key) == phase) order.push_back(k);
-    }
-    std::stable_sort(order.begin(), order.end(),
-                     [&](std::size_t a, std::size_t b) { return store.tiles[a].total() > store.tiles[b].total(); });
-    parallel_for_blocks(order.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t n = begin; n < end; ++n) {
-        const TileContents& tile = store.tiles[order[n]];
-        const std::filesystem::path file = result_path(config, tile.key);
-        nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
-        if (read_tile_result(file, fingerprint, store)) {
-          entry["reused"] = true;
-          const std::lock_guard lock(mutex);
-          ++times.reused;
-        } else {
-          throw_if_interrupted("tile processing");
-          const std::uint64_t estimate = tile.total() * kBytesPerTileTriangle;
-          gate.acquire(estimate);
-          try {
-            const TileResult r =
-                process_tile(store, tile.key, config, settled_labels(config, store, tile.key, fingerprint));
-            write_tile_result(file, r, fingerprint);
-            entry["seconds"] = {{"read", r.seconds_read}, {"detect", r.seconds_detect}, {"mosaic", r.seconds_mosaic}};
-          } catch (...) {
-            gate.release(estimate);
-            throw;
-          }
-          gate.release(estimate);
-        }
-        times.per_tile[order[n]] = std::move(entry);
-        progress.done(tile.owned());
-      }
-    });
-  }
-  return times;
-}
 
 LoadedAcquisitions describe_acquisitions(const Config& config) {
   LoadedAcquisitions d;
@@ -205,29 +58,32 @@ void write_labels(const Config& config, const TileAssembly& assembly, const Pict
                         .read_seconds = clock.seconds()});
 }
 
-}  // namespace
 
-void run_tiled(const Config& config, const TiledRunOptions& options) {
+/// The outputs from every tile's result: assembly, labels, the seam pass, mosaic, 3D Tiles and
+/// run.json. `seconds` holds the stages timed so far.
+void write_run_outputs(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+                       const TileStageReport& tiles, const PictureOptions& pictures, nlohmann::json seconds,
+                       int ranks) {
   Stopwatch total, clock;
-  const auto keys = result_keys(config);
-  check_run_config(config.project.work, keys, options.force);
-  const std::uint64_t result_fingerprint = fingerprint(keys, false);
-  const TileStore store = tile_or_reuse(config, fingerprint(keys, true));
-  nlohmann::json seconds{{"tiling", clock.restart()}};
-  std::filesystem::create_directories(config.project.work / "results");
-  TileTimes times = process_tiles(config, store, result_fingerprint);
-  seconds["tiles"] = clock.restart();
-
   TileAssembly assembly(store, config.output.labels);
-  for (const TileContents& tile : store.tiles) {
-    std::optional<TileResult> r = read_tile_result(result_path(config, tile.key), result_fingerprint, store);
+  std::vector<nlohmann::json> per_tile;
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    const TileContents& tile = store.tiles[k];
+    std::optional<TileResult> r = read_tile_result(result_path(config, tile.key), fingerprint, store);
     if (!r) throw ProcessingError(fmt::format("{}: the tile result vanished", result_path(config, tile.key).string()));
+    nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
+    if (tiles.processed[k] != 0) {
+      entry["seconds"] = {{"read", r->seconds_read}, {"detect", r->seconds_detect}, {"mosaic", r->seconds_mosaic}};
+    } else {
+      entry["reused"] = true;
+    }
+    per_tile.push_back(std::move(entry));
     assembly.add(std::move(*r));
   }
   MergedMesh merged = assembly.merged();
   const std::uint64_t selected = merged.mesh.triangle_count();
   seconds["assembly"] = clock.restart();
-  if (config.output.labels) write_labels(config, assembly, options.pictures);
+  if (config.output.labels) write_labels(config, assembly, pictures);
   seconds["labels"] = clock.restart();
   // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
   // like seams inside a tile.
@@ -240,20 +96,25 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
   stats.selected = selected;
   write_mosaic_outputs(config, describe_acquisitions(config), merged, stats,
                        {.dir = config.project.output / "mosaic",
-                        .pixel_size = options.pictures.pixel_size,
-                        .pictures = options.pictures.pictures,
+                        .pixel_size = pictures.pixel_size,
+                        .pictures = pictures.pictures,
                         .seconds = seconds,
                         .stitch = stitched});
   seconds["outputs"] = clock.restart();
   const nlohmann::json exported = write_tileset_outputs(config, merged);
   seconds["export"] = clock.restart();
 
-  const double wall = total.seconds();
+  double wall = total.seconds();
+  for (const auto& [stage, s] : seconds.items()) {
+    if (stage == "tiling" || stage == "tiles") wall += s.get<double>();
+  }
+  const std::size_t reused = store.tiles.size() - tiles.count;
   nlohmann::json report;
   report["tiles"] = store.tiles.size();
-  report["reused_tiles"] = times.reused;
+  report["reused_tiles"] = reused;
   report["input_triangles"] = assembly.owned();
   report["output_triangles"] = merged.mesh.triangle_count();
+  report["ranks"] = ranks;
   report["threads"] = available_threads();
   report["memory_budget"] = format_byte_size(config.run.memory);
   report["peak_rss_bytes"] = peak_resident_bytes();
@@ -264,13 +125,81 @@ void run_tiled(const Config& config, const TiledRunOptions& options) {
                       {"empty_space_copies", store.stats.empty_space_copies},
                       {"bytes_written", store.stats.bytes_written}};
   report["export"] = exported;
-  report["per_tile"] = times.per_tile;
+  report["per_tile"] = per_tile;
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
   std::cout << fmt::format("run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
-                           "({:.2f} M triangles/s), peak memory {:.0f} MiB\n",
-                           store.tiles.size(), times.reused, assembly.owned(), merged.mesh.triangle_count(),
-                           wall, static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6,
+                           "({:.2f} M triangles/s), {} rank(s), peak memory {:.0f} MiB (rank 0)\n",
+                           store.tiles.size(), reused, assembly.owned(), merged.mesh.triangle_count(), wall,
+                           static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6, ranks,
                            static_cast<double>(peak_resident_bytes()) / (1 << 20));
+}
+
+/// Every tile index of the store.
+std::vector<std::size_t> all_tiles(const TileStore& store) {
+  std::vector<std::size_t> tiles(store.tiles.size());
+  for (std::size_t k = 0; k < tiles.size(); ++k) tiles[k] = k;
+  return tiles;
+}
+
+/// A subset's share: its tiles and, where they wait for tiles of other subsets that are not
+/// finished yet, those too (the same bytes whoever makes them). No outputs: `merge` writes them.
+void run_subset(const Config& config, const TileStore& store, std::uint64_t fingerprint, const Subset& subset,
+                Cluster& cluster) {
+  Stopwatch clock;
+  const std::vector<std::size_t> own = subset_tiles(store, subset);
+  const std::vector<std::size_t> needed = with_dependencies(store, own);
+  const TileStageReport report = process_tiles(config, store, fingerprint, cluster, needed);
+  std::size_t own_processed = 0;
+  for (const std::size_t k : own) own_processed += report.processed[k];
+  std::cout << fmt::format("subset {}: {} of its {} tiles processed ({} reused); {} tiles of other subsets it waits "
+                           "for processed here, {} reused; {:.2f} s. When every subset is done: citymesh merge CONFIG\n",
+                           subset.name(), own_processed, own.size(), own.size() - own_processed,
+                           report.count - own_processed, needed.size() - own.size() - (report.count - own_processed),
+                           clock.seconds());
+}
+
+}  // namespace
+
+void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cluster) {
+  Stopwatch clock;
+  const auto keys = result_keys(config);
+  if (cluster.root()) check_run_config(config.project.work, keys, options.force);
+  const std::uint64_t result_fingerprint = fingerprint(keys, false);
+  const TileStore store = prepare_tile_store(config, fingerprint(keys, true), cluster, options.subset);
+  nlohmann::json seconds{{"tiling", clock.restart()}};
+  if (options.subset) return run_subset(config, store, result_fingerprint, *options.subset, cluster);
+  const TileStageReport tiles = process_tiles(config, store, result_fingerprint, cluster, all_tiles(store));
+  seconds["tiles"] = clock.restart();
+  // The seam pass and the outputs need every tile: the root writes them alone.
+  if (cluster.root()) write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, cluster.size());
+  cluster.barrier();
+}
+
+void merge_tiled(const Config& config, const PictureOptions& pictures) {
+  const auto keys = result_keys(config);
+  check_run_config(config.project.work, keys, false);
+  const std::uint64_t result_fingerprint = fingerprint(keys, false);
+  const std::filesystem::path dir = config.project.work / "tiles";
+  const std::optional<TileStore> store = read_tile_manifest(dir);
+  if (!store || store->fingerprint != fmt::format("{:016x}", fingerprint(keys, true))) {
+    throw InputError(fmt::format("{}: no finished tile store for this config; run the subsets first "
+                                 "(citymesh run CONFIG --subset i/N)",
+                                 dir.string()));
+  }
+  std::vector<std::string> missing;
+  for (const TileContents& tile : store->tiles) {
+    if (!read_tile_result(result_path(config, tile.key), result_fingerprint, *store)) missing.push_back(tile.key.name());
+  }
+  if (!missing.empty()) {
+    const std::size_t shown = std::min<std::size_t>(missing.size(), 8);
+    throw InputError(fmt::format("{}: {} of {} tiles have no finished result ({}{}); run the subsets that own them "
+                                 "again, or citymesh run CONFIG to finish them here",
+                                 (config.project.work / "results").string(), missing.size(), store->tiles.size(),
+                                 fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
+                                 shown < missing.size() ? ", ..." : ""));
+  }
+  const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0};
+  write_run_outputs(config, *store, result_fingerprint, none, pictures, nlohmann::json::object(), 1);
 }
 
 }  // namespace citymesh::app

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 
@@ -38,6 +39,15 @@ void parallel_for_blocks(std::size_t count, std::size_t grain,
         for (std::size_t b = r.begin(); b != r.end(); ++b) {
           body(b * grain, std::min(count, (b + 1) * grain));
         }
+      },
+      tbb::simple_partitioner());
+}
+
+void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body) {
+  tbb::parallel_for(
+      tbb::blocked_range<unsigned>(0, workers, 1),
+      [&](const tbb::blocked_range<unsigned>& r) {
+        for (unsigned w = r.begin(); w != r.end(); ++w) tbb::this_task_arena::isolate([&] { body(w); });
       },
       tbb::simple_partitioner());
 }

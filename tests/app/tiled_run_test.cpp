@@ -16,18 +16,6 @@ namespace {
 
 nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
 
-/// Every result file of a run (PLYs, pair lists, 3D Tiles), by name: what must not change.
-/// Summaries and the run report hold timings and are left out.
-std::map<std::string, std::string> result_bytes(const std::filesystem::path& output) {
-  std::map<std::string, std::string> files;
-  for (const auto& e : std::filesystem::recursive_directory_iterator(output)) {
-    const auto ext = e.path().extension();
-    const bool tileset = ext == ".json" && e.path().parent_path().filename() == "tiles";
-    if (ext == ".ply" || ext == ".bin" || ext == ".glb" || tileset) files[std::filesystem::relative(e.path(), output).string()] = test::read_text(e.path());
-  }
-  return files;
-}
-
 std::string run_args(const std::string& sim, const std::string& name, const std::string& extra) {
   return fmt::format("run {}/config.toml --no-pictures --set project.output={} --set project.work=work-{} {}", sim,
                      name, name, extra);
@@ -70,9 +58,9 @@ TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {
   const std::string tiles = "--set tiling.tile_size=8";
   ASSERT_EQ(test::run_citymesh(run_args(sim, "t1", tiles + " --threads 1")).exit_code, 0);
   ASSERT_EQ(test::run_citymesh(run_args(sim, "t2", tiles + " --threads 2")).exit_code, 0);
-  const auto reference = result_bytes(dir / "sim/t1");
+  const auto reference = test::result_bytes(dir / "sim/t1");
   ASSERT_GE(reference.size(), 7u);  // labelled PLYs, pairs, mosaic
-  EXPECT_TRUE(result_bytes(dir / "sim/t2") == reference) << "1 and 2 threads differ";
+  EXPECT_TRUE(test::result_bytes(dir / "sim/t2") == reference) << "1 and 2 threads differ";
   EXPECT_GE(read_json(dir / "sim/t1/run.json")["tiles"].get<int>(), 9);
 
   // Killed (SIGKILL) at several moments, then run to the end: the same bytes.
@@ -83,7 +71,7 @@ TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {
   }
   const auto resumed = test::run_citymesh(run_args(sim, "k", tiles));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
-  EXPECT_TRUE(result_bytes(dir / "sim/k") == reference) << "a killed and resumed run differs";
+  EXPECT_TRUE(test::result_bytes(dir / "sim/k") == reference) << "a killed and resumed run differs";
   // A re-run reuses every tile.
   const auto again = test::run_citymesh(run_args(sim, "k", tiles));
   ASSERT_EQ(again.exit_code, 0) << again.err;
@@ -96,7 +84,7 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
   ASSERT_EQ(test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10")).exit_code, 0);
-  const auto reference = result_bytes(dir / "sim/c");
+  const auto reference = test::result_bytes(dir / "sim/c");
 
   const auto changed = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2"));
   EXPECT_EQ(changed.exit_code, 1);
@@ -112,7 +100,7 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   const auto redone = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(redone.exit_code, 0) << redone.err;
   EXPECT_NE(redone.err.find("processed again"), std::string::npos) << redone.err;
-  EXPECT_TRUE(result_bytes(dir / "sim/c") == reference);
+  EXPECT_TRUE(test::result_bytes(dir / "sim/c") == reference);
 
   // A rewritten input file (same bytes, new modification time) is redone, not refused.
   const std::string input = test::read_text(dir / "sim/acq_0.ply");
@@ -122,7 +110,7 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   ASSERT_EQ(rewritten.exit_code, 0) << rewritten.err;
   EXPECT_NE(rewritten.err.find("acquisition[0].file changed"), std::string::npos) << rewritten.err;
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
-  EXPECT_TRUE(result_bytes(dir / "sim/c") == reference);
+  EXPECT_TRUE(test::result_bytes(dir / "sim/c") == reference);
 
   const auto forced = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2 --force"));
   EXPECT_EQ(forced.exit_code, 0) << forced.err;

@@ -143,6 +143,9 @@ TEST_F(ConfigTest, EffectiveConfigIsItselfAValidConfig) {
 TEST(ConfigExamples, CommentedExampleAndDemoParse) {
   const Config example = load_config(test::source_dir() / "configs/example.toml", {.overrides = {}, .check_files = false});
   EXPECT_GE(example.acquisitions.size(), 2u);
+  const Config cluster = load_config(test::source_dir() / "configs/cluster.toml", {.overrides = {}, .check_files = false});
+  EXPECT_GE(cluster.acquisitions.size(), 2u);
+  EXPECT_EQ(cluster.project.work, std::filesystem::path("/shared/citymesh/paris/work"));
   const Config demo = load_config(test::source_dir() / "configs/demo.toml");
   EXPECT_GE(demo.acquisitions.size(), 2u);
 }

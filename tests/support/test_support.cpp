@@ -63,4 +63,16 @@ std::filesystem::path real_data_dir() {
   return std::filesystem::is_directory(dir) ? dir : std::filesystem::path();
 }
 
+std::map<std::string, std::string> result_bytes(const std::filesystem::path& output) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(output)) {
+    const auto ext = e.path().extension();
+    const bool tileset = ext == ".json" && e.path().parent_path().filename() == "tiles";
+    if (ext == ".ply" || ext == ".bin" || ext == ".glb" || tileset) {
+      files[std::filesystem::relative(e.path(), output).string()] = read_text(e.path());
+    }
+  }
+  return files;
+}
+
 }  // namespace citymesh::test

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 namespace citymesh::test {
@@ -36,6 +37,11 @@ std::filesystem::path source_dir();
 std::filesystem::path real_data_dir();
 
 std::string read_text(const std::filesystem::path& path);
+
+/// Every result file under a run's output folder (PLYs, pair lists, glb, tileset JSON), by
+/// relative name: what must not change between equivalent runs. Summaries and run.json hold
+/// timings and are left out.
+std::map<std::string, std::string> result_bytes(const std::filesystem::path& output);
 void write_text(const std::filesystem::path& path, const std::string& text);
 
 }  // namespace citymesh::test

@@ -33,6 +33,12 @@ class ThreadLimit {
 void parallel_for_blocks(std::size_t count, std::size_t grain,
                          const std::function<void(std::size_t, std::size_t)>& body);
 
+/// Runs `body(w)` for every w in [0, workers) on the pool, as long-lived worker loops. Each
+/// body runs isolated: while it waits for its own nested parallel loops, its thread runs only
+/// their tasks, never another worker loop, so a body may block until another body's work is
+/// done without deadlock.
+void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body);
+
 /// Sorts ascending on all threads. Keys are compared whole, so equal keys are identical and
 /// the result does not depend on the thread count.
 void parallel_sort(std::span<std::pair<std::uint32_t, std::uint32_t>> values);

@@ -1,0 +1,41 @@
+// SPDX-License-Identifier: MIT
+// The stages of a tiled run, shared by `citymesh run` (one process or the ranks of an MPI job),
+// `citymesh run --subset i/N` and `citymesh merge`.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "citymesh/config/config.h"
+#include "citymesh/tiler/tiler.h"
+#include "cluster.h"
+#include "tile_plan.h"
+
+namespace citymesh::app {
+
+/// <work>/results/<tile>.bin
+std::filesystem::path result_path(const Config& config, TileKey key);
+
+/// The tile store of `config`: the finished one in <work>/tiles when it was made with
+/// `fingerprint`, otherwise made now. Acquisitions already tiled with `fingerprint` are kept;
+/// the others are handed out to the ranks of `cluster`, largest file first. A subset (which
+/// may run beside other subsets, unknown to it) takes them in turn starting at its own share,
+/// so that subsets started together tile different acquisitions. Collective.
+TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+                             const std::optional<Subset>& subset);
+
+struct TileStageReport {
+  std::vector<std::uint8_t> processed;  ///< per store tile: processed now (not reused)
+  std::size_t count = 0;                ///< tiles processed now
+};
+
+/// Processes every tile of `tiles` (indices into store.tiles, closed under
+/// tile_dependencies) that has no finished result, each once its dependencies are done,
+/// largest first, on the worker threads of every rank within each rank's memory budget.
+/// Results go to <work>/results. Collective; the report is complete on the root only.
+TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+                              Cluster& cluster, const std::vector<std::size_t>& tiles);
+
+}  // namespace citymesh::app

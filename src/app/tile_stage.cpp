@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: MIT
+// The tile stage: every tile processed once its earlier-phase neighbours are done, on the
+// worker threads of every rank, within each rank's memory budget.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <thread>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/process_memory.h"
+#include "citymesh/core/stopwatch.h"
+#include "run_stages.h"
+#include "tile_job.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// Estimated peak bytes of a tile in flight per triangle it holds (all roles): meshes, change
+/// step (~180 B) and mosaic, measured on the default street (docs/tiling.md).
+constexpr std::uint64_t kBytesPerTileTriangle = 900;
+
+/// Bounds the estimated bytes of the tiles in flight. A tile larger than the whole budget
+/// still runs, alone.
+class MemoryGate {
+ public:
+  explicit MemoryGate(std::uint64_t budget) : budget_(budget) {}
+  void acquire(std::uint64_t bytes) {
+    std::unique_lock lock(mutex_);
+    freed_.wait(lock, [&] { return in_use_ == 0 || in_use_ + bytes <= budget_; });
+    in_use_ += bytes;
+  }
+  void release(std::uint64_t bytes) {
+    {
+      const std::lock_guard lock(mutex_);
+      in_use_ -= bytes;
+    }
+    freed_.notify_all();
+  }
+
+ private:
+  std::mutex mutex_;
+  std::condition_variable freed_;
+  std::uint64_t budget_, in_use_ = 0;
+};
+
+/// Progress lines on stderr: tiles done, input triangles per second, ETA, memory.
+class Progress {
+ public:
+  Progress(std::size_t tiles, std::uint64_t triangles) : tiles_(tiles), triangles_(triangles) {}
+  /// Called under the work channel's lock.
+  void done(std::uint64_t owned) {
+    ++done_;
+    triangles_done_ += owned;
+    if (done_ < tiles_ && since_line_.seconds() < 1.0) return;
+    since_line_.restart();
+    const double rate = static_cast<double>(triangles_done_) / std::max(clock_.seconds(), 1e-9);
+    const double eta = rate > 0 ? static_cast<double>(triangles_ - triangles_done_) / rate : 0.0;
+    log::info("tiles {}/{}, {:.2f} M triangles/s, ETA {:.0f} s, memory {:.0f} MiB", done_, tiles_, rate / 1e6, eta,
+              static_cast<double>(resident_bytes()) / (1 << 20));
+  }
+
+ private:
+  std::size_t tiles_, done_ = 0;
+  std::uint64_t triangles_, triangles_done_ = 0;
+  Stopwatch clock_, since_line_;
+};
+
+/// A dependency's result. On a shared filesystem a file another machine just renamed into
+/// place may take a moment to appear: look again for a few seconds before giving up.
+TileResult dependency_result(const Config& config, const TileStore& store, TileKey key, TileKey needed_by,
+                             std::uint64_t fingerprint) {
+  const std::filesystem::path file = result_path(config, key);
+  for (int attempt = 0;; ++attempt) {
+    if (std::optional<TileResult> r = read_tile_result(file, fingerprint, store)) return std::move(*r);
+    if (attempt == 20) throw ProcessingError(fmt::format("{}: missing, needed by tile {}", file.string(), needed_by.name()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(250));
+  }
+}
+
+/// The labels of the tiles `k` waits for, sorted.
+std::vector<OwnedLabel> settled_labels(const Config& config, const TileStore& store, std::size_t k,
+                                       std::uint64_t fingerprint) {
+  std::vector<OwnedLabel> labels;
+  for (const std::size_t d : tile_dependencies(store, k)) {
+    const TileResult r = dependency_result(config, store, store.tiles[d].key, store.tiles[k].key, fingerprint);
+    labels.insert(labels.end(), r.labels.begin(), r.labels.end());
+  }
+  std::sort(labels.begin(), labels.end(), by_triangle);
+  return labels;
+}
+
+/// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
+WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+                           const std::vector<std::size_t>& tiles) {
+  std::vector<std::uint64_t> costs;
+  std::vector<std::vector<std::size_t>> after;
+  std::vector<std::uint8_t> done;
+  for (const std::size_t k : tiles) {
+    costs.push_back(store.tiles[k].total());
+    std::vector<std::size_t> positions;
+    for (const std::size_t d : tile_dependencies(store, k)) {
+      const auto it = std::lower_bound(tiles.begin(), tiles.end(), d);
+      if (it == tiles.end() || *it != d) {
+        throw ProcessingError(fmt::format("tile {} waits for tile {}, which is not planned", store.tiles[k].key.name(),
+                                          store.tiles[d].key.name()));
+      }
+      positions.push_back(static_cast<std::size_t>(it - tiles.begin()));
+    }
+    after.push_back(std::move(positions));
+    done.push_back(read_tile_result(result_path(config, store.tiles[k].key), fingerprint, store) ? 1 : 0);
+  }
+  return WorkSchedule(std::move(costs), after, done);
+}
+
+}  // namespace
+
+std::filesystem::path result_path(const Config& config, TileKey key) {
+  return config.project.work / "results" / (key.name() + ".bin");
+}
+
+TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+                              Cluster& cluster, const std::vector<std::size_t>& tiles) {
+  std::filesystem::create_directories(config.project.work / "results");
+  TileStageReport report;
+  report.processed.assign(store.tiles.size(), 0);
+  std::optional<WorkSchedule> schedule;
+  std::uint64_t input = 0;
+  for (const std::size_t k : tiles) input += store.tiles[k].owned();
+  Progress progress(tiles.size(), input);
+  if (cluster.root()) schedule.emplace(tile_schedule(config, store, fingerprint, tiles));
+  MemoryGate gate(config.run.memory);
+  const auto on_finish = [&](std::size_t item) {
+    report.processed[tiles[item]] = 1;
+    ++report.count;
+    progress.done(store.tiles[tiles[item]].owned());
+  };
+  // The channel ends (every rank's workers stopped) before the report is returned.
+  auto channel = cluster.share(schedule ? &*schedule : nullptr, on_finish);
+  run_workers(*channel, available_threads(), [&](std::size_t item) {
+    const std::size_t k = tiles[item];
+    const TileContents& tile = store.tiles[k];
+    throw_if_interrupted("tile processing");
+    const std::uint64_t estimate = tile.total() * kBytesPerTileTriangle;
+    gate.acquire(estimate);
+    try {
+      const TileResult r = process_tile(store, tile.key, config, settled_labels(config, store, k, fingerprint));
+      write_tile_result(result_path(config, tile.key), r, fingerprint);
+    } catch (...) {
+      gate.release(estimate);
+      throw;
+    }
+    gate.release(estimate);
+  });
+  channel.reset();
+  return report;
+}
+
+}  // namespace citymesh::app

@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+// The tiling stage: acquisitions tiled once each, shared between the ranks of a cluster.
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <nlohmann/json.hpp>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/stopwatch.h"
+#include "run_stages.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// Which acquisition comes first: the largest file (a cluster), or the subset's own share
+/// first, then the others in turn (a subset beside unknown others).
+std::vector<std::uint64_t> tiling_priorities(std::span<const Acquisition> acquisitions,
+                                             const std::optional<Subset>& subset) {
+  const std::size_t n = acquisitions.size();
+  std::vector<std::uint64_t> priority(n);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (subset) {
+      const std::size_t start = (subset->index - 1) * n / subset->count;
+      priority[k] = n - (k + n - start) % n;
+    } else {
+      std::error_code ec;
+      priority[k] = std::filesystem::file_size(acquisitions[k].path, ec);
+    }
+  }
+  return priority;
+}
+
+}  // namespace
+
+TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+                             const std::optional<Subset>& subset) {
+  const std::filesystem::path dir = config.project.work / "tiles";
+  const std::string wanted = fmt::format("{:016x}", fingerprint);
+  const std::optional<TileStore> existing = read_tile_manifest(dir);
+  cluster.barrier();  // every rank has looked before any rank changes the store
+  if (existing && existing->fingerprint == wanted) {
+    log::info("{}: reusing the tile store ({} tiles)", dir.string(), existing->tiles.size());
+    return *existing;
+  }
+  Stopwatch clock;
+  const std::vector<Acquisition> acquisitions = config.acquisition_list();
+  // Only a run that owns the folder removes unfinished staging: subsets may be tiling there.
+  if (cluster.root()) prune_tile_store(dir, acquisitions.size(), wanted, !subset);
+
+  TilerParams params;
+  params.grid = {config.tiling.tile_size, config.tiling.halo, config.tiling.origin};
+  params.ply = config.ply_read_params();
+  params.dir = dir;
+  params.buffer_bytes = std::max<std::uint64_t>(config.run.memory / 4, 16ull << 20);
+  std::optional<WorkSchedule> schedule;
+  if (cluster.root()) {
+    std::vector<std::uint8_t> done(acquisitions.size());
+    for (std::size_t k = 0; k < acquisitions.size(); ++k) {
+      done[k] = read_acquisition_tiling(dir, static_cast<std::uint32_t>(k), wanted).has_value() ? 1 : 0;
+    }
+    schedule.emplace(tiling_priorities(acquisitions, subset),
+                     std::vector<std::vector<std::size_t>>(acquisitions.size()), done);
+  }
+  {
+    // One acquisition at a time per rank: the tiler holds its vertices whole.
+    const auto channel = cluster.share(schedule ? &*schedule : nullptr, nullptr);
+    run_workers(*channel, 1, [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted); });
+  }
+  if (cluster.root()) {
+    std::vector<AcquisitionTiling> parts;
+    for (std::uint32_t k = 0; k < acquisitions.size(); ++k) {
+      std::optional<AcquisitionTiling> part = read_acquisition_tiling(dir, k, wanted);
+      if (!part) throw ProcessingError(fmt::format("{}: the tiled acquisition vanished", acquisition_tiles_path(dir, k).string()));
+      parts.push_back(std::move(*part));
+    }
+    TileStore store = assemble_tile_store(dir, params.grid, parts, wanted);
+    write_tile_manifest(store);
+    log::info("tiled {} acquisitions into {} tiles in {:.2f} s", acquisitions.size(), store.tiles.size(),
+              clock.seconds());
+  }
+  cluster.barrier();
+  std::optional<TileStore> store = read_tile_manifest(dir);
+  if (!store || store->fingerprint != wanted) {
+    throw ProcessingError(fmt::format("{}: no finished tile store after tiling (is the work folder shared by every "
+                                      "rank?)",
+                                      dir.string()));
+  }
+  return *store;
+}
+
+}  // namespace citymesh::app

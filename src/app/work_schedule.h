@@ -1,0 +1,87 @@
+// SPDX-License-Identifier: MIT
+// Handing out work: items with costs and dependencies, taken by worker threads of this
+// process (LocalChannel) or of every rank of an MPI job (cluster.h), largest ready item first.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <set>
+#include <utility>
+#include <vector>
+
+namespace citymesh::app {
+
+/// Which items may start: an item is ready once every item it waits for is finished. Ready
+/// items are taken largest cost first (ties: lowest index), so big tiles do not end a run alone.
+class WorkSchedule {
+ public:
+  /// `after[k]`: the items k waits for (indices < costs.size(), never k). `done[k]`: finished
+  /// already (a resumed run). Throws std::invalid_argument on a bad index.
+  WorkSchedule(std::vector<std::uint64_t> costs, const std::vector<std::vector<std::size_t>>& after,
+               const std::vector<std::uint8_t>& done);
+
+  /// A ready item, now in flight; nothing when none is ready.
+  std::optional<std::size_t> take();
+  /// Marks an item taken earlier as finished; items waiting only for it become ready.
+  void finish(std::size_t item);
+
+  [[nodiscard]] bool finished() const { return done_ == costs_.size(); }
+  [[nodiscard]] std::size_t in_flight() const { return in_flight_; }
+  [[nodiscard]] std::size_t size() const { return costs_.size(); }
+
+ private:
+  void make_ready(std::size_t item) { ready_.emplace(~costs_[item], item); }
+
+  std::vector<std::uint64_t> costs_;
+  std::vector<std::vector<std::size_t>> dependents_;
+  std::vector<std::size_t> waiting_;  ///< unfinished items each item waits for
+  std::set<std::pair<std::uint64_t, std::size_t>> ready_;  ///< (~cost, item): largest first
+  std::size_t done_ = 0, in_flight_ = 0;
+};
+
+/// What a worker gets when it asks for work.
+struct WorkReply {
+  enum class Kind { item, wait, done } kind = Kind::done;
+  std::size_t item = 0;
+};
+
+/// Where a worker thread gets its next item.
+class WorkChannel {
+ public:
+  virtual ~WorkChannel() = default;
+  /// Reports `finished` (the worker's previous item), then blocks until another item is ready
+  /// for this worker; nothing once every item is finished.
+  virtual std::optional<std::size_t> next(std::optional<std::size_t> finished) = 0;
+  /// Wakes every waiting worker with an error: a worker failed, the others stop.
+  virtual void abort() = 0;
+};
+
+/// The worker threads of this process sharing one schedule. `on_finish` runs (under the
+/// channel's lock) for every finished item, whoever processed it.
+class LocalChannel final : public WorkChannel {
+ public:
+  LocalChannel(WorkSchedule& schedule, std::function<void(std::size_t)> on_finish);
+  std::optional<std::size_t> next(std::optional<std::size_t> finished) override;
+  void abort() override;
+  /// next() without blocking, for a worker elsewhere (another rank): an item, wait or done.
+  WorkReply poll(std::optional<std::size_t> finished);
+
+ private:
+  WorkReply step(std::optional<std::size_t> finished);
+
+  WorkSchedule& schedule_;
+  std::function<void(std::size_t)> on_finish_;
+  std::mutex mutex_;
+  std::condition_variable changed_;
+  bool aborted_ = false;
+};
+
+/// Runs `workers` loops (on the TBB pool) that take items from `channel` and call `body` on
+/// each until every item is finished. The first exception stops every loop and is rethrown.
+void run_workers(WorkChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body);
+
+}  // namespace citymesh::app

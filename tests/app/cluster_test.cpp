@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+// Cluster runs through the binary: `mpirun -n 3 citymesh run` and subsets 1/3..3/3 plus
+// `citymesh merge` give the same bytes as one process; a rank killed mid-run loses only its
+// work in flight; merge refuses to assemble an unfinished run.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+
+#include <cstdlib>
+#include <map>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+namespace citymesh {
+namespace {
+
+nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
+
+std::string args(const std::string& sim, const std::string& name) {
+  return fmt::format("{}/config.toml --no-pictures --set project.output={} --set project.work=work-{} "
+                     "--set tiling.tile_size=10",
+                     sim, name, name);
+}
+
+/// mpirun as the tests need it: root allowed (CI containers), more ranks than cores.
+std::string mpirun(int ranks) {
+  return fmt::format("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_rmaps_base_oversubscribe=1 "
+                     "mpirun --oversubscribe -n {} {}",
+                     ranks, CITYMESH_BINARY);
+}
+
+bool have_mpi() {
+#ifdef CITYMESH_WITH_MPI
+  return std::system("command -v mpirun > /dev/null 2>&1") == 0;
+#else
+  return false;
+#endif
+}
+
+/// The default street simulated once, with a one-process run as the reference.
+class ClusterRun : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new test::TempDir;
+    sim_ = (*dir_ / "sim").string();
+    ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {}", sim_)).exit_code, 0);
+    const auto one = test::run_citymesh("run " + args(sim_, "one"));
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+    reference_ = new std::map<std::string, std::string>(test::result_bytes(*dir_ / "sim/one"));
+  }
+  static void TearDownTestSuite() {
+    delete reference_;
+    delete dir_;
+  }
+  static std::filesystem::path output(const std::string& name) { return *dir_ / "sim" / name; }
+
+  static inline test::TempDir* dir_ = nullptr;
+  static inline std::string sim_;
+  static inline std::map<std::string, std::string>* reference_ = nullptr;
+};
+
+TEST_F(ClusterRun, ThreeMpiRanksGiveTheBytesOfOneProcess) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  ASSERT_GE(reference_->size(), 7u);
+  ASSERT_GE(read_json(output("one") / "run.json")["tiles"].get<int>(), 9);
+  const std::string cmd = fmt::format("{} run {} > {} 2>&1", mpirun(3), args(sim_, "mpi"), (*dir_ / "mpi.log").string());
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(*dir_ / "mpi.log");
+  EXPECT_TRUE(test::result_bytes(output("mpi")) == *reference_) << "3 ranks differ from one process";
+  const nlohmann::json report = read_json(output("mpi") / "run.json");
+  EXPECT_EQ(report["ranks"], 3);
+  EXPECT_EQ(report["reused_tiles"], 0);
+}
+
+TEST_F(ClusterRun, AKilledRankLosesOnlyItsWorkInFlight) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  // Kill the newest rank (SIGKILL) while the job runs: mpirun ends the job with an error.
+  const std::filesystem::path script = *dir_ / "kill.sh";
+  test::write_text(script, fmt::format("{} run {} > /dev/null 2>&1 &\njob=$!\nsleep 2.5\n"
+                                       "pkill -KILL -n -f 'citymesh run .*work-kill'\nwait $job\n",
+                                       mpirun(3), args(sim_, "kill")));
+  EXPECT_NE(std::system(("bash " + script.string()).c_str()), 0) << "the job survived a killed rank";
+  ASSERT_FALSE(std::filesystem::exists(output("kill") / "run.json")) << "killed too late to test anything";
+  const std::string again =
+      fmt::format("{} run {} > {} 2>&1", mpirun(3), args(sim_, "kill"), (*dir_ / "kill.log").string());
+  ASSERT_EQ(std::system(again.c_str()), 0) << test::read_text(*dir_ / "kill.log");
+  EXPECT_TRUE(test::result_bytes(output("kill")) == *reference_) << "the resumed job differs";
+  const nlohmann::json report = read_json(output("kill") / "run.json");
+  EXPECT_GT(report["reused_tiles"].get<int>(), 0) << "finished tiles were not kept";
+}
+
+TEST_F(ClusterRun, SubsetsThenMergeGiveTheBytesOfOneProcess) {
+  const std::string run = args(sim_, "sub");
+  const auto early = test::run_citymesh("merge " + run);
+  EXPECT_EQ(early.exit_code, 2) << "merge before any subset";
+  EXPECT_NE(early.err.find("--subset"), std::string::npos) << early.err;
+  std::size_t own_tiles = 0;
+  for (int i = 1; i <= 3; ++i) {
+    const auto part = test::run_citymesh(fmt::format("run {} --subset {}/3", run, i));
+    ASSERT_EQ(part.exit_code, 0) << part.err;
+    EXPECT_NE(part.out.find(fmt::format("subset {}/3:", i)), std::string::npos) << part.out;
+    EXPECT_FALSE(std::filesystem::exists(output("sub") / "mosaic")) << "a subset wrote outputs";
+    if (i == 2) {
+      // Subset 3 has not run: merge names what is missing and writes nothing.
+      const auto partial = test::run_citymesh("merge " + run);
+      EXPECT_EQ(partial.exit_code, 2);
+      EXPECT_NE(partial.err.find("have no finished result"), std::string::npos) << partial.err;
+      EXPECT_FALSE(std::filesystem::exists(output("sub") / "run.json"));
+    }
+    own_tiles += static_cast<std::size_t>(std::stoul(part.out.substr(part.out.find(" of its ") + 8)));
+  }
+  const nlohmann::json one = read_json(output("one") / "run.json");
+  EXPECT_EQ(own_tiles, one["tiles"].get<std::size_t>()) << "every tile belongs to exactly one subset";
+  const auto merged = test::run_citymesh("merge " + run);
+  ASSERT_EQ(merged.exit_code, 0) << merged.err;
+  EXPECT_TRUE(test::result_bytes(output("sub")) == *reference_) << "subsets + merge differ from one process";
+}
+
+TEST_F(ClusterRun, BadSubsetsAreUsageErrors) {
+  for (const char* bad : {"0/3", "4/3", "x"}) {
+    const auto r = test::run_citymesh(fmt::format("run {} --subset {}", args(sim_, "bad"), bad));
+    EXPECT_EQ(r.exit_code, 1) << bad;
+    EXPECT_NE(r.err.find("i/N"), std::string::npos) << r.err;
+  }
+}
+
+}  // namespace
+}  // namespace citymesh

@@ -1,0 +1,143 @@
+// SPDX-License-Identifier: MIT
+// Handing out work: the schedule against a brute-force reference on random dependency graphs,
+// worker threads that never start an item before what it waits for, and failures that stop
+// every worker instead of hanging.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <random>
+#include <stdexcept>
+#include <thread>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "work_schedule.h"
+
+namespace citymesh::app {
+namespace {
+
+struct RandomGraph {
+  std::vector<std::uint64_t> costs;
+  std::vector<std::vector<std::size_t>> after;
+  std::vector<std::uint8_t> done;
+};
+
+/// Items wait only for items of lower index: acyclic. Some items are done already.
+RandomGraph random_graph(std::mt19937& rng, std::size_t n) {
+  RandomGraph g;
+  std::uniform_int_distribution<std::uint64_t> cost(0, 5);  // ties on purpose
+  for (std::size_t k = 0; k < n; ++k) {
+    g.costs.push_back(cost(rng));
+    std::vector<std::size_t> deps;
+    for (std::size_t d = 0; d < k; ++d) {
+      if (rng() % 4 == 0) deps.push_back(d);
+    }
+    g.after.push_back(deps);
+    g.done.push_back(rng() % 5 == 0 ? 1 : 0);
+  }
+  // A done item's dependencies are done too, as in a resumed run.
+  for (std::size_t k = n; k-- > 0;) {
+    if (g.done[k] != 0) {
+      for (const std::size_t d : g.after[k]) g.done[d] = 1;
+    }
+  }
+  return g;
+}
+
+TEST(WorkSchedule, HandsOutTheLargestReadyItemLikeBruteForce) {
+  std::mt19937 rng(7);
+  for (int round = 0; round < 200; ++round) {
+    const RandomGraph g = random_graph(rng, 1 + rng() % 14);
+    WorkSchedule schedule(g.costs, g.after, g.done);
+    std::vector<std::uint8_t> finished = g.done, taken = g.done;
+    std::vector<std::size_t> in_flight;
+    while (!schedule.finished()) {
+      // Brute force: the ready items, largest cost first, then lowest index.
+      std::optional<std::size_t> expected;
+      for (std::size_t k = 0; k < g.costs.size(); ++k) {
+        if (taken[k] != 0) continue;
+        bool ready = true;
+        for (const std::size_t d : g.after[k]) ready = ready && finished[d] != 0;
+        if (ready && (!expected || g.costs[k] > g.costs[*expected])) expected = k;
+      }
+      // Take while something is ready, finishing a random in-flight item now and then.
+      if (expected && (in_flight.empty() || rng() % 2 == 0)) {
+        const std::optional<std::size_t> got = schedule.take();
+        ASSERT_EQ(got, expected) << "round " << round;
+        taken[*got] = 1;
+        in_flight.push_back(*got);
+      } else {
+        ASSERT_FALSE(in_flight.empty()) << "nothing ready, nothing in flight, not finished";
+        if (!expected) {
+          EXPECT_EQ(schedule.take(), std::nullopt);
+        }
+        const std::size_t at = rng() % in_flight.size();
+        schedule.finish(in_flight[at]);
+        finished[in_flight[at]] = 1;
+        in_flight.erase(in_flight.begin() + static_cast<std::ptrdiff_t>(at));
+      }
+    }
+    // Every item finished; items done before the schedule started were never handed out
+    // (the reference skips them and every take matched it).
+    for (std::size_t k = 0; k < g.costs.size(); ++k) EXPECT_NE(finished[k], 0);
+  }
+}
+
+TEST(WorkSchedule, RefusesBadDependencies) {
+  EXPECT_THROW(WorkSchedule({1, 1}, {{1}, {5}}, {0, 0}), std::invalid_argument);
+  EXPECT_THROW(WorkSchedule({1}, {{0}}, {0}), std::invalid_argument);
+  EXPECT_THROW(WorkSchedule({1, 1}, {{}}, {0, 0}), std::invalid_argument);
+}
+
+TEST(LocalChannel, WorkersRunEveryItemOnceAfterWhatItWaitsFor) {
+  std::mt19937 rng(11);
+  for (unsigned threads : {1u, 2u, 4u}) {
+    const ThreadLimit limit(threads);
+    const RandomGraph g = random_graph(rng, 60);
+    WorkSchedule schedule(g.costs, g.after, g.done);
+    std::vector<std::atomic<int>> runs(g.costs.size());
+    std::vector<std::atomic<std::uint8_t>> finished(g.costs.size());
+    for (std::size_t k = 0; k < g.costs.size(); ++k) finished[k] = g.done[k];
+    std::atomic<bool> early = false;
+    std::size_t reported = 0;
+    LocalChannel channel(schedule, [&](std::size_t) { ++reported; });
+    run_workers(channel, threads, [&](std::size_t k) {
+      for (const std::size_t d : g.after[k]) early = early || finished[d] == 0;
+      std::this_thread::sleep_for(std::chrono::microseconds(200 * g.costs[k]));
+      ++runs[k];
+      finished[k] = 1;
+    });
+    EXPECT_FALSE(early) << threads << " threads: an item started before its dependencies";
+    std::size_t expected = 0;
+    for (std::size_t k = 0; k < g.costs.size(); ++k) {
+      EXPECT_EQ(runs[k].load(), g.done[k] != 0 ? 0 : 1) << "item " << k;
+      expected += g.done[k] != 0 ? 0 : 1;
+    }
+    EXPECT_EQ(reported, expected);
+  }
+}
+
+TEST(LocalChannel, AFailingWorkerStopsTheOthersInsteadOfHanging) {
+  const ThreadLimit limit(2);
+  // Item 1 waits for item 0, which fails: the worker waiting for it must not wait forever.
+  WorkSchedule schedule({5, 1, 1}, {{}, {0}, {}}, {0, 0, 0});
+  LocalChannel channel(schedule, nullptr);
+  EXPECT_THROW(run_workers(channel, 2,
+                           [&](std::size_t k) {
+                             if (k == 0) {
+                               std::this_thread::sleep_for(std::chrono::milliseconds(50));
+                               throw InputError("broken tile");
+                             }
+                           }),
+               Error);
+}
+
+TEST(LocalChannel, ACycleIsAnErrorNotAHang) {
+  // Items 0 and 1 wait for each other: nothing is ever ready.
+  WorkSchedule schedule({1, 1}, {{1}, {0}}, {0, 0});
+  LocalChannel channel(schedule, nullptr);
+  EXPECT_THROW(run_workers(channel, 2, [](std::size_t) {}), ProcessingError);
+}
+
+}  // namespace
+}  // namespace citymesh::app
