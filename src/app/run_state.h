@@ -13,7 +13,7 @@ namespace citymesh::app {
 
 inline constexpr const char* kRunConfigFile = "run-config.json";
 /// Bumped whenever what the tiler stores or what a tile result means changes.
-inline constexpr int kTileStoreVersion = 1;
+inline constexpr int kTileStoreVersion = 2;  // 2: one folder per acquisition
 inline constexpr int kTileResultVersion = 2;
 
 /// A hash of the result-affecting keys (tiling_only: those that change the tile store).
