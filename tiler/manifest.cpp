@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
-#include <regex>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
@@ -60,6 +59,17 @@ std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folde
   }
 }
 
+/// k for a folder named "a<k>" (1 to 9 digits), nothing for any other name.
+std::optional<std::size_t> acquisition_folder_index(const std::string& name) {
+  if (name.size() < 2 || name.size() > 10 || name[0] != 'a') return std::nullopt;
+  std::size_t k = 0;
+  for (std::size_t c = 1; c < name.size(); ++c) {
+    if (name[c] < '0' || name[c] > '9') return std::nullopt;
+    k = k * 10 + static_cast<std::size_t>(name[c] - '0');
+  }
+  return k;
+}
+
 /// Whether the manifest in `dir` is readable and made with `fingerprint`.
 bool manifest_made_with(const std::filesystem::path& dir, const std::string& fingerprint) {
   try {
@@ -111,14 +121,12 @@ void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", dir.string(), ec.message()));
-  static const std::regex acquisition_folder("a([0-9]{1,9})");
   std::vector<std::filesystem::path> stale;
   for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
     const std::string name = entry.path().filename().string();
-    std::smatch m;
     if (name == kStagingFolder) {
       if (staging) stale.push_back(entry.path());
-    } else if (std::regex_match(name, m, acquisition_folder) && std::stoull(m[1].str()) < acquisitions) {
+    } else if (const std::optional<std::size_t> k = acquisition_folder_index(name); k && *k < acquisitions) {
       if (!read_summary(entry.path(), fingerprint)) stale.push_back(entry.path());
     } else if (name == kManifestFile) {
       if (!manifest_made_with(dir, fingerprint)) stale.push_back(entry.path());
