@@ -18,6 +18,10 @@ namespace citymesh::app {
 /// <work>/results/<tile>.bin
 std::filesystem::path result_path(const Config& config, TileKey key);
 
+/// The finished tile store in <work>/tiles when it was made with `fingerprint`; nothing
+/// otherwise.
+std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t fingerprint);
+
 /// The tile store of `config`: the finished one in <work>/tiles when it was made with
 /// `fingerprint`, otherwise made now. Acquisitions already tiled with `fingerprint` are kept;
 /// the others are handed out to the ranks of `cluster`, largest file first. A subset (which

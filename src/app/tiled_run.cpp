@@ -5,26 +5,22 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
-#include <condition_variable>
 #include <iostream>
-#include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
-#include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
-#include "citymesh/tiler/tiler.h"
 #include "detect_output.h"
 #include "mosaic_output.h"
 #include "mosaic_step.h"
 #include "run_state.h"
 #include "tile_assembly.h"
-#include "tile_job.h"
 #include "run_stages.h"
+#include "tile_job.h"
 #include "tileset_output.h"
 
 namespace citymesh::app {
@@ -179,12 +175,11 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const auto keys = result_keys(config);
   check_run_config(config.project.work, keys, false);
   const std::uint64_t result_fingerprint = fingerprint(keys, false);
-  const std::filesystem::path dir = config.project.work / "tiles";
-  const std::optional<TileStore> store = read_tile_manifest(dir);
-  if (!store || store->fingerprint != fmt::format("{:016x}", fingerprint(keys, true))) {
+  const std::optional<TileStore> store = finished_tile_store(config, fingerprint(keys, true));
+  if (!store) {
     throw InputError(fmt::format("{}: no finished tile store for this config; run the subsets first "
                                  "(citymesh run CONFIG --subset i/N)",
-                                 dir.string()));
+                                 (config.project.work / "tiles").string()));
   }
   std::vector<std::string> missing;
   for (const TileContents& tile : store->tiles) {

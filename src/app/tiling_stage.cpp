@@ -32,15 +32,23 @@ std::vector<std::uint64_t> tiling_priorities(std::span<const Acquisition> acquis
   return priority;
 }
 
+std::string store_fingerprint(std::uint64_t fingerprint) { return fmt::format("{:016x}", fingerprint); }
+
 }  // namespace
+
+std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t fingerprint) {
+  std::optional<TileStore> store = read_tile_manifest(config.project.work / "tiles");
+  if (!store || store->fingerprint != store_fingerprint(fingerprint)) return std::nullopt;
+  return store;
+}
 
 TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
                              const std::optional<Subset>& subset) {
   const std::filesystem::path dir = config.project.work / "tiles";
-  const std::string wanted = fmt::format("{:016x}", fingerprint);
-  const std::optional<TileStore> existing = read_tile_manifest(dir);
+  const std::string wanted = store_fingerprint(fingerprint);
+  const std::optional<TileStore> existing = finished_tile_store(config, fingerprint);
   cluster.barrier();  // every rank has looked before any rank changes the store
-  if (existing && existing->fingerprint == wanted) {
+  if (existing) {
     log::info("{}: reusing the tile store ({} tiles)", dir.string(), existing->tiles.size());
     return *existing;
   }
@@ -81,8 +89,8 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
               clock.seconds());
   }
   cluster.barrier();
-  std::optional<TileStore> store = read_tile_manifest(dir);
-  if (!store || store->fingerprint != wanted) {
+  std::optional<TileStore> store = finished_tile_store(config, fingerprint);
+  if (!store) {
     throw ProcessingError(fmt::format("{}: no finished tile store after tiling (is the work folder shared by every "
                                       "rank?)",
                                       dir.string()));
