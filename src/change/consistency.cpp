@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/radix_sort.h"
 #include "frames.h"
 
 namespace citymesh::change_detail {
@@ -87,7 +88,7 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
     pairs.insert(pairs.end(), b.begin(), b.end());
     std::vector<TrianglePair>().swap(b);
   }
-  parallel_sort(pairs);
+  radix_sort_pairs(pairs);
   stats.consistent_pairs = pairs.size();
   return pairs;
 }

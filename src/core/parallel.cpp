@@ -5,7 +5,6 @@
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
-#include <tbb/parallel_sort.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 
@@ -50,10 +49,6 @@ void parallel_workers(unsigned workers, const std::function<void(unsigned)>& bod
         for (unsigned w = r.begin(); w != r.end(); ++w) tbb::this_task_arena::isolate([&] { body(w); });
       },
       tbb::simple_partitioner());
-}
-
-void parallel_sort(std::span<std::pair<std::uint32_t, std::uint32_t>> values) {
-  tbb::parallel_sort(values.begin(), values.end());
 }
 
 }  // namespace citymesh

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/radix_sort.h"
 
 #ifdef __SSE2__
 #include <emmintrin.h>  // four box tests at once: SSE2 is part of x86-64
@@ -135,7 +136,7 @@ BoxTree::BoxTree(std::vector<Box3f> boxes) : impl_(std::make_unique<Impl>()) {
   parallel_for_blocks(boxes.size(), 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) order[i] = {frame.code(boxes[i]), static_cast<std::uint32_t>(i)};
   });
-  parallel_sort(order);  // ties broken by index: the same tree on any thread count
+  radix_sort_pairs(order);  // ties broken by index: the same tree on any thread count
   std::vector<Box3f> sorted(boxes.size());
   impl_->original.resize(boxes.size());
   for (std::size_t i = 0; i < order.size(); ++i) {

@@ -2,9 +2,13 @@
 // Change detection on a simulated street the size of the paper's Robotcar experiment (about
 // 300 k triangles over 7 epochs): wall time per step, triangles/s, pre-filter hit rate and
 // speed-up, 1 and 2 threads, and peak memory per input triangle.
-//   detect_bench [--length 30] [--epochs 7] [--voxel 0.5]
+// The default run is repeated (`--repeat`, default 5) and judged on its median wall time: one
+// run on a shared 2-core machine varies by ±10 %.
+//   detect_bench [--length 30] [--epochs 7] [--voxel 0.5] [--repeat 5]
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
 #include <string>
@@ -48,10 +52,12 @@ int main(int argc, char** argv) {
   street.length = 30.0f;
   street.epochs = 7;
   ChangeParams with;
+  int repeat = 5;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (std::strcmp(argv[i], "--voxel") == 0) with.voxel_size = std::stod(argv[i + 1]);
     if (std::strcmp(argv[i], "--length") == 0) street.length = std::stof(argv[i + 1]);
     if (std::strcmp(argv[i], "--epochs") == 0) street.epochs = std::stoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::max(1, std::stoi(argv[i + 1]));
   }
   bench::BenchScene scene = bench::simulated_street(street.length, street.epochs);
   std::vector<Mesh>& meshes = scene.meshes;
@@ -92,6 +98,15 @@ int main(int argc, char** argv) {
     const ChangeResult single = detect_changes({meshes, dates}, with);
     print_run("1 thread, pre-filter", single.stats, clock.seconds());
   }
-  fmt::print("target: <= 0.5 s wall on 2 cores -> {}\n", wall <= 0.5 ? "met" : "NOT met");
+  std::vector<double> walls{wall};
+  for (int k = 1; k < repeat; ++k) {
+    clock.restart();
+    const ChangeResult again = detect_changes({meshes, dates}, with);
+    walls.push_back(clock.seconds());
+  }
+  std::sort(walls.begin(), walls.end());
+  const double median = walls[walls.size() / 2];
+  fmt::print("2 threads, pre-filter, {} runs: {:.3f} s (sorted)\n", walls.size(), fmt::join(walls, " "));
+  fmt::print("target: median {:.3f} s <= 0.5 s wall on 2 cores -> {}\n", median, median <= 0.5 ? "met" : "NOT met");
   return 0;
 }

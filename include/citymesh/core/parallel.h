@@ -39,8 +39,4 @@ void parallel_for_blocks(std::size_t count, std::size_t grain,
 /// done without deadlock.
 void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body);
 
-/// Sorts ascending on all threads. Keys are compared whole, so equal keys are identical and
-/// the result does not depend on the thread count.
-void parallel_sort(std::span<std::pair<std::uint32_t, std::uint32_t>> values);
-
 }  // namespace citymesh

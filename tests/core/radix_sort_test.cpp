@@ -1,0 +1,46 @@
+// SPDX-License-Identifier: MIT
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <vector>
+
+#include "citymesh/core/radix_sort.h"
+
+namespace citymesh {
+namespace {
+
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+Pairs random_pairs(std::size_t n, std::uint32_t first_max, std::uint32_t second_max, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_int_distribution<std::uint32_t> first(0, first_max), second(0, second_max);
+  Pairs out(n);
+  for (auto& p : out) p = {first(rng), second(rng)};
+  return out;
+}
+
+void expect_sorted_like_std(Pairs values) {
+  Pairs expected = values;
+  std::sort(expected.begin(), expected.end());
+  radix_sort_pairs(values);
+  EXPECT_EQ(values, expected);
+}
+
+TEST(RadixSortPairs, MatchesStdSortOnSmallAndLargeKeys) {
+  expect_sorted_like_std(random_pairs(10'000, 300'000, 300'000, 1));        // triangle ids
+  expect_sorted_like_std(random_pairs(10'000, 0xffffffffu, 0xffffffffu, 2));  // every digit used
+  expect_sorted_like_std(random_pairs(5'000, 7, 3, 3));                        // many ties
+  expect_sorted_like_std(random_pairs(3'000, 0, 0xffffffffu, 4));              // first all zero
+  expect_sorted_like_std(random_pairs(3'001, (1u << 30) - 1, 0, 5));            // odd pass count
+}
+
+TEST(RadixSortPairs, EdgeCases) {
+  expect_sorted_like_std({});
+  expect_sorted_like_std({{5, 1}});
+  expect_sorted_like_std({{0, 0}, {0, 0}});
+  expect_sorted_like_std({{2, 1}, {1, 2}, {1, 1}, {0xffffffffu, 0}, {0, 0xffffffffu}});
+}
+
+}  // namespace
+}  // namespace citymesh
