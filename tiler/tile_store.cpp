@@ -13,6 +13,7 @@
 #include <unordered_map>
 
 #include "citymesh/core/checksum.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/error.h"
 
 namespace citymesh {
@@ -158,10 +159,9 @@ void sync_tile_files(const std::filesystem::path& dir) {
 }
 
 TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin, std::uint32_t acquisition) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open the tile chunk", file.string()));
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return decode_tile_blocks(bytes, origin, acquisition, file.string());
+  const std::optional<std::string> bytes = read_file_bytes(file);
+  if (!bytes) throw InputError(fmt::format("{}: cannot open the tile chunk", file.string()));
+  return decode_tile_blocks(*bytes, origin, acquisition, file.string());
 }
 
 TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,

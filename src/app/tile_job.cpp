@@ -11,6 +11,7 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/stopwatch.h"
@@ -174,9 +175,9 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
 
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
                                            const TileStore& store) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::optional<std::string> read = read_file_bytes(file);
+  if (!read) return std::nullopt;
+  const std::string& bytes = *read;
   ResultHeader h{};
   std::uint64_t sum = 0;
   const auto stale = [&](std::string_view why) -> std::optional<TileResult> {

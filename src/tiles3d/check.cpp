@@ -12,6 +12,7 @@
 #include <set>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/encode/glb.h"
 
 namespace citymesh {
@@ -21,9 +22,9 @@ namespace {
 using nlohmann::json;
 
 std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(fmt::format("{}: cannot open", path.string()));
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  const std::optional<std::string> bytes = read_file_bytes(path);
+  if (!bytes) throw InputError(fmt::format("{}: cannot open", path.string()));
+  return {bytes->begin(), bytes->end()};
 }
 
 bool finite_numbers(const json& j, std::size_t count) {
