@@ -21,7 +21,9 @@ namespace citymesh::app {
 
 namespace {
 
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '1'};
+// Version 02: a version 01 result may have been cut short by a failing worker (fixed in
+// parallel_workers); such folders are processed again rather than trusted.
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '2'};
 
 struct ResultHeader {
   char magic[8];

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 
@@ -46,7 +47,16 @@ void parallel_workers(unsigned workers, const std::function<void(unsigned)>& bod
   tbb::parallel_for(
       tbb::blocked_range<unsigned>(0, workers, 1),
       [&](const tbb::blocked_range<unsigned>& r) {
-        for (unsigned w = r.begin(); w != r.end(); ++w) tbb::this_task_arena::isolate([&] { body(w); });
+        for (unsigned w = r.begin(); w != r.end(); ++w) {
+          tbb::this_task_arena::isolate([&] {
+            // An isolated cancellation group: when another worker throws, TBB cancels this
+            // loop's context, and without its own group a worker's nested loops would be cut
+            // short and return normally - a half-computed tile written as finished.
+            tbb::task_group_context own(tbb::task_group_context::isolated);
+            tbb::task_group group(own);
+            group.run_and_wait([&] { body(w); });
+          });
+        }
       },
       tbb::simple_partitioner());
 }

@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <stdexcept>
+#include <thread>
 #include <mutex>
 #include <set>
 #include <vector>
@@ -43,6 +46,32 @@ TEST(ParallelForBlocks, EmptyRangeCallsNothing) {
   int calls = 0;
   parallel_for_blocks(0, 10, [&](std::size_t, std::size_t) { ++calls; });
   EXPECT_EQ(calls, 0);
+}
+
+// A worker that throws must not cut short another worker's nested loop: the loop would return
+// normally with blocks skipped, and a tile computed by it would be written as finished.
+TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
+  ThreadLimit limit(2);
+  constexpr std::size_t kBlocks = 200;
+  std::atomic<bool> started{false};
+  std::atomic<std::size_t> blocks_run{0};
+  EXPECT_THROW(parallel_workers(2,
+                                [&](unsigned w) {
+                                  if (w == 0) {
+                                    std::this_thread::sleep_for(std::chrono::milliseconds(30));
+                                    throw std::runtime_error("worker 0 fails");
+                                  }
+                                  started = true;
+                                  parallel_for_blocks(kBlocks, 1, [&](std::size_t, std::size_t) {
+                                    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                                    ++blocks_run;
+                                  });
+                                }),
+               std::runtime_error);
+  // With one thread worker 1 may never start; once started, its loop must run every block.
+  if (started) {
+    EXPECT_EQ(blocks_run.load(), kBlocks);
+  }
 }
 
 TEST(ThreadLimit, BoundsTheAvailableThreads) {

@@ -36,7 +36,8 @@ void parallel_for_blocks(std::size_t count, std::size_t grain,
 /// Runs `body(w)` for every w in [0, workers) on the pool, as long-lived worker loops. Each
 /// body runs isolated: while it waits for its own nested parallel loops, its thread runs only
 /// their tasks, never another worker loop, so a body may block until another body's work is
-/// done without deadlock.
+/// done without deadlock. A body that throws ends the call with its exception, but never cuts
+/// short the nested loops of the bodies still running: they finish whatever they started.
 void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body);
 
 }  // namespace citymesh
