@@ -8,13 +8,11 @@
 
 #include <cstdio>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <unordered_map>
 
 #include "citymesh/core/checksum.h"
-#include "citymesh/core/read_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/read_file.h"
 
 namespace citymesh {
 

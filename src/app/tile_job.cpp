@@ -5,15 +5,13 @@
 
 #include <algorithm>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <unordered_map>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
-#include "citymesh/core/read_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/mosaic.h"
 

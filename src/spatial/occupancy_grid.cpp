@@ -57,7 +57,8 @@ struct OccupancyGrid::Impl {
   openvdb::BoolGrid::Ptr grid;
   openvdb::BoolGrid::Accessor accessor;  ///< caches the last nodes marked (not thread-safe, like marking)
   std::array<openvdb::CoordBBox, kRecentBoxes> recent;  ///< boxes marked lately, by box_slot
-  Impl(double voxel_size, openvdb::BoolGrid::Ptr g) : size(voxel_size), inverse_size(1.0 / voxel_size), grid(std::move(g)), accessor(grid->getAccessor()) {}
+  Impl(double voxel_size, openvdb::BoolGrid::Ptr g)
+      : size(voxel_size), inverse_size(1.0 / voxel_size), grid(std::move(g)), accessor(grid->getAccessor()) {}
 };
 
 namespace {

@@ -5,11 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
-#include <iterator>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <set>
+#include <span>
+#include <string>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
@@ -21,10 +21,17 @@ namespace {
 
 using nlohmann::json;
 
-std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path) {
-  const std::optional<std::string> bytes = read_file_bytes(path);
-  if (!bytes) throw InputError(fmt::format("{}: cannot open", path.string()));
-  return {bytes->begin(), bytes->end()};
+/// The file's bytes, or nullopt when it is missing or unreadable (reported, not thrown).
+std::optional<std::string> read_bytes(const std::filesystem::path& path) {
+  try {
+    return read_file_bytes(path);
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
+std::span<const std::uint8_t> as_bytes(const std::string& s) {
+  return {reinterpret_cast<const std::uint8_t*>(s.data()), s.size()};
 }
 
 bool finite_numbers(const json& j, std::size_t count) {
@@ -57,12 +64,9 @@ class Checker {
   void tileset_file(const std::string& name, double parent_error, int depth) {
     if (!visited_.insert(name).second) return error(name, "", "referenced twice (a cycle or a shared external tileset)");
     const std::filesystem::path path = dir_ / name;
-    std::vector<std::uint8_t> bytes;
-    try {
-      bytes = read_bytes(path);
-    } catch (const InputError&) {
-      return error(name, "", "missing or unreadable");
-    }
+    const std::optional<std::string> read = read_bytes(path);
+    if (!read) return error(name, "", "missing or unreadable");
+    const std::string& bytes = *read;
     ++report_.json_files;
     report_.json_bytes += bytes.size();
     if (bytes.size() > params_.max_json_bytes) {
@@ -139,16 +143,12 @@ class Checker {
   }
 
   void glb(const std::string& name, const std::optional<Bounds>& bounds, bool leaf) {
-    std::vector<std::uint8_t> bytes;
-    try {
-      bytes = read_bytes(dir_ / name);
-    } catch (const InputError&) {
-      return error(name, "", "missing or unreadable");
-    }
+    const std::optional<std::string> bytes = read_bytes(dir_ / name);
+    if (!bytes) return error(name, "", "missing or unreadable");
     ++report_.glb_files;
-    report_.glb_bytes += bytes.size();
+    report_.glb_bytes += bytes->size();
     try {
-      const GlbFile g = parse_glb(bytes, name);
+      const GlbFile g = parse_glb(as_bytes(*bytes), name);
       glb_json(name, g.json);
       const DecodedMesh m = read_glb_mesh(g, name);
       glb_mesh(name, g.json, m, bounds);
