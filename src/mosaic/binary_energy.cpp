@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <deque>
 #include <numeric>
 #include <random>
 
@@ -26,32 +25,54 @@ namespace {
 /// The interaction strength of a pair: e01 + e10 - e00 - e11, > 0 for submodular terms.
 double coupling(const BinaryEnergy::Pair& p) { return p.e01 + p.e10 - p.e00 - p.e11; }
 
+/// The pair with its ends flipped as asked (x -> 1 - x).
+BinaryEnergy::Pair flip_pair(BinaryEnergy::Pair p, bool flip_i, bool flip_j) {
+  if (flip_i) {
+    std::swap(p.e00, p.e10);
+    std::swap(p.e01, p.e11);
+  }
+  if (flip_j) {
+    std::swap(p.e00, p.e01);
+    std::swap(p.e10, p.e11);
+  }
+  // Rounding can leave a modular term a hair non-submodular: it carries no coupling.
+  if (!p.submodular() && coupling(p) > -1e-12 * (std::abs(p.e00) + std::abs(p.e11) + 1)) p.e11 = p.e01 + p.e10 - p.e00;
+  return p;
+}
+
 /// Loads a cut graph into our max-flow.
 MaxFlow max_flow_of(const CutGraph& c) {
   MaxFlow g(c.nodes);
+  g.reserve_edges(c.arcs.size());
   for (std::size_t i = 0; i < c.nodes; ++i) {
     if (c.terminal[i][0] > 0 || c.terminal[i][1] > 0) {
       g.add_terminal(static_cast<MaxFlow::Node>(i), c.terminal[i][0], c.terminal[i][1]);
     }
   }
-  for (const CutGraph::Arc& a : c.arcs) g.add_edge(a.from, a.to, a.capacity, 0);
+  for (const CutGraph::Arc& a : c.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
   return g;
 }
 
 }  // namespace
 
-CutGraph cut_graph(const BinaryEnergy& e, bool doubled) {
+CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips) {
+  const auto flipped_at = [&flips](std::uint32_t i) { return !flips.empty() && flips[i] != 0; };
   const std::size_t n = e.size();
   CutGraph g;
   g.nodes = doubled ? 2 * n : n;
   g.terminal.assign(g.nodes, {0.0, 0.0});
-  const auto add_edge = [&g](std::uint32_t from, std::uint32_t to, double capacity) {
-    g.arcs.push_back({from, to, capacity});
+  // Both directions of a pair of nodes go into one arc pair: half the arcs to scan.
+  const auto add_edge = [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse = 0) {
+    g.arcs.push_back({from, to, capacity, reverse});
   };
   std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0 (constants dropped)
-  for (std::size_t i = 0; i < n; ++i) cost_of_one[i] = e.unary[i][1] - e.unary[i][0];
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto v = static_cast<std::uint32_t>(i);
+    cost_of_one[i] = flipped_at(v) ? e.unary[i][0] - e.unary[i][1] : e.unary[i][1] - e.unary[i][0];
+  }
   const auto bar = [n](std::uint32_t i) { return static_cast<std::uint32_t>(n + i); };
-  for (const BinaryEnergy::Pair& p : e.pairs) {
+  for (const BinaryEnergy::Pair& term : e.pairs) {
+    const BinaryEnergy::Pair p = flips.empty() ? term : flip_pair(term, flipped_at(term.i), flipped_at(term.j));
     // Each term is written as unary parts plus two "both ways" costs of weights alpha and
     // beta (alpha + beta = |coupling|), split so that the unary parts are balanced: unary
     // parts push flow through the graph from terminal to terminal, and a split that leaves
@@ -63,13 +84,10 @@ CutGraph cut_graph(const BinaryEnergy& e, bool doubled) {
       const double beta = std::clamp((2 * p.e10 - p.e00 - p.e11) / 2, 0.0, c), alpha = c - beta;
       cost_of_one[p.i] += p.e10 - p.e00 - beta;
       cost_of_one[p.j] += p.e01 - p.e00 - alpha;
-      if (alpha > 0) {
-        add_edge(i, j, alpha);  // cut when i is on the source side and j is not
-        if (doubled) add_edge(bar(j), bar(i), alpha);
-      }
-      if (beta > 0) {
-        add_edge(j, i, beta);
-        if (doubled) add_edge(bar(i), bar(j), beta);
+      // alpha: cut when i is on the source side and j is not; beta: the other way round.
+      if (alpha > 0 || beta > 0) {
+        add_edge(i, j, alpha, beta);
+        if (doubled) add_edge(bar(j), bar(i), alpha, beta);
       }
     } else {
       if (!doubled) throw ProcessingError("graph cut: a non-submodular term in a single cut");
@@ -102,26 +120,41 @@ CutGraph cut_graph(const BinaryEnergy& e, bool doubled) {
 }
 
 
+bool flips_make_submodular(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
+  return std::all_of(e.pairs.begin(), e.pairs.end(), [&](const BinaryEnergy::Pair& p) {
+    const double c = coupling(p);
+    return c == 0 || (c < 0) == ((flips[p.i] != 0) != (flips[p.j] != 0));
+  });
+}
+
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e) {
   const std::size_t n = e.size();
-  // Adjacency: for each pair with a real coupling, whether its ends must differ.
-  std::vector<std::vector<std::pair<std::uint32_t, bool>>> adjacent(n);
+  // Adjacency (compressed rows): for each pair with a real coupling, whether its ends must differ.
+  std::vector<std::uint32_t> offsets(n + 1, 0);
+  for (const BinaryEnergy::Pair& p : e.pairs) {
+    if (coupling(p) == 0) continue;
+    ++offsets[p.i + 1];
+    ++offsets[p.j + 1];
+  }
+  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
+  std::vector<std::pair<std::uint32_t, bool>> adjacent(offsets.back());
+  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
   for (const BinaryEnergy::Pair& p : e.pairs) {
     const double c = coupling(p);
     if (c == 0) continue;
-    adjacent[p.i].emplace_back(p.j, c < 0);
-    adjacent[p.j].emplace_back(p.i, c < 0);
+    adjacent[fill[p.i]++] = {p.j, c < 0};
+    adjacent[fill[p.j]++] = {p.i, c < 0};
   }
   std::vector<std::int8_t> colour(n, -1);
-  std::deque<std::uint32_t> queue;
+  std::vector<std::uint32_t> queue;
   for (std::uint32_t s = 0; s < n; ++s) {
     if (colour[s] >= 0) continue;
     colour[s] = 0;
-    queue.push_back(s);
-    while (!queue.empty()) {
-      const std::uint32_t i = queue.front();
-      queue.pop_front();
-      for (const auto& [j, differ] : adjacent[i]) {
+    queue.assign(1, s);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::uint32_t i = queue[head];
+      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
+        const auto [j, differ] = adjacent[k];
         const auto want = static_cast<std::int8_t>(differ ? 1 - colour[i] : colour[i]);
         if (colour[j] < 0) {
           colour[j] = want;
@@ -140,23 +173,12 @@ BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips)
   for (std::size_t i = 0; i < f.size(); ++i) {
     if (flips[i] != 0) std::swap(f.unary[i][0], f.unary[i][1]);
   }
-  for (BinaryEnergy::Pair& p : f.pairs) {
-    if (flips[p.i] != 0) {
-      std::swap(p.e00, p.e10);
-      std::swap(p.e01, p.e11);
-    }
-    if (flips[p.j] != 0) {
-      std::swap(p.e00, p.e01);
-      std::swap(p.e10, p.e11);
-    }
-    // Rounding can leave a modular term a hair non-submodular: it carries no coupling.
-    if (!p.submodular() && coupling(p) > -1e-12 * (std::abs(p.e00) + std::abs(p.e11) + 1)) p.e11 = p.e01 + p.e10 - p.e00;
-  }
+  for (BinaryEnergy::Pair& p : f.pairs) p = flip_pair(p, flips[p.i] != 0, flips[p.j] != 0);
   return f;
 }
 
 std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
-  MaxFlow g = max_flow_of(cut_graph(flipped(e, flips), /*doubled=*/false));
+  MaxFlow g = max_flow_of(cut_graph(e, /*doubled=*/false, flips));
   g.solve();
   const std::vector<std::uint8_t> source = g.source_side();
   std::vector<std::int8_t> x(e.size());

@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <limits>
 
 #include "citymesh/core/error.h"
@@ -254,16 +253,15 @@ double MaxFlow::solve() {
 
 std::vector<std::uint8_t> MaxFlow::source_side() const {
   std::vector<std::uint8_t> side(nodes_.size(), 0);
-  std::deque<Node> queue;
+  std::vector<Node> queue;
   for (Node i = 0; i < nodes_.size(); ++i) {
     if (nodes_[i].terminal > zero_) {
       side[i] = 1;
       queue.push_back(i);
     }
   }
-  while (!queue.empty()) {
-    const Node i = queue.front();
-    queue.pop_front();
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const Node i = queue[head];
     for (Arc a = nodes_[i].first; a != kNone; a = arcs_[a].next) {
       const Node j = arcs_[a].head;
       if (side[j] == 0 && arcs_[a].residual > zero_) {

@@ -6,32 +6,14 @@
 
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/binary_energy.h"
+#include "restricted_energy.h"
 
 namespace citymesh {
 
+using mosaic_detail::PairIndex;
+using mosaic_detail::restricted;
+
 namespace {
-
-/// Pair indices per variable.
-struct PairIndex {
-  std::vector<std::uint32_t> offsets, pairs;
-
-  explicit PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
-    for (const auto& p : e.pairs) {
-      ++offsets[p.i + 1];
-      ++offsets[p.j + 1];
-    }
-    for (std::size_t i = 0; i < e.size(); ++i) offsets[i + 1] += offsets[i];
-    pairs.resize(offsets.back());
-    std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (std::uint32_t k = 0; k < e.pairs.size(); ++k) {
-      pairs[fill[e.pairs[k].i]++] = k;
-      pairs[fill[e.pairs[k].j]++] = k;
-    }
-  }
-  [[nodiscard]] std::span<const std::uint32_t> of(std::uint32_t v) const {
-    return {pairs.data() + offsets[v], pairs.data() + offsets[v + 1]};
-  }
-};
 
 /// Cost of v taking label `l` given every other variable's label in x.
 double local_cost(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x, std::uint32_t v,
@@ -84,31 +66,6 @@ std::vector<std::vector<std::uint32_t>> free_components(const BinaryEnergy& e, c
     }
   }
   return components;
-}
-
-/// The energy of the variables flagged in `open` with every other variable fixed to x;
-/// `local` receives the variables in order (local index -> variable).
-BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x,
-                        std::span<const std::uint32_t> open, std::vector<std::uint32_t>& to_local) {
-  BinaryEnergy r;
-  r.unary.resize(open.size());
-  for (std::uint32_t l = 0; l < open.size(); ++l) to_local[open[l]] = l;
-  for (std::uint32_t l = 0; l < open.size(); ++l) {
-    const std::uint32_t v = open[l];
-    r.unary[l] = e.unary[v];
-    for (const std::uint32_t k : index.of(v)) {
-      const auto& p = e.pairs[k];
-      const std::uint32_t o = p.i == v ? p.j : p.i;
-      if (to_local[o] != UINT32_MAX) {
-        if (p.i == v) r.pairs.push_back({l, to_local[o], p.e00, p.e01, p.e10, p.e11});  // once, from its i end
-        continue;
-      }
-      for (int b = 0; b < 2; ++b) r.unary[l][static_cast<std::size_t>(b)] += p.i == v ? p.value(b != 0, x[o] != 0)
-                                                                                       : p.value(x[o] != 0, b != 0);
-    }
-  }
-  for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;
-  return r;
 }
 
 /// Energy terms touching the component (unaries of its variables, pairs with an end in it).
@@ -186,48 +143,6 @@ std::vector<std::int8_t> improve_qpbo_i(const BinaryEnergy& e, std::span<const s
     }
   }
   return x;
-}
-
-GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std::uint32_t> group,
-                                      std::vector<std::int8_t>& x, int max_sweeps) {
-  const PairIndex index(e);
-  GroupMoveStats stats;
-  const std::uint32_t groups = group.empty() ? 0 : *std::max_element(group.begin(), group.end()) + 1;
-  std::vector<std::uint32_t> to_local(e.size(), UINT32_MAX);
-  for (int sweep = 0; sweep < max_sweeps; ++sweep) {
-    ++stats.sweeps;
-    bool changed = false;
-    for (std::uint32_t k = 0; k < groups; ++k) {
-      std::vector<std::uint32_t> open;
-      for (std::uint32_t v = 0; v < e.size(); ++v) {
-        if (group[v] == k || x[v] == 1) open.push_back(v);
-      }
-      if (open.empty()) continue;
-      ++stats.moves;
-      const BinaryEnergy sub = restricted(e, index, x, open, to_local);
-      std::vector<std::int8_t> y;
-      if (const auto flips = submodular_flips(sub)) {
-        y = minimise_by_flipped_cut(sub, *flips);
-        ++stats.exact_moves;
-      } else {
-        y = qpbo(sub);  // persistent labels only; the others keep their value
-        for (std::size_t l = 0; l < y.size(); ++l) {
-          if (y[l] == kUnlabelled) y[l] = x[open[l]];
-        }
-      }
-      // The restricted energy differs from the whole one by a constant: compare there.
-      std::vector<std::int8_t> now(open.size());
-      for (std::size_t l = 0; l < open.size(); ++l) now[l] = x[open[l]];
-      const double before = sub.evaluate(now), after = sub.evaluate(y);
-      if (after < before - 1e-9 * (1 + std::abs(before))) {
-        for (std::size_t l = 0; l < open.size(); ++l) x[open[l]] = y[l];
-        ++stats.improving_moves;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  return stats;
 }
 
 std::vector<std::int8_t> minimise(const BinaryEnergy& e, const ImproveParams& params, MinimiseStats& stats) {

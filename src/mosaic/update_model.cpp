@@ -18,14 +18,19 @@ namespace {
 /// Visits the acquisitions in `order`; in each, selects the kept triangles with no selected
 /// triangle within the distance threshold of their centroid (what is selected at the start of
 /// the acquisition: its own triangles never hide each other). Returns how many were added.
+/// The triangles selected at the start are indexed once; the ones added on the way are
+/// indexed again per acquisition (few, for the hole fill).
 std::uint64_t add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected) {
   const ChangeResult& change = *input.change;
   const GlobalTriangles& index = change.index;
   const double reach = input.distance_threshold;
+  const MergedMesh initial = merge_selection(input.meshes, index, selected);
+  const MeshProximity near_initial(initial.mesh, reach);
+  std::vector<std::uint8_t> added_so_far(selected.size(), 0);
   std::uint64_t added = 0;
   for (const std::size_t a : order) {
-    const MergedMesh kept = merge_selection(input.meshes, index, selected);
-    const MeshProximity near(kept.mesh, reach);
+    const MergedMesh later = merge_selection(input.meshes, index, added_so_far);
+    const MeshProximity near_later(later.mesh, reach);
     const Mesh& mesh = input.meshes[a];
     const std::size_t base = index.offsets[a];
     std::vector<std::uint8_t> add(mesh.triangle_count(), 0);
@@ -33,11 +38,13 @@ std::uint64_t add_uncovered(const MosaicInput& input, std::span<const std::size_
       for (std::size_t t = begin; t < end; ++t) {
         if (change.kept[base + t] == 0 || selected[base + t] != 0) continue;
         const auto [p, q, r] = mesh.corners(t);
-        add[t] = near.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
+        const Vec3d centroid = (p + q + r) / 3.0;
+        add[t] = near_initial.any_within(centroid, reach) || near_later.any_within(centroid, reach) ? 0 : 1;
       }
     });
     for (std::size_t t = 0; t < add.size(); ++t) {
       selected[base + t] |= add[t];
+      added_so_far[base + t] |= add[t];
       added += add[t];
     }
   }

@@ -2,10 +2,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 #include <vector>
 
+#include "citymesh/core/parallel.h"
 #include "citymesh/mosaic/binary_energy.h"
+#include "restricted_energy.h"
 
 namespace citymesh {
 namespace {
@@ -130,6 +133,12 @@ TEST(Qpbo, TwoMeshEnergiesAreFlippedAndSolvedExactly) {
   }
 }
 
+GroupMoveParams sweeps(int max_sweeps) {
+  GroupMoveParams params;
+  params.max_sweeps = max_sweeps;
+  return params;
+}
+
 TEST(GroupMoves, NeverRaiseTheEnergyAndUsuallyReachTheMinimumOnThreeMeshEnergies) {
   // Three "meshes": overlap terms across meshes (odd cycles: QPBO cannot label them), seam
   // terms inside each; every move must be exact and improving or rejected.
@@ -157,7 +166,7 @@ TEST(GroupMoves, NeverRaiseTheEnergyAndUsuallyReachTheMinimumOnThreeMeshEnergies
     }
     std::vector<std::int8_t> x(n, 0);
     const double start = e.evaluate(x);
-    const GroupMoveStats stats = improve_by_group_moves(e, group, x, 5);
+    const GroupMoveStats stats = improve_by_group_moves(e, group, x, sweeps(5));
     const double energy = e.evaluate(x);
     ASSERT_LE(energy, start + 1e-12) << "trial " << trial;
     ASSERT_EQ(stats.exact_moves, stats.moves) << "trial " << trial;  // no overlaps among the kept
@@ -165,6 +174,103 @@ TEST(GroupMoves, NeverRaiseTheEnergyAndUsuallyReachTheMinimumOnThreeMeshEnergies
     optimal += energy <= enumerate(e).minimum + 1e-9 ? 1 : 0;
   }
   EXPECT_GT(optimal, trials * 8 / 10) << optimal;
+}
+
+/// A street-like energy: `n` variables of three meshes spread along a line, overlap terms
+/// between nearby variables of different meshes, seam terms between nearby ones of the same.
+BinaryEnergy street_energy(std::mt19937& rng, std::size_t n, std::vector<std::uint32_t>& group,
+                           std::vector<float>& coordinate) {
+  BinaryEnergy e;
+  std::uniform_real_distribution<double> reward(-1.5, 0.3), w(0, 1);
+  std::uniform_real_distribution<float> where(0, float(n) / 10);
+  for (std::size_t v = 0; v < n; ++v) {
+    group.push_back(static_cast<std::uint32_t>(v % 3));
+    coordinate.push_back(where(rng));
+    e.unary.push_back({0.0, reward(rng)});
+  }
+  for (std::uint32_t i = 0; i < n; ++i) {
+    for (std::uint32_t j = i + 1; j < n; ++j) {
+      if (std::abs(coordinate[i] - coordinate[j]) > 0.5f || rng() % 4 != 0) continue;
+      if (group[i] != group[j]) {
+        e.pairs.push_back({i, j, 0, 0, 0, 10});
+      } else {
+        const double c = w(rng);
+        e.pairs.push_back({i, j, 0, c, c, 0});
+      }
+    }
+  }
+  return e;
+}
+
+TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThreadCount) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<std::uint32_t> group;
+    std::vector<float> coordinate;
+    const BinaryEnergy e = street_energy(rng, 600, group, coordinate);
+    std::vector<std::int8_t> whole(e.size(), 0);
+    improve_by_group_moves(e, group, whole, sweeps(3));
+    std::vector<std::vector<std::int8_t>> split;
+    for (const unsigned threads : {1u, 2u}) {
+      const ThreadLimit limit(threads);
+      std::vector<std::int8_t> x(e.size(), 0);
+      GroupMoveParams params = sweeps(3);
+      params.coordinate = coordinate;
+      params.slabs = 4;
+      params.border_hops = 2;
+      const GroupMoveStats stats = improve_by_group_moves(e, group, x, params);
+      ASSERT_EQ(stats.exact_moves, stats.moves) << "trial " << trial;
+      ASSERT_GT(stats.solves, stats.moves);  // slabs and borders, not one cut per move
+      ASSERT_LE(e.evaluate(x), 0.0);         // never above the empty start
+      split.push_back(x);
+    }
+    ASSERT_EQ(split[0], split[1]) << "trial " << trial;
+    // Holding the borders fixed costs little against one cut per move.
+    EXPECT_LE(e.evaluate(split[0]), e.evaluate(whole) + 0.02 * std::abs(e.evaluate(whole))) << "trial " << trial;
+  }
+}
+
+TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<std::uint32_t> group;
+    std::vector<float> coordinate;
+    const BinaryEnergy e = street_energy(rng, 400, group, coordinate);
+    const mosaic_detail::PairIndex index(e);
+    std::vector<std::uint8_t> open(e.size());
+    std::vector<std::uint32_t> all, slab(e.size());
+    for (std::uint32_t v = 0; v < e.size(); ++v) {
+      open[v] = rng() % 3 != 0 ? 1 : 0;
+      if (open[v] != 0) all.push_back(v);
+      slab[v] = static_cast<std::uint32_t>(coordinate[v] / 10.0f);  // 4 slabs along the street
+    }
+    const mosaic_detail::SlabSplit split = mosaic_detail::split_by_slab(index, all, open, slab, 4);
+    std::vector<int> where(e.size(), -2);  // -2 not listed, -1 border, else the interior's slab
+    std::size_t listed = split.border.size();
+    for (const std::uint32_t v : split.border) where[v] = -1;
+    for (std::uint32_t s = 0; s < 4; ++s) {
+      listed += split.interior[s].size();
+      for (const std::uint32_t v : split.interior[s]) {
+        ASSERT_EQ(slab[v], s);
+        where[v] = static_cast<int>(s);
+      }
+    }
+    ASSERT_EQ(listed, all.size());  // each open variable exactly once
+    ASSERT_GT(split.border.size(), 0u);
+    for (const auto& p : e.pairs) {
+      if (where[p.i] >= 0 && where[p.j] >= 0) {
+        ASSERT_EQ(where[p.i], where[p.j]) << "trial " << trial;
+      }
+    }
+    for (const std::uint32_t v : split.border) {  // a border variable really reaches another slab
+      bool reaches = false;
+      for (const auto& p : e.pairs) {
+        const std::uint32_t o = p.i == v ? p.j : p.j == v ? p.i : v;
+        reaches = reaches || (o != v && open[o] != 0 && slab[o] != slab[v]);
+      }
+      ASSERT_TRUE(reaches);
+    }
+  }
 }
 
 TEST(Qpbo, ThreeMutuallyOverlappingTrianglesCannotBeFlipped) {

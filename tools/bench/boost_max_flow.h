@@ -31,10 +31,10 @@ inline BoostRun boost_max_flow(const CutGraph& c) {
   const auto source = static_cast<Traits::vertex_descriptor>(c.nodes), sink = source + 1;
   auto capacity = boost::get(boost::edge_capacity, g);
   auto reverse = boost::get(boost::edge_reverse, g);
-  const auto add = [&](std::size_t from, std::size_t to, double cap) {
+  const auto add = [&](std::size_t from, std::size_t to, double cap, double reverse_cap = 0) {
     const auto e = boost::add_edge(from, to, g).first, r = boost::add_edge(to, from, g).first;
     capacity[e] = cap;
-    capacity[r] = 0;
+    capacity[r] = reverse_cap;
     reverse[e] = r;
     reverse[r] = e;
   };
@@ -42,7 +42,7 @@ inline BoostRun boost_max_flow(const CutGraph& c) {
     if (c.terminal[i][0] > 0) add(source, i, c.terminal[i][0]);
     if (c.terminal[i][1] > 0) add(i, sink, c.terminal[i][1]);
   }
-  for (const CutGraph::Arc& a : c.arcs) add(a.from, a.to, a.capacity);
+  for (const CutGraph::Arc& a : c.arcs) add(a.from, a.to, a.capacity, a.reverse_capacity);
   BoostRun run;
   run.seconds_build = clock.restart();
   run.flow = boost::boykov_kolmogorov_max_flow(g, source, sink);

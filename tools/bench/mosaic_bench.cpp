@@ -3,12 +3,13 @@
 // epochs; the paper reports 2107 s with QPBO-I at that size): wall time per phase, energy,
 // unlabelled fraction before and after improvement; and our max-flow against Boost.Graph's
 // boykov_kolmogorov_max_flow on the same two-mesh graphs.
-//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3]
+//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5]
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <cstring>
 #include <string>
+#include <vector>
 
 #include "bench_scene.h"
 #include "citymesh/change/detect.h"
@@ -25,11 +26,11 @@ namespace {
 
 void print_selection(const char* label, const MosaicSelection& s, double wall) {
   const MosaicStats& t = s.stats;
-  fmt::print("{:<22} {:6.3f} s | build {:.3f}, solve {:.3f} | {} variables, {} seam and {} overlap terms | {}\n",
-             label, wall, t.seconds_build, t.seconds_solve, t.candidates, t.seam_terms, t.overlap_terms,
+  fmt::print("{:<22} {:6.3f} s | build {:.3f}, solve {:.3f}, fill {:.3f} | {} variables, {} seam and {} overlap terms | {}\n",
+             label, wall, t.seconds_build, t.seconds_solve, t.seconds_fill, t.candidates, t.seam_terms, t.overlap_terms,
              t.solver.exact ? "exact (flipped single cut)"
-                            : fmt::format("{} group moves in {} sweeps ({} exact, {} improving)", t.moves.moves,
-                                          t.moves.sweeps, t.moves.exact_moves, t.moves.improving_moves));
+                            : fmt::format("{} group moves in {} sweeps ({} exact, {} improving; {} cuts)", t.moves.moves,
+                                          t.moves.sweeps, t.moves.exact_moves, t.moves.improving_moves, t.moves.solves));
   fmt::print("  energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f}); {} selected\n", t.energy,
              t.quality, t.boundary, t.seam, t.overlap, t.selected);
 }
@@ -52,7 +53,7 @@ void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& chang
     for (std::size_t i = 0; i < graph.nodes; ++i) {
       g.add_terminal(static_cast<MaxFlow::Node>(i), graph.terminal[i][0], graph.terminal[i][1]);
     }
-    for (const CutGraph::Arc& a : graph.arcs) g.add_edge(a.from, a.to, a.capacity, 0);
+    for (const CutGraph::Arc& a : graph.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
     const double build = clock.restart();
     const double flow = g.solve();
     const double solve = clock.seconds();
@@ -79,22 +80,33 @@ void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& chang
 int main(int argc, char** argv) {
   float length = 30.0f;
   int epochs = 7;
+  int repeat = 5;
   MosaicParams params;
   for (int i = 1; i + 1 < argc; i += 2) {
     if (std::strcmp(argv[i], "--sweeps") == 0) params.sweeps = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--length") == 0) length = std::stof(argv[i + 1]);
     if (std::strcmp(argv[i], "--epochs") == 0) epochs = std::stoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::stoi(argv[i + 1]);
   }
   const bench::BenchScene scene = bench::simulated_street(length, epochs);
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", length, scene.meshes.size(), scene.triangles);
   const ChangeParams change_params;
   const ChangeResult change = detect_changes({scene.meshes, scene.dates}, change_params);
   const MosaicInput input{scene.meshes, scene.dates, &change, change_params.distance_threshold, {}};
+  // The target is judged on the median of `repeat` runs: single runs on this shared VM vary
+  // by +-10 %.
+  std::vector<double> walls;
+  MosaicSelection energy;
+  for (int r = 0; r < std::max(1, repeat); ++r) {
+    Stopwatch run_clock;
+    energy = select_mosaic(input, params);
+    walls.push_back(run_clock.seconds());
+    print_selection("mosaic (2 threads)", energy, walls.back());
+  }
+  std::sort(walls.begin(), walls.end());
+  const double wall = walls[walls.size() / 2];
+  fmt::print("mosaic median of {} runs: {:.3f} s\n", walls.size(), wall);
   Stopwatch clock;
-  const MosaicSelection energy = select_mosaic(input, params);
-  const double wall = clock.seconds();
-  print_selection("mosaic (2 threads)", energy, wall);
-  clock.restart();
   const MosaicSelection baseline = select_update_model(input);
   fmt::print("update model baseline   {:6.3f} s, {} selected of {}\n", clock.seconds(), baseline.stats.selected,
              baseline.stats.candidates);

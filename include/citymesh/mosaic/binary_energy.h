@@ -38,6 +38,10 @@ constexpr std::int8_t kUnlabelled = -1;
 /// overlap terms between them only, flipping one mesh is such a set.
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e);
 
+/// True when flipping the variables in `flips` makes every pairwise term submodular (the
+/// test submodular_flips() applies to the set it finds): a cheap check of a known candidate.
+bool flips_make_submodular(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
+
 /// The energy with the variables in `flips` flipped (x -> 1 - x): same minimum, relabelled.
 BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
 
@@ -47,13 +51,14 @@ BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips)
 struct CutGraph {
   struct Arc {
     std::uint32_t from = 0, to = 0;
-    double capacity = 0;
+    double capacity = 0, reverse_capacity = 0;  ///< from -> to, and to -> from
   };
   std::size_t nodes = 0;
   std::vector<std::array<double, 2>> terminal;  ///< per node: from the source, to the sink
   std::vector<Arc> arcs;
 };
-CutGraph cut_graph(const BinaryEnergy& e, bool doubled);
+/// With `flips` (one flag per variable), the graph of the energy flipped there.
+CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips = {});
 
 /// Exact minimum of an energy whose terms are all submodular once the variables in `flips`
 /// are flipped: one graph cut. Returns a complete labelling.
@@ -76,8 +81,22 @@ struct ImproveParams {
 std::vector<std::int8_t> improve_qpbo_i(const BinaryEnergy& e, std::span<const std::int8_t> partial,
                                         const ImproveParams& params, double* completed_energy = nullptr);
 
+struct GroupMoveParams {
+  int max_sweeps = 2;
+  /// One coordinate per variable (a triangle's centroid along the scene's longest axis), or
+  /// empty. With it, every move is cut into `slabs` slabs of equal variable counts along the
+  /// coordinate, solved in parallel; the variables with a term reaching into another slab are
+  /// held fixed meanwhile and re-solved afterwards, with their neighbourhood up to
+  /// `border_hops` terms away. The slabs depend on the coordinates only, never on the thread
+  /// count, so the result does not either.
+  std::span<const float> coordinate;
+  std::uint32_t slabs = 1;
+  std::uint32_t border_hops = 16;
+};
+
 struct GroupMoveStats {
   std::size_t moves = 0, exact_moves = 0, improving_moves = 0, sweeps = 0;
+  std::size_t solves = 0;  ///< restricted energies solved: one per move, or its slabs and borders
 };
 
 /// Group moves, a QPBO-I whose fixed set is chosen so that the re-solve is exact: `group`
@@ -86,10 +105,10 @@ struct GroupMoveStats {
 /// re-solved together, every other variable fixed to its value in x. With overlap-like terms
 /// (non-submodular only across groups, and none among the variables at 1) that restricted
 /// energy flips to submodular and one cut solves it exactly; otherwise QPBO's persistent
-/// labels of it are taken. A move is kept only when it lowers the energy, so x never gets
+/// labels of it are taken. A re-solve is kept only when it lowers the energy, so x never gets
 /// worse. Sweeps over the groups until a sweep changes nothing or `max_sweeps`.
 GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std::uint32_t> group,
-                                      std::vector<std::int8_t>& x, int max_sweeps);
+                                      std::vector<std::int8_t>& x, const GroupMoveParams& params);
 
 struct MinimiseStats {
   bool exact = false;               ///< solved by one cut after flipping

@@ -19,6 +19,9 @@ class MaxFlow {
   Node add_node();
   [[nodiscard]] std::size_t node_count() const { return nodes_.size(); }
 
+  /// Makes room for this many more edges (add_edge calls).
+  void reserve_edges(std::size_t edges) { arcs_.reserve(arcs_.size() + 2 * edges); }
+
   /// Adds capacity from the source to i and from i to the sink (both >= 0, accumulated).
   void add_terminal(Node i, double from_source, double to_sink);
   /// Adds an arc i -> j of capacity `cap` and its reverse j -> i of capacity `rev_cap`

@@ -50,7 +50,10 @@ struct MosaicEnergy {
   BinaryEnergy energy;  ///< pairs: the seam terms first, then the overlap terms
   std::vector<std::uint32_t> triangle_of;  ///< variable -> global triangle
   std::vector<double> quality, boundary;   ///< per variable: its weighted unary parts
-  MosaicStats stats;                       ///< counts and length unit
+  /// Per variable: its centroid along the scene's longer horizontal extent (where the group
+  /// moves cut their slabs).
+  std::vector<float> coordinate;
+  MosaicStats stats;  ///< counts and length unit
 };
 MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& params);
 

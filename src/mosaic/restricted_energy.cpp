@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: MIT
+#include "restricted_energy.h"
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+
+namespace citymesh::mosaic_detail {
+
+PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
+  for (const auto& p : e.pairs) {
+    ++offsets[p.i + 1];
+    ++offsets[p.j + 1];
+  }
+  for (std::size_t i = 0; i < e.size(); ++i) offsets[i + 1] += offsets[i];
+  if (e.size() >= kAtJ) throw ProcessingError("energy: too many variables");
+  pairs.resize(offsets.back());
+  ends.resize(offsets.back());
+  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+  for (std::uint32_t k = 0; k < e.pairs.size(); ++k) {
+    const std::uint32_t i = e.pairs[k].i, j = e.pairs[k].j;
+    ends[fill[i]] = j;
+    pairs[fill[i]++] = k;
+    ends[fill[j]] = i | kAtJ;
+    pairs[fill[j]++] = k;
+  }
+}
+
+BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x,
+                        std::span<const std::uint32_t> open, std::vector<std::uint32_t>& to_local) {
+  BinaryEnergy r;
+  r.unary.resize(open.size());
+  r.pairs.reserve(2 * open.size());
+  for (std::uint32_t l = 0; l < open.size(); ++l) to_local[open[l]] = l;
+  for (std::uint32_t l = 0; l < open.size(); ++l) {
+    const std::uint32_t v = open[l];
+    r.unary[l] = e.unary[v];
+    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
+      const std::uint32_t end = index.ends[entry], o = PairIndex::variable(end);
+      const bool at_i = (end & PairIndex::kAtJ) == 0;
+      if (to_local[o] != UINT32_MAX) {
+        if (!at_i) continue;  // both ends open: the pair is taken once, from its i end
+        const auto& p = e.pairs[index.pairs[entry]];
+        r.pairs.push_back({l, to_local[o], p.e00, p.e01, p.e10, p.e11});
+        continue;
+      }
+      const auto& p = e.pairs[index.pairs[entry]];
+      for (int b = 0; b < 2; ++b) r.unary[l][static_cast<std::size_t>(b)] += at_i ? p.value(b != 0, x[o] != 0)
+                                                                                   : p.value(x[o] != 0, b != 0);
+    }
+  }
+  for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;
+  return r;
+}
+
+SlabSplit split_by_slab(const PairIndex& index, std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
+                        std::span<const std::uint32_t> slab, std::uint32_t slabs) {
+  const auto on_border = [&](std::uint32_t v) {
+    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
+      const std::uint32_t o = PairIndex::variable(index.ends[entry]);
+      if (open[o] != 0 && slab[o] != slab[v]) return true;
+    }
+    return false;
+  };
+  // Read-only per variable: in parallel.
+  std::vector<std::uint8_t> border_flag(all.size());
+  parallel_for_blocks(all.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t l = begin; l < end; ++l) border_flag[l] = on_border(all[l]) ? 1 : 0;
+  });
+  SlabSplit out;
+  out.interior.resize(slabs);
+  for (std::size_t l = 0; l < all.size(); ++l) {
+    if (border_flag[l] != 0) {
+      out.border.push_back(all[l]);
+    } else {
+      out.interior[slab[all[l]]].push_back(all[l]);
+    }
+  }
+  return out;
+}
+
+}  // namespace citymesh::mosaic_detail

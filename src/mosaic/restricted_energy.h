@@ -1,0 +1,47 @@
+// SPDX-License-Identifier: MIT
+// Pieces of a binary energy shared by the solvers that re-solve part of it (QPBO-I, group
+// moves): which pairs touch each variable, and the energy of a subset of the variables with
+// every other one fixed.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "citymesh/mosaic/binary_energy.h"
+
+namespace citymesh::mosaic_detail {
+
+/// Pair indices per variable (compressed rows), with the pair's other end beside each, so
+/// that a walk over neighbours need not load the pairs.
+struct PairIndex {
+  static constexpr std::uint32_t kAtJ = 1u << 31;  ///< in `ends`: the variable is the pair's j
+  std::vector<std::uint32_t> offsets, pairs;
+  std::vector<std::uint32_t> ends;  ///< per entry: the other end, | kAtJ when the variable is j
+
+  explicit PairIndex(const BinaryEnergy& e);
+  [[nodiscard]] std::span<const std::uint32_t> of(std::uint32_t v) const {
+    return {pairs.data() + offsets[v], pairs.data() + offsets[v + 1]};
+  }
+  [[nodiscard]] static std::uint32_t variable(std::uint32_t end) { return end & ~kAtJ; }
+};
+
+/// The energy of the variables in `open` with every other variable fixed to its value in x;
+/// local variable l is open[l]. `to_local` is scratch: e.size() entries, all UINT32_MAX, and
+/// left so.
+BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x,
+                        std::span<const std::uint32_t> open, std::vector<std::uint32_t>& to_local);
+
+/// The variables `all` (flagged in `open`, one flag per variable) cut by `slab` (one per
+/// variable, < slabs): per slab its interior, the variables with no pair term reaching an
+/// open variable of another slab, and the border, all the others. No term joins the
+/// interiors of two slabs, so they can be re-solved at the same time. Lists keep the order of
+/// `all`.
+struct SlabSplit {
+  std::vector<std::vector<std::uint32_t>> interior;
+  std::vector<std::uint32_t> border;
+};
+SlabSplit split_by_slab(const PairIndex& index, std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
+                        std::span<const std::uint32_t> slab, std::uint32_t slabs);
+
+}  // namespace citymesh::mosaic_detail
