@@ -8,7 +8,6 @@
 #include <random>
 
 #include "citymesh/core/error.h"
-#include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/max_flow.h"
 
 namespace citymesh {

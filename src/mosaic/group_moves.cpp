@@ -116,7 +116,7 @@ struct Mover {
     return region;
   }
 
-  /// Re-solves group k against the variables at 1; true when x changed.
+  /// Re-solves group k against the variables at 1 (x changes only where that lowers the energy).
   SolveOutcome move(std::uint32_t k, std::vector<std::int8_t>& x, GroupMoveStats& stats) {
     std::vector<std::uint32_t> all;
     for (std::uint32_t v = 0; v < e.size(); ++v) {

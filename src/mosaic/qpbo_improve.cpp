@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // QPBO-I improvement of a partial labelling, and the minimisation strategy.
 #include <algorithm>
-#include <deque>
 #include <random>
 
 #include "citymesh/core/stopwatch.h"
