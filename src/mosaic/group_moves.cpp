@@ -116,13 +116,15 @@ struct Mover {
     return region;
   }
 
-  /// Re-solves group k against the variables at 1 (x changes only where that lowers the energy).
-  SolveOutcome move(std::uint32_t k, std::vector<std::int8_t>& x, GroupMoveStats& stats) {
+  /// Re-solves group k against the variables at 1 (x changes only where that lowers the
+  /// energy); nullopt when no variable is open.
+  std::optional<SolveOutcome> move(std::uint32_t k, std::vector<std::int8_t>& x, GroupMoveStats& stats) {
     std::vector<std::uint32_t> all;
     for (std::uint32_t v = 0; v < e.size(); ++v) {
       open[v] = group[v] == k || x[v] == 1 ? 1 : 0;
       if (open[v] != 0) all.push_back(v);
     }
+    if (all.empty()) return std::nullopt;
     SolveOutcome out;
     if (slab.empty()) {
       ++stats.solves;
@@ -166,11 +168,12 @@ GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std
     ++stats.sweeps;
     bool changed = false;
     for (std::uint32_t k = 0; k < groups; ++k) {
+      const std::optional<SolveOutcome> o = mover.move(k, x, stats);
+      if (!o) continue;  // nothing open: no move
       ++stats.moves;
-      const SolveOutcome o = mover.move(k, x, stats);
-      stats.exact_moves += o.exact ? 1 : 0;
-      stats.improving_moves += o.improved ? 1 : 0;
-      changed = changed || o.improved;
+      stats.exact_moves += o->exact ? 1 : 0;
+      stats.improving_moves += o->improved ? 1 : 0;
+      changed = changed || o->improved;
     }
     if (!changed) break;
   }

@@ -58,12 +58,14 @@ TriangleShape shape(const Mesh& m, std::size_t t) {
 /// Each variable's centroid along the longer horizontal extent of the scene: where the
 /// group moves cut their slabs (a street is long and narrow).
 std::vector<float> slab_coordinates(std::span<const TriangleShape> shapes) {
-  Vec3f lo{FLT_MAX, FLT_MAX, FLT_MAX}, hi{-FLT_MAX, -FLT_MAX, -FLT_MAX};
+  float x_lo = FLT_MAX, x_hi = -FLT_MAX, y_lo = FLT_MAX, y_hi = -FLT_MAX;
   for (const TriangleShape& s : shapes) {
-    lo = {std::min(lo.x, s.centroid.x), std::min(lo.y, s.centroid.y), 0};
-    hi = {std::max(hi.x, s.centroid.x), std::max(hi.y, s.centroid.y), 0};
+    x_lo = std::min(x_lo, s.centroid.x);
+    x_hi = std::max(x_hi, s.centroid.x);
+    y_lo = std::min(y_lo, s.centroid.y);
+    y_hi = std::max(y_hi, s.centroid.y);
   }
-  const bool along_x = hi.x - lo.x >= hi.y - lo.y;
+  const bool along_x = x_hi - x_lo >= y_hi - y_lo;
   std::vector<float> out;
   out.reserve(shapes.size());
   for (const TriangleShape& s : shapes) out.push_back(along_x ? s.centroid.x : s.centroid.y);

@@ -178,9 +178,14 @@ TEST(GroupMoves, NeverRaiseTheEnergyAndUsuallyReachTheMinimumOnThreeMeshEnergies
 
 /// A street-like energy: `n` variables of three meshes spread along a line, overlap terms
 /// between nearby variables of different meshes, seam terms between nearby ones of the same.
-BinaryEnergy street_energy(std::mt19937& rng, std::size_t n, std::vector<std::uint32_t>& group,
-                           std::vector<float>& coordinate) {
-  BinaryEnergy e;
+struct StreetEnergy {
+  BinaryEnergy energy;
+  std::vector<std::uint32_t> group;
+  std::vector<float> coordinate;  ///< along the street, 10 variables per unit
+};
+StreetEnergy street_energy(std::mt19937& rng, std::size_t n) {
+  StreetEnergy street;
+  auto& [e, group, coordinate] = street;
   std::uniform_real_distribution<double> reward(-1.5, 0.3), w(0, 1);
   std::uniform_real_distribution<float> where(0, float(n) / 10);
   for (std::size_t v = 0; v < n; ++v) {
@@ -199,15 +204,13 @@ BinaryEnergy street_energy(std::mt19937& rng, std::size_t n, std::vector<std::ui
       }
     }
   }
-  return e;
+  return street;
 }
 
 TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThreadCount) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {
-    std::vector<std::uint32_t> group;
-    std::vector<float> coordinate;
-    const BinaryEnergy e = street_energy(rng, 600, group, coordinate);
+    const auto [e, group, coordinate] = street_energy(rng, 600);
     std::vector<std::int8_t> whole(e.size(), 0);
     improve_by_group_moves(e, group, whole, sweeps(3));
     std::vector<std::vector<std::int8_t>> split;
@@ -233,9 +236,7 @@ TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThre
 TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
   std::mt19937 rng(11);
   for (int trial = 0; trial < 20; ++trial) {
-    std::vector<std::uint32_t> group;
-    std::vector<float> coordinate;
-    const BinaryEnergy e = street_energy(rng, 400, group, coordinate);
+    const auto [e, group, coordinate] = street_energy(rng, 400);
     const mosaic_detail::PairIndex index(e);
     std::vector<std::uint8_t> open(e.size());
     std::vector<std::uint32_t> all, slab(e.size());
