@@ -60,6 +60,7 @@ CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uin
   CutGraph g;
   g.nodes = doubled ? 2 * n : n;
   g.terminal.assign(g.nodes, {0.0, 0.0});
+  g.arcs.reserve(doubled ? 2 * e.pairs.size() : e.pairs.size());
   // Both directions of a pair of nodes go into one arc pair: half the arcs to scan.
   const auto add_edge = [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse = 0) {
     g.arcs.push_back({from, to, capacity, reverse});

@@ -39,12 +39,26 @@ void MaxFlow::add_terminal(Node i, double from_source, double to_sink) {
 void MaxFlow::add_edge(Node i, Node j, double cap, double rev_cap) {
   if (i == j) throw ProcessingError("max-flow: an edge from a node to itself");
   largest_ = std::max({largest_, cap, rev_cap});
-  if (arcs_.size() + 2 >= kOrphan) throw ProcessingError("max-flow: too many edges");
-  const auto a = static_cast<Arc>(arcs_.size());
-  arcs_.push_back({j, nodes_[i].first, cap});
-  arcs_.push_back({i, nodes_[j].first, rev_cap});
-  nodes_[i].first = a;
-  nodes_[j].first = a + 1;
+  if (staged_.size() + 2 >= kOrphan) throw ProcessingError("max-flow: too many edges");
+  staged_.push_back({j, cap});
+  staged_.push_back({i, rev_cap});
+}
+
+void MaxFlow::lay_out_arcs() {
+  // Counting sort by tail (the tail of arc a is the head of a ^ 1). Within a node, the arcs
+  // keep the order of the linked lists this layout replaced: the last added first.
+  for (std::size_t a = 0; a < staged_.size(); ++a) ++nodes_[staged_[a ^ 1].head].end;
+  Arc next = 0;
+  for (NodeData& n : nodes_) {
+    n.first = next;
+    next += n.end;
+    n.end = n.first;
+  }
+  std::vector<Arc> position(staged_.size());
+  for (std::size_t a = staged_.size(); a-- > 0;) position[a] = nodes_[staged_[a ^ 1].head].end++;
+  arcs_.resize(staged_.size());
+  for (std::size_t a = 0; a < staged_.size(); ++a) arcs_[position[a]] = {staged_[a].head, position[a ^ 1], staged_[a].capacity};
+  staged_ = {};
 }
 
 void MaxFlow::set_active(Node i) {
@@ -78,23 +92,23 @@ MaxFlow::Node MaxFlow::next_active() {
 bool MaxFlow::grow(Node i, Arc& bridge) {
   const NodeData& ni = nodes_[i];
   const bool source = ni.tree == Tree::source;
-  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
-    // Source tree: grow along i -> j. Sink tree: along j -> i (the reverse arc a ^ 1).
-    if (!((source ? arcs_[a].residual : arcs_[a ^ 1].residual) > zero_)) continue;
+  for (Arc a = ni.first; a < ni.end; ++a) {
+    // Source tree: grow along i -> j. Sink tree: along j -> i (the reverse arc).
+    if (!((source ? arcs_[a].residual : arcs_[arcs_[a].reverse].residual) > zero_)) continue;
     const Node j = arcs_[a].head;
     NodeData& nj = nodes_[j];
     if (nj.tree == Tree::free) {
       nj.tree = ni.tree;
-      nj.parent = a ^ 1;
+      nj.parent = arcs_[a].reverse;
       nj.stamp = ni.stamp;
       nj.distance = ni.distance + 1;
       set_active(j);
     } else if (nj.tree != ni.tree) {
-      bridge = source ? a : a ^ 1;  // always from the source tree to the sink tree
+      bridge = source ? a : arcs_[a].reverse;  // always from the source tree to the sink tree
       return true;
     } else if (nj.stamp <= ni.stamp && nj.distance > ni.distance) {
       // A shorter way to the terminal through i: re-hang j (keeps the trees shallow).
-      nj.parent = a ^ 1;
+      nj.parent = arcs_[a].reverse;
       nj.stamp = ni.stamp;
       nj.distance = ni.distance + 1;
     }
@@ -106,21 +120,21 @@ void MaxFlow::augment(Arc bridge) {
   // Bottleneck: the bridge, the source-side path (arcs parent -> child), the sink-side path
   // (arcs child -> parent) and the two terminal capacities.
   double f = arcs_[bridge].residual;
-  Node i = arcs_[bridge ^ 1].head;
-  for (Arc p; (p = nodes_[i].parent) != kTerminal; i = arcs_[p].head) f = std::min(f, arcs_[p ^ 1].residual);
+  Node i = arcs_[arcs_[bridge].reverse].head;
+  for (Arc p; (p = nodes_[i].parent) != kTerminal; i = arcs_[p].head) f = std::min(f, arcs_[arcs_[p].reverse].residual);
   f = std::min(f, nodes_[i].terminal);
   i = arcs_[bridge].head;
   for (Arc p; (p = nodes_[i].parent) != kTerminal; i = arcs_[p].head) f = std::min(f, arcs_[p].residual);
   f = std::min(f, -nodes_[i].terminal);
 
   arcs_[bridge].residual -= f;
-  arcs_[bridge ^ 1].residual += f;
-  i = arcs_[bridge ^ 1].head;
+  arcs_[arcs_[bridge].reverse].residual += f;
+  i = arcs_[arcs_[bridge].reverse].head;
   for (Arc p; (p = nodes_[i].parent) != kTerminal;) {
     arcs_[p].residual += f;
-    arcs_[p ^ 1].residual -= f;
+    arcs_[arcs_[p].reverse].residual -= f;
     const Node up = arcs_[p].head;
-    if (!(arcs_[p ^ 1].residual > zero_)) {
+    if (!(arcs_[arcs_[p].reverse].residual > zero_)) {
       nodes_[i].parent = kOrphan;
       orphans_.push_back(i);
     }
@@ -133,7 +147,7 @@ void MaxFlow::augment(Arc bridge) {
   }
   i = arcs_[bridge].head;
   for (Arc p; (p = nodes_[i].parent) != kTerminal;) {
-    arcs_[p ^ 1].residual += f;
+    arcs_[arcs_[p].reverse].residual += f;
     arcs_[p].residual -= f;
     const Node up = arcs_[p].head;
     if (!(arcs_[p].residual > zero_)) {
@@ -149,6 +163,23 @@ void MaxFlow::augment(Arc bridge) {
   }
   flow_ += f;
   ++augmentations_;
+}
+
+void MaxFlow::push_two_arc_paths() {
+  // Most paths in a labelling graph are source -> i -> j -> sink: pushing them in one pass
+  // over the arcs is far cheaper than finding each with the search trees.
+  for (NodeData& ni : nodes_) {
+    for (Arc a = ni.first; a < ni.end && ni.terminal > zero_; ++a) {
+      NodeData& nj = nodes_[arcs_[a].head];
+      if (!(nj.terminal < -zero_) || !(arcs_[a].residual > zero_)) continue;
+      const double f = std::min({ni.terminal, -nj.terminal, arcs_[a].residual});
+      ni.terminal -= f;
+      nj.terminal += f;
+      arcs_[a].residual -= f;
+      arcs_[arcs_[a].reverse].residual += f;
+      flow_ += f;
+    }
+  }
 }
 
 bool MaxFlow::rooted(Node j, std::uint32_t& distance) {
@@ -185,9 +216,9 @@ void MaxFlow::adopt(Node i) {
   const bool source = ni.tree == Tree::source;
   Arc best = kNone;
   std::uint32_t best_distance = std::numeric_limits<std::uint32_t>::max();
-  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
+  for (Arc a = ni.first; a < ni.end; ++a) {
     // A parent j must send (source tree: j -> i) or take (sink tree: i -> j) flow.
-    if (!((source ? arcs_[a ^ 1].residual : arcs_[a].residual) > zero_)) continue;
+    if (!((source ? arcs_[arcs_[a].reverse].residual : arcs_[a].residual) > zero_)) continue;
     const Node j = arcs_[a].head;
     if (nodes_[j].tree != ni.tree) continue;
     std::uint32_t d = 0;
@@ -204,11 +235,11 @@ void MaxFlow::adopt(Node i) {
   }
   // No parent: i leaves its tree. Its children become orphans; neighbours that could grow
   // into it again are made active.
-  for (Arc a = ni.first; a != kNone; a = arcs_[a].next) {
+  for (Arc a = ni.first; a < ni.end; ++a) {
     const Node j = arcs_[a].head;
     NodeData& nj = nodes_[j];
     if (nj.tree != ni.tree) continue;
-    if ((source ? arcs_[a ^ 1].residual : arcs_[a].residual) > zero_) set_active(j);
+    if ((source ? arcs_[arcs_[a].reverse].residual : arcs_[a].residual) > zero_) set_active(j);
     if (nj.parent != kTerminal && nj.parent != kOrphan && nj.parent != kNone && arcs_[nj.parent].head == i) {
       nj.parent = kOrphan;
       orphans_.push_back(j);
@@ -222,6 +253,8 @@ double MaxFlow::solve() {
   // Sums of pushes leave rounding crumbs on arcs that are saturated in exact arithmetic:
   // residuals this far below the largest capacity count as zero, or the cut would leak.
   zero_ = largest_ * kRelativeZero;
+  lay_out_arcs();
+  push_two_arc_paths();
   for (Node i = 0; i < nodes_.size(); ++i) {
     NodeData& n = nodes_[i];
     if (!(std::abs(n.terminal) > zero_)) continue;
@@ -262,7 +295,7 @@ std::vector<std::uint8_t> MaxFlow::source_side() const {
   }
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const Node i = queue[head];
-    for (Arc a = nodes_[i].first; a != kNone; a = arcs_[a].next) {
+    for (Arc a = nodes_[i].first, end = nodes_[i].end; a < end; ++a) {
       const Node j = arcs_[a].head;
       if (side[j] == 0 && arcs_[a].residual > zero_) {
         side[j] = 1;

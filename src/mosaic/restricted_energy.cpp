@@ -23,6 +23,15 @@ PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
     ends[fill[j]] = i | kAtJ;
     pairs[fill[j]++] = k;
   }
+  // The values are the bulk (32 bytes an entry) and each entry is independent: in parallel.
+  values.resize(offsets.back());
+  parallel_for_blocks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t entry = begin; entry < end; ++entry) {
+      const auto& p = e.pairs[pairs[entry]];
+      values[entry] = (ends[entry] & kAtJ) == 0 ? std::array{p.e00, p.e01, p.e10, p.e11}
+                                                : std::array{p.e00, p.e10, p.e01, p.e11};
+    }
+  });
 }
 
 BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x,
@@ -36,16 +45,15 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
     r.unary[l] = e.unary[v];
     for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
       const std::uint32_t end = index.ends[entry], o = PairIndex::variable(end);
-      const bool at_i = (end & PairIndex::kAtJ) == 0;
+      const auto& w = index.values[entry];  // w[2 * (this end) + (other end)]
       if (to_local[o] != UINT32_MAX) {
-        if (!at_i) continue;  // both ends open: the pair is taken once, from its i end
-        const auto& p = e.pairs[index.pairs[entry]];
-        r.pairs.push_back({l, to_local[o], p.e00, p.e01, p.e10, p.e11});
+        // Both ends open: the pair is taken once, from its i end.
+        if ((end & PairIndex::kAtJ) == 0) r.pairs.push_back({l, to_local[o], w[0], w[1], w[2], w[3]});
         continue;
       }
-      const auto& p = e.pairs[index.pairs[entry]];
-      for (int b = 0; b < 2; ++b) r.unary[l][static_cast<std::size_t>(b)] += at_i ? p.value(b != 0, x[o] != 0)
-                                                                                   : p.value(x[o] != 0, b != 0);
+      const std::size_t other = x[o] != 0 ? 1 : 0;
+      r.unary[l][0] += w[other];
+      r.unary[l][1] += w[2 + other];
     }
   }
   for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;

@@ -4,6 +4,7 @@
 // every other one fixed.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -18,6 +19,7 @@ struct PairIndex {
   static constexpr std::uint32_t kAtJ = 1u << 31;  ///< in `ends`: the variable is the pair's j
   std::vector<std::uint32_t> offsets, pairs;
   std::vector<std::uint32_t> ends;  ///< per entry: the other end, | kAtJ when the variable is j
+  std::vector<std::array<double, 4>> values;  ///< per entry: the pair's values, this end first
 
   explicit PairIndex(const BinaryEnergy& e);
   [[nodiscard]] std::span<const std::uint32_t> of(std::uint32_t v) const {

@@ -20,7 +20,7 @@ class MaxFlow {
   [[nodiscard]] std::size_t node_count() const { return nodes_.size(); }
 
   /// Makes room for this many more edges (add_edge calls).
-  void reserve_edges(std::size_t edges) { arcs_.reserve(arcs_.size() + 2 * edges); }
+  void reserve_edges(std::size_t edges) { staged_.reserve(staged_.size() + 2 * edges); }
 
   /// Adds capacity from the source to i and from i to the sink (both >= 0, accumulated).
   void add_terminal(Node i, double from_source, double to_sink);
@@ -48,21 +48,29 @@ class MaxFlow {
   enum class Tree : std::uint8_t { free, source, sink };
 
   struct NodeData {
-    Arc first = kNone;   ///< first outgoing arc
-    Arc parent = kNone;  ///< arc from the node to its parent (towards the terminal)
+    Arc first = 0, end = 0;  ///< outgoing arcs: [first, end) once solve() has laid them out
+    Arc parent = kNone;      ///< arc from the node to its parent (towards the terminal)
     Node next_active = 0;
     bool active = false;
     Tree tree = Tree::free;
     double terminal = 0;  ///< residual: > 0 from the source, < 0 to the sink
     std::uint32_t stamp = 0, distance = 0;  ///< distance-to-terminal heuristic, valid at `stamp`
   };
+  /// An arc as added: arcs come in pairs, the reverse of arc a is a ^ 1.
+  struct StagedArc {
+    Node head = 0;
+    double capacity = 0;
+  };
+  /// An arc as solved: the arcs out of one node are contiguous (a cache line holds several
+  /// of them, where a linked list would jump), each knows its reverse.
   struct ArcData {
     Node head = 0;
-    Arc next = kNone;  ///< next arc out of the same tail
+    Arc reverse = 0;
     double residual = 0;
   };
-  // The reverse of arc a is a ^ 1: arcs are added in pairs.
 
+  void lay_out_arcs();
+  void push_two_arc_paths();
   void set_active(Node i);
   Node next_active();
   bool grow(Node i, Arc& bridge);
@@ -71,6 +79,7 @@ class MaxFlow {
   [[nodiscard]] bool rooted(Node i, std::uint32_t& distance);
 
   std::vector<NodeData> nodes_;
+  std::vector<StagedArc> staged_;
   std::vector<ArcData> arcs_;
   std::vector<Node> orphans_;
   Node active_first_ = 0, active_last_ = 0;
