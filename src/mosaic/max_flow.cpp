@@ -285,24 +285,11 @@ double MaxFlow::solve() {
 }
 
 std::vector<std::uint8_t> MaxFlow::source_side() const {
+  // When solve() stops no node is active, so the source tree cannot grow: every residual arc
+  // out of it stays inside, and each of its nodes hangs from the source by residual arcs.
+  // It is exactly the set reachable from the source.
   std::vector<std::uint8_t> side(nodes_.size(), 0);
-  std::vector<Node> queue;
-  for (Node i = 0; i < nodes_.size(); ++i) {
-    if (nodes_[i].terminal > zero_) {
-      side[i] = 1;
-      queue.push_back(i);
-    }
-  }
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const Node i = queue[head];
-    for (Arc a = nodes_[i].first, end = nodes_[i].end; a < end; ++a) {
-      const Node j = arcs_[a].head;
-      if (side[j] == 0 && arcs_[a].residual > zero_) {
-        side[j] = 1;
-        queue.push_back(j);
-      }
-    }
-  }
+  for (Node i = 0; i < nodes_.size(); ++i) side[i] = nodes_[i].tree == Tree::source ? 1 : 0;
   return side;
 }
 

@@ -11,8 +11,13 @@
 namespace citymesh {
 namespace {
 
+struct ReferenceFlow {
+  double flow = 0;
+  std::vector<bool> reachable;  ///< per node: reachable from the source in the final residual graph
+};
+
 /// Edmonds-Karp on a dense capacity matrix: node 0 the source, node n + 1 the sink.
-double reference_max_flow(std::vector<std::vector<double>> cap) {
+ReferenceFlow reference_max_flow(std::vector<std::vector<double>> cap) {
   const std::size_t n = cap.size(), s = 0, t = n - 1;
   double flow = 0;
   for (;;) {
@@ -29,7 +34,11 @@ double reference_max_flow(std::vector<std::vector<double>> cap) {
         }
       }
     }
-    if (parent[t] < 0) return flow;
+    if (parent[t] < 0) {
+      ReferenceFlow out{flow, std::vector<bool>(n)};
+      for (std::size_t v = 0; v < n; ++v) out.reachable[v] = parent[v] >= 0;
+      return out;
+    }
     double f = 1e300;
     for (std::size_t v = t; v != s; v = static_cast<std::size_t>(parent[v])) {
       f = std::min(f, cap[static_cast<std::size_t>(parent[v])][v]);
@@ -70,10 +79,16 @@ TEST(MaxFlow, EqualsEdmondsKarpAndItsCutOnRandomGraphs) {
       dense[static_cast<std::size_t>(j + 1)][static_cast<std::size_t>(i + 1)] += r;
     }
     const double flow = g.solve();
-    const double expected = reference_max_flow(dense);
+    const ReferenceFlow reference = reference_max_flow(dense);
+    const double expected = reference.flow;
     ASSERT_NEAR(flow, expected, 1e-9 * (1 + expected)) << "trial " << trial;
-    // The source side is a cut of exactly that capacity.
+    // The source side is a cut of exactly that capacity, and the smallest one: what the source
+    // reaches in the residual graph, the same set for every maximum flow.
     const std::vector<std::uint8_t> side = g.source_side();
+    for (int i = 0; i < n; ++i) {
+      ASSERT_EQ(side[static_cast<std::size_t>(i)] != 0, reference.reachable[static_cast<std::size_t>(i + 1)])
+          << "trial " << trial << ", node " << i;
+    }
     double cut = 0;
     for (std::size_t a = 0; a < dense.size(); ++a) {
       for (std::size_t b = 0; b < dense.size(); ++b) {

@@ -3,7 +3,7 @@
 // epochs; the paper reports 2107 s with QPBO-I at that size): wall time per phase, energy,
 // unlabelled fraction before and after improvement; and our max-flow against Boost.Graph's
 // boykov_kolmogorov_max_flow on the same two-mesh graphs.
-//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--mosaic-only 1]
+//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--threads N] [--mosaic-only 1]
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -13,6 +13,7 @@
 
 #include "bench_scene.h"
 #include "citymesh/change/detect.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/max_flow.h"
 #include "citymesh/mosaic/mosaic.h"
@@ -24,7 +25,7 @@ using namespace citymesh;
 
 namespace {
 
-void print_selection(const char* label, const MosaicSelection& s, double wall) {
+void print_selection(const std::string& label, const MosaicSelection& s, double wall) {
   const MosaicStats& t = s.stats;
   fmt::print("{:<22} {:6.3f} s | build {:.3f}, solve {:.3f}, fill {:.3f} | {} variables, {} seam and {} overlap terms | {}\n",
              label, wall, t.seconds_build, t.seconds_solve, t.seconds_fill, t.candidates, t.seam_terms, t.overlap_terms,
@@ -81,6 +82,7 @@ int main(int argc, char** argv) {
   float length = 30.0f;
   int epochs = 7;
   int repeat = 5;
+  unsigned threads = 0;       // 0: every core
   bool mosaic_only = false;  // skips the baseline, the whole-energy QPBO and the max-flow race
   MosaicParams params;
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -88,8 +90,10 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--length") == 0) length = std::stof(argv[i + 1]);
     if (std::strcmp(argv[i], "--epochs") == 0) epochs = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::stoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--threads") == 0) threads = static_cast<unsigned>(std::stoul(argv[i + 1]));
     if (std::strcmp(argv[i], "--mosaic-only") == 0) mosaic_only = std::strcmp(argv[i + 1], "0") != 0;
   }
+  const ThreadLimit limit(threads);
   const bench::BenchScene scene = bench::simulated_street(length, epochs);
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", length, scene.meshes.size(), scene.triangles);
   const ChangeParams change_params;
@@ -103,7 +107,7 @@ int main(int argc, char** argv) {
     Stopwatch run_clock;
     energy = select_mosaic(input, params);
     walls.push_back(run_clock.seconds());
-    print_selection("mosaic (2 threads)", energy, walls.back());
+    print_selection(fmt::format("mosaic ({} threads)", threads == 0 ? available_threads() : threads), energy, walls.back());
   }
   std::sort(walls.begin(), walls.end());
   const double wall = walls[walls.size() / 2];
