@@ -2,9 +2,10 @@
 #include "snap.h"
 
 #include <algorithm>
+#include <optional>
 #include <span>
-#include <unordered_map>
 
+#include "citymesh/core/parallel.h"
 #include "citymesh/spatial/box_tree.h"
 #include "citymesh/spatial/kd_tree.h"
 
@@ -12,49 +13,7 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
-constexpr auto key = directed_edge_key;
-
-/// The mesh with its directed edges and vertex-to-triangle incidence kept up to date. The
-/// invariant of every operation: a directed edge is used by at most one triangle, which makes
-/// the mesh edge-manifold and consistently oriented.
-struct Topology {
-  MergedMesh& merged;
-  std::unordered_map<std::uint64_t, std::uint32_t> half_edges;  ///< directed edge -> its triangle
-  std::vector<std::vector<std::uint32_t>> triangles_of;         ///< vertex -> triangles using it
-  SnapStats stats;
-
-  explicit Topology(MergedMesh& m) : merged(m), triangles_of(m.mesh.vertex_count()) {
-    for (std::uint32_t t = 0; t < m.mesh.triangle_count(); ++t) {
-      insert_edges(t);
-      for (const std::uint32_t v : m.mesh.triangles[t]) triangles_of[v].push_back(t);
-    }
-  }
-  [[nodiscard]] Vec3d position(std::uint32_t v) const { return Vec3d(merged.mesh.positions[v]); }
-  [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged.mesh.triangles[t]; }
-  [[nodiscard]] bool has(std::uint32_t from, std::uint32_t to) const { return half_edges.contains(key(from, to)); }
-  [[nodiscard]] bool is_boundary(std::uint32_t from, std::uint32_t to) const { return !has(to, from); }
-  void insert_edges(std::uint32_t t) {
-    const Triangle& tri = triangle(t);
-    for (int k = 0; k < 3; ++k) half_edges.emplace(key(tri[k], tri[(k + 1) % 3]), t);
-  }
-  void erase_edges(std::uint32_t t) {
-    const Triangle& tri = triangle(t);
-    for (int k = 0; k < 3; ++k) half_edges.erase(key(tri[k], tri[(k + 1) % 3]));
-  }
-  /// True when none of the triangles' directed edges is in use, nor used twice among them.
-  [[nodiscard]] bool edges_free(const std::vector<Triangle>& tris) const {
-    std::vector<std::uint64_t> keys;
-    for (const Triangle& tri : tris) {
-      for (int k = 0; k < 3; ++k) keys.push_back(key(tri[k], tri[(k + 1) % 3]));
-    }
-    std::sort(keys.begin(), keys.end());
-    if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) return false;
-    return std::none_of(keys.begin(), keys.end(), [&](std::uint64_t k) { return half_edges.contains(k); });
-  }
-  [[nodiscard]] std::int32_t source_of_vertex(std::uint32_t v) const {
-    return triangles_of[v].empty() ? kNoSource : merged.source_acq[triangles_of[v].front()];
-  }
-};
+using Topology = MeshTopology;  // every operation keeps a directed edge used by at most one triangle
 
 Vec3d normal_of(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return cross(b - a, c - a); }
 
@@ -68,14 +27,22 @@ struct DirectedEdge {
   std::uint32_t from, to, triangle;
 };
 
+/// The directed edges whose reverse no triangle uses, in triangle order.
 std::vector<DirectedEdge> boundary_half_edges(const Topology& topo) {
-  std::vector<DirectedEdge> out;
-  for (std::uint32_t t = 0; t < topo.merged.mesh.triangle_count(); ++t) {
-    const Triangle& tri = topo.triangle(t);
-    for (int k = 0; k < 3; ++k) {
-      if (topo.is_boundary(tri[k], tri[(k + 1) % 3])) out.push_back({tri[k], tri[(k + 1) % 3], t});
+  const std::vector<Triangle>& triangles = topo.merged().mesh.triangles;
+  constexpr std::size_t kGrain = 1 << 16;
+  std::vector<std::vector<DirectedEdge>> per_block((triangles.size() + kGrain - 1) / kGrain);
+  parallel_for_blocks(triangles.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      const Triangle& tri = triangles[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
+        if (!topo.has(to, from)) per_block[begin / kGrain].push_back({from, to, static_cast<std::uint32_t>(t)});
+      }
     }
-  }
+  });
+  std::vector<DirectedEdge> out;
+  for (const auto& block : per_block) out.insert(out.end(), block.begin(), block.end());
   return out;
 }
 
@@ -97,40 +64,36 @@ bool try_merge(Topology& topo, std::uint32_t v, std::uint32_t w) {
   const Vec3d mid = (topo.position(v) + topo.position(w)) * 0.5;
   const auto moved = [&](std::uint32_t u) { return u == v || u == w ? mid : topo.position(u); };
   std::vector<Triangle> renamed;
-  for (const std::uint32_t t : topo.triangles_of[w]) {
+  const std::vector<std::uint32_t> around_w(topo.triangles_of(w).begin(), topo.triangles_of(w).end());
+  for (const std::uint32_t t : around_w) {
     Triangle tri = topo.triangle(t);
     for (std::uint32_t& u : tri) u = u == w ? v : u;
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) return false;  // v and w share it
     renamed.push_back(tri);
   }
-  for (const auto* list : {&topo.triangles_of[v], &topo.triangles_of[w]}) {
-    for (const std::uint32_t t : *list) {
+  for (const std::uint32_t u : {v, w}) {
+    for (const std::uint32_t t : topo.triangles_of(u)) {
       const Triangle& tri = topo.triangle(t);
       const Vec3d before = normal_of(topo.position(tri[0]), topo.position(tri[1]), topo.position(tri[2]));
       if (!acceptable(before, normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
     }
   }
-  for (const std::uint32_t t : topo.triangles_of[w]) topo.erase_edges(t);
-  if (!topo.edges_free(renamed)) {
-    for (const std::uint32_t t : topo.triangles_of[w]) topo.insert_edges(t);
-    return false;
-  }
+  if (!topo.edges_free(renamed, around_w)) return false;
+  std::vector<std::uint32_t>& around_v = topo.edit(v);
   for (std::size_t i = 0; i < renamed.size(); ++i) {
-    const std::uint32_t t = topo.triangles_of[w][i];
-    topo.merged.mesh.triangles[t] = renamed[i];
-    topo.insert_edges(t);
-    topo.triangles_of[v].push_back(t);
+    topo.merged().mesh.triangles[around_w[i]] = renamed[i];
+    around_v.push_back(around_w[i]);
   }
-  topo.triangles_of[w].clear();
-  topo.merged.mesh.positions[v] = Vec3f(mid);
+  topo.edit(w).clear();
+  topo.merged().mesh.positions[v] = Vec3f(mid);
   return true;
 }
 
 /// Stage 1: boundary vertices of different sources within the tolerance become one.
-void merge_close_vertices(Topology& topo, double tolerance) {
+void merge_close_vertices(Topology& topo, double tolerance, SnapStats& stats) {
   const std::vector<std::uint32_t> vertices = vertices_of(boundary_half_edges(topo));
   std::vector<Vec3f> points;
-  for (const std::uint32_t v : vertices) points.push_back(topo.merged.mesh.positions[v]);
+  for (const std::uint32_t v : vertices) points.push_back(topo.merged().mesh.positions[v]);
   const PointKdTree tree(points);
   std::vector<std::uint8_t> done(vertices.size(), 0);
   std::vector<std::uint32_t> near;
@@ -153,9 +116,9 @@ void merge_close_vertices(Topology& topo, double tolerance) {
     if (best == UINT32_MAX) continue;
     if (try_merge(topo, v, vertices[best])) {
       done[i] = done[best] = 1;
-      ++topo.stats.vertices_merged;
+      ++stats.vertices_merged;
     } else {
-      ++topo.stats.rejected;
+      ++stats.rejected;
     }
   }
 }
@@ -170,8 +133,8 @@ struct Insertion {
 
 /// True when a triangle around v comes from `source`.
 bool touches_source(const Topology& topo, std::uint32_t v, std::int32_t source) {
-  return std::any_of(topo.triangles_of[v].begin(), topo.triangles_of[v].end(),
-                     [&](std::uint32_t t) { return topo.merged.source_acq[t] == source; });
+  const std::span<const std::uint32_t> around = topo.triangles_of(v);
+  return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return topo.merged().source_acq[t] == source; });
 }
 
 /// For every boundary vertex, the nearest boundary edge of another source passing within the
@@ -180,7 +143,7 @@ std::vector<Insertion> find_insertions(const Topology& topo, std::span<const Dir
   std::vector<Box3f> boxes;
   const auto pad = static_cast<float>(tolerance);
   for (const DirectedEdge& e : edges) {
-    const Vec3f a = topo.merged.mesh.positions[e.from], b = topo.merged.mesh.positions[e.to];
+    const Vec3f a = topo.merged().mesh.positions[e.from], b = topo.merged().mesh.positions[e.to];
     boxes.push_back({Vec3f{std::min(a.x, b.x) - pad, std::min(a.y, b.y) - pad, std::min(a.z, b.z) - pad},
                      Vec3f{std::max(a.x, b.x) + pad, std::max(a.y, b.y) + pad, std::max(a.z, b.z) + pad}});
   }
@@ -188,14 +151,14 @@ std::vector<Insertion> find_insertions(const Topology& topo, std::span<const Dir
   std::vector<Insertion> out;
   std::vector<std::uint32_t> hits;
   for (const std::uint32_t v : vertices_of(edges)) {
-    tree.containing(topo.merged.mesh.positions[v], hits);
+    tree.containing(topo.merged().mesh.positions[v], hits);
     std::sort(hits.begin(), hits.end());
     const Vec3d p = topo.position(v);
     Insertion best{SIZE_MAX, 0, v};
     double best_d2 = tolerance * tolerance;
     for (const std::uint32_t h : hits) {
       const DirectedEdge& e = edges[h];
-      if (e.from == v || e.to == v || touches_source(topo, v, topo.merged.source_acq[e.triangle])) continue;
+      if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle])) continue;
       const Vec3d a = topo.position(e.from), ab = topo.position(e.to) - a;
       const double len2 = dot(ab, ab);
       if (!(len2 > 0)) continue;
@@ -216,9 +179,9 @@ std::vector<Insertion> find_insertions(const Topology& topo, std::span<const Dir
 /// Splits the triangle on directed edge from -> to into a fan through the inserted vertices
 /// (in order along the edge), unless a piece would flip or degenerate or reuse a directed edge.
 bool try_split(Topology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
-  const auto it = topo.half_edges.find(key(from, to));
-  if (it == topo.half_edges.end()) return false;
-  const std::uint32_t t = it->second;
+  const std::optional<std::uint32_t> found = topo.triangle_with(from, to);
+  if (!found) return false;
+  const std::uint32_t t = *found;
   const Triangle old = topo.triangle(t);
   int k = 0;
   while (old[k] != from) ++k;
@@ -234,12 +197,8 @@ bool try_split(Topology& topo, std::uint32_t from, std::uint32_t to, const std::
     const Vec3d after = normal_of(topo.position(chain[i]), topo.position(chain[i + 1]), topo.position(apex));
     if (dot(before, after) <= 0 || norm(after) < 1e-3 * norm(before)) return false;
   }
-  topo.erase_edges(t);
-  if (!topo.edges_free(fan)) {
-    topo.insert_edges(t);
-    return false;
-  }
-  MergedMesh& m = topo.merged;
+  if (!topo.edges_free(fan, std::span(&t, 1))) return false;
+  MergedMesh& m = topo.merged();
   for (std::size_t i = 0; i < fan.size(); ++i) {
     const std::uint32_t slot = i == 0 ? t : static_cast<std::uint32_t>(m.mesh.triangle_count());
     if (i == 0) {
@@ -250,19 +209,16 @@ bool try_split(Topology& topo, std::uint32_t from, std::uint32_t to, const std::
       m.source_acq.push_back(m.source_acq[t]);
       m.source_triangle.push_back(m.source_triangle[t]);
     }
-    topo.insert_edges(slot);
-    if (i > 0) {
-      for (const std::uint32_t u : fan[i]) topo.triangles_of[u].push_back(slot);
-    }
+    if (i > 0) topo.add_triangle(slot);
   }
   // Triangle t now spans from, the first inserted vertex and the apex.
-  topo.triangles_of[chain[1]].push_back(t);
-  std::erase(topo.triangles_of[to], t);
+  topo.edit(chain[1]).push_back(t);
+  std::erase(topo.edit(to), t);
   return true;
 }
 
 /// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
-void split_edges_at_vertices(Topology& topo, double tolerance) {
+void split_edges_at_vertices(Topology& topo, double tolerance, SnapStats& stats) {
   const std::vector<DirectedEdge> edges = boundary_half_edges(topo);
   const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
   for (std::size_t i = 0; i < insertions.size();) {
@@ -271,9 +227,9 @@ void split_edges_at_vertices(Topology& topo, double tolerance) {
     for (; j < insertions.size() && insertions[j].edge == insertions[i].edge; ++j) inserted.push_back(insertions[j].vertex);
     const DirectedEdge& e = edges[insertions[i].edge];
     if (try_split(topo, e.from, e.to, inserted)) {
-      ++topo.stats.edges_split;
+      ++stats.edges_split;
     } else {
-      ++topo.stats.rejected;
+      ++stats.rejected;
     }
     i = j;
   }
@@ -281,11 +237,11 @@ void split_edges_at_vertices(Topology& topo, double tolerance) {
 
 }  // namespace
 
-SnapStats snap_boundaries(MergedMesh& merged, double tolerance) {
-  Topology topo(merged);
-  merge_close_vertices(topo, tolerance);
-  split_edges_at_vertices(topo, tolerance);
-  return topo.stats;
+SnapStats snap_boundaries(MeshTopology& topo, double tolerance) {
+  SnapStats stats;
+  merge_close_vertices(topo, tolerance, stats);
+  split_edges_at_vertices(topo, tolerance, stats);
+  return stats;
 }
 
 }  // namespace citymesh::mosaic_detail

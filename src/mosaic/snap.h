@@ -7,15 +7,9 @@
 
 #include <cstdint>
 
-#include "citymesh/mosaic/merged_mesh.h"
+#include "mesh_topology.h"
 
 namespace citymesh::mosaic_detail {
-
-/// One directed edge (from -> to) as a hash key; snapping and zippering both refuse to use a
-/// directed edge twice.
-constexpr std::uint64_t directed_edge_key(std::uint32_t from, std::uint32_t to) {
-  return (std::uint64_t{from} << 32) | to;
-}
 
 struct SnapStats {
   std::uint64_t vertices_merged = 0;  ///< pairs of boundary vertices of different sources made one
@@ -28,7 +22,8 @@ struct SnapStats {
 /// boundary vertices of other sources within `tolerance` of it (the edge's triangle becomes a
 /// fan; the new triangles keep its provenance). An operation is skipped when a triangle would
 /// flip or degenerate, or a directed edge would be used twice (the mesh stays edge-manifold
-/// and consistently oriented). Deterministic: vertices and edges in index order.
-SnapStats snap_boundaries(MergedMesh& merged, double tolerance);
+/// and consistently oriented). Deterministic: vertices and edges in index order. The mesh is
+/// topo's, which is kept up to date.
+SnapStats snap_boundaries(MeshTopology& topo, double tolerance);
 
 }  // namespace citymesh::mosaic_detail

@@ -2,7 +2,6 @@
 #include "citymesh/mosaic/stitch.h"
 
 #include <algorithm>
-#include <array>
 #include <numeric>
 #include <unordered_map>
 #include <unordered_set>
@@ -30,10 +29,11 @@ struct Boundary {
   std::vector<std::uint32_t> vertices;                          ///< in increasing order
 };
 
-Boundary find_boundary(const Mesh& m) {
+Boundary find_boundary(const mosaic_detail::MeshTopology& topo) {
+  const Mesh& m = topo.merged().mesh;
   Boundary b;
   std::unordered_map<std::uint32_t, int> outgoing;
-  for (const EdgeUse& e : boundary_edges(m.triangles)) {
+  for (const EdgeUse& e : topo.boundary_edges()) {
     const Triangle& tri = m.triangles[e.triangle];
     // Orient as in the triangle: the half-edge u -> v whose reverse no triangle has.
     for (int k = 0; k < 3; ++k) {
@@ -54,10 +54,10 @@ Boundary find_boundary(const Mesh& m) {
 struct StitchContext {
   MergedMesh& merged;
   const StitchParams& params;
+  mosaic_detail::MeshTopology& topo;  ///< which directed edges are in use
   Boundary boundary;
   std::unordered_map<std::uint32_t, std::uint32_t> partner;  ///< boundary vertex -> matched vertex of another source
   std::unordered_set<std::uint32_t> consumed;                 ///< boundary half-edges (by their start) joined
-  std::unordered_set<std::uint64_t> directed;                 ///< every directed edge in use
   StitchStats stats;
 
   [[nodiscard]] std::int32_t source(std::uint32_t v) const {
@@ -108,33 +108,21 @@ std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from
   return run;
 }
 
-using mosaic_detail::directed_edge_key;
-
-std::unordered_set<std::uint64_t> directed_edges(const Mesh& m) {
-  std::unordered_set<std::uint64_t> out;
-  for (const Triangle& t : m.triangles) {
-    for (int k = 0; k < 3; ++k) out.insert(directed_edge_key(t[k], t[(k + 1) % 3]));
-  }
-  return out;
-}
-
 /// Adds the strip triangle (a, b, c) unless it is degenerate, faces against `reference` or
 /// uses a directed edge already in use (which would fold the mesh or break its manifoldness).
 bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std::uint32_t d, const Vec3d& reference) {
   const Mesh& m = c.merged.mesh;
   const Vec3d n = face_normal(m, a, b, d);
   const double len = norm(n);
-  const std::array<std::uint64_t, 3> keys{directed_edge_key(a, b), directed_edge_key(b, d), directed_edge_key(d, a)};
-  if (!(len > 1e-10) || dot(n, reference) <= 0 ||
-      std::any_of(keys.begin(), keys.end(), [&](std::uint64_t k) { return c.directed.contains(k); })) {
+  if (!(len > 1e-10) || dot(n, reference) <= 0 || c.topo.has(a, b) || c.topo.has(b, d) || c.topo.has(d, a)) {
     ++c.stats.rejected;
     return false;
   }
-  c.directed.insert(keys.begin(), keys.end());
   c.merged.mesh.triangles.push_back({a, b, d});
   c.merged.mesh.triangle_ids.push_back({});
   c.merged.source_acq.push_back(kNoSource);
   c.merged.source_triangle.push_back(kNoSource);
+  c.topo.add_triangle(static_cast<std::uint32_t>(c.merged.mesh.triangle_count() - 1));
   ++c.stats.triangles_added;
   return true;
 }
@@ -237,17 +225,24 @@ void weld(StitchContext& c) {
 
 }  // namespace
 
-double open_boundary_length(const Mesh& m) {
+namespace {
+
+double length_of(const Mesh& m, std::span<const EdgeUse> edges) {
   double total = 0;
-  for (const EdgeUse& e : boundary_edges(m.triangles)) total += norm(position(m, e.lo) - position(m, e.hi));
+  for (const EdgeUse& e : edges) total += norm(position(m, e.lo) - position(m, e.hi));
   return total;
 }
 
+}  // namespace
+
+double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(m.triangles)); }
+
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
-  const double before = open_boundary_length(merged.mesh);
-  const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(merged, params.snap);
-  StitchContext c{merged, params, find_boundary(merged.mesh), {}, {}, directed_edges(merged.mesh), {}};
+  mosaic_detail::MeshTopology topo(merged);
+  const double before = length_of(merged.mesh, topo.boundary_edges());
+  const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
+  StitchContext c{merged, params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
   c.stats.vertices_snapped = snapped.vertices_merged;
   c.stats.edges_split = snapped.edges_split;

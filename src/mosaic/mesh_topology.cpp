@@ -1,0 +1,112 @@
+// SPDX-License-Identifier: MIT
+#include "mesh_topology.h"
+
+#include <algorithm>
+
+#include "citymesh/core/parallel.h"
+
+namespace citymesh::mosaic_detail {
+
+MeshTopology::MeshTopology(MergedMesh& merged)
+    : merged_(merged), offsets_(merged.mesh.vertex_count() + 1, 0), edited_(merged.mesh.vertex_count(), UINT32_MAX) {
+  const auto& triangles = merged.mesh.triangles;
+  for (const Triangle& tri : triangles) {
+    for (const std::uint32_t v : tri) ++offsets_[v + 1];
+  }
+  for (std::size_t v = 0; v + 1 < offsets_.size(); ++v) offsets_[v + 1] += offsets_[v];
+  packed_.resize(offsets_.back());
+  std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+  for (std::uint32_t t = 0; t < triangles.size(); ++t) {
+    for (const std::uint32_t v : triangles[t]) packed_[fill[v]++] = t;
+  }
+}
+
+std::span<const std::uint32_t> MeshTopology::triangles_of(std::uint32_t v) const {
+  if (edited_[v] != UINT32_MAX) return edits_[edited_[v]];
+  return {packed_.data() + offsets_[v], packed_.data() + offsets_[v + 1]};
+}
+
+std::vector<std::uint32_t>& MeshTopology::edit(std::uint32_t v) {
+  if (edited_[v] == UINT32_MAX) {
+    const std::span<const std::uint32_t> now = triangles_of(v);
+    edited_[v] = static_cast<std::uint32_t>(edits_.size());
+    edits_.emplace_back(now.begin(), now.end());
+  }
+  return edits_[edited_[v]];
+}
+
+void MeshTopology::add_triangle(std::uint32_t t) {
+  for (const std::uint32_t v : triangle(t)) edit(v).push_back(t);
+}
+
+std::optional<std::uint32_t> MeshTopology::triangle_with(std::uint32_t from, std::uint32_t to) const {
+  for (const std::uint32_t t : triangles_of(from)) {
+    const Triangle& tri = triangle(t);
+    for (int k = 0; k < 3; ++k) {
+      if (tri[k] == from && tri[(k + 1) % 3] == to) return t;
+    }
+  }
+  return std::nullopt;
+}
+
+bool MeshTopology::edges_free(std::span<const Triangle> tris, std::span<const std::uint32_t> replaced) const {
+  std::vector<std::uint64_t> keys;
+  for (const Triangle& tri : tris) {
+    for (int k = 0; k < 3; ++k) keys.push_back((std::uint64_t{tri[k]} << 32) | tri[(k + 1) % 3]);
+  }
+  std::sort(keys.begin(), keys.end());
+  if (std::adjacent_find(keys.begin(), keys.end()) != keys.end()) return false;
+  return std::none_of(keys.begin(), keys.end(), [&](std::uint64_t key) {
+    const auto from = static_cast<std::uint32_t>(key >> 32), to = static_cast<std::uint32_t>(key);
+    for (const std::uint32_t t : triangles_of(from)) {
+      if (std::find(replaced.begin(), replaced.end(), t) != replaced.end()) continue;
+      const Triangle& tri = triangle(t);
+      for (int k = 0; k < 3; ++k) {
+        if (tri[k] == from && tri[(k + 1) % 3] == to) return true;
+      }
+    }
+    return false;
+  });
+}
+
+std::int32_t MeshTopology::source_of_vertex(std::uint32_t v) const {
+  const std::span<const std::uint32_t> around = triangles_of(v);
+  return around.empty() ? kNoSource : merged_.source_acq[around.front()];
+}
+
+std::vector<EdgeUse> MeshTopology::boundary_edges() const {
+  const auto& triangles = merged_.mesh.triangles;
+  // Per block of triangles, its edges that no other use shares; blocks joined in order.
+  constexpr std::size_t kGrain = 1 << 16;
+  std::vector<std::vector<EdgeUse>> per_block((triangles.size() + kGrain - 1) / kGrain);
+  parallel_for_blocks(triangles.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<EdgeUse>& out = per_block[begin / kGrain];
+    for (std::size_t t = begin; t < end; ++t) {
+      const Triangle& tri = triangles[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t lo = std::min(tri[k], tri[(k + 1) % 3]), hi = std::max(tri[k], tri[(k + 1) % 3]);
+        // The uses of {lo, hi}, by the triangles around lo (each counted once).
+        std::size_t uses = 0;
+        const std::span<const std::uint32_t> around = triangles_of(lo);
+        for (std::size_t i = 0; i < around.size() && uses < 2; ++i) {
+          if (std::find(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(i), around[i]) !=
+              around.begin() + static_cast<std::ptrdiff_t>(i)) {
+            continue;
+          }
+          const Triangle& other = triangle(around[i]);
+          for (int j = 0; j < 3; ++j) {
+            const std::uint32_t a = other[j], b = other[(j + 1) % 3];
+            if (std::min(a, b) == lo && std::max(a, b) == hi) ++uses;
+          }
+        }
+        if (uses == 1) out.push_back({lo, hi, static_cast<std::uint32_t>(t)});
+      }
+    }
+  });
+  std::vector<EdgeUse> out;
+  for (const auto& block : per_block) out.insert(out.end(), block.begin(), block.end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace citymesh::mosaic_detail

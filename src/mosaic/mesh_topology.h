@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// The vertex-to-triangle incidence of a merged mesh, kept up to date while stitching changes
+// it (internal to stitching). Directed edges are found by looking at the few triangles around
+// a vertex: no hash table of every edge of a city-sized mesh (18 M entries, a gigabyte, and
+// most of the stitching time).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "citymesh/mosaic/edges.h"
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh::mosaic_detail {
+
+class MeshTopology {
+ public:
+  explicit MeshTopology(MergedMesh& merged);
+
+  [[nodiscard]] MergedMesh& merged() const { return merged_; }
+  [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
+  [[nodiscard]] Vec3d position(std::uint32_t v) const { return Vec3d(merged_.mesh.positions[v]); }
+
+  /// The triangles using vertex v, in the order they were added.
+  [[nodiscard]] std::span<const std::uint32_t> triangles_of(std::uint32_t v) const;
+  /// v's list, to change (copied out of the packed lists on its first change).
+  std::vector<std::uint32_t>& edit(std::uint32_t v);
+  /// Registers triangle t (already in the mesh) with its vertices.
+  void add_triangle(std::uint32_t t);
+
+  /// The triangle using the directed edge from -> to (the first one if several do).
+  [[nodiscard]] std::optional<std::uint32_t> triangle_with(std::uint32_t from, std::uint32_t to) const;
+  [[nodiscard]] bool has(std::uint32_t from, std::uint32_t to) const { return triangle_with(from, to).has_value(); }
+  /// True when no directed edge of `tris` is used by a triangle other than those in
+  /// `replaced` (about to be overwritten by `tris`), nor twice among `tris`.
+  [[nodiscard]] bool edges_free(std::span<const Triangle> tris, std::span<const std::uint32_t> replaced) const;
+  /// The source of the first triangle around v, kNoSource for none.
+  [[nodiscard]] std::int32_t source_of_vertex(std::uint32_t v) const;
+
+  /// The edges used by exactly one triangle, sorted as boundary_edges() sorts them (which
+  /// gives the same list, from the lists around each vertex instead of a sort of every edge).
+  [[nodiscard]] std::vector<EdgeUse> boundary_edges() const;
+
+ private:
+  MergedMesh& merged_;
+  std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
+  std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
+  std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows
+};
+
+}  // namespace citymesh::mosaic_detail
