@@ -80,6 +80,7 @@ MergedMesh TileAssembly::merged() const {
     m.origin = whole_metre_origin(first.mesh.world_position(first.mesh.triangles[std::get<3>(order.front())][0]));
   }
   std::unordered_map<std::uint64_t, std::uint32_t> vertex;  // (acquisition, vertex id) -> merged vertex
+  vertex.reserve(order.size());  // about one vertex for every two triangles; no rehash on the way
   for (const auto& [a, index, p, t] : order) {
     const TilePiece& piece = pieces_[p];
     Triangle tri{};

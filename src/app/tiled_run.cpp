@@ -55,6 +55,20 @@ void write_labels(const Config& config, const TileAssembly& assembly, const Pict
 }
 
 
+/// Adds one tile's result to the assembly and its entry to the run report.
+void add_tile_result(const Config& config, const TileContents& tile, bool processed, std::optional<TileResult> r,
+                     TileAssembly& assembly, std::vector<nlohmann::json>& per_tile) {
+  if (!r) throw ProcessingError(fmt::format("{}: the tile result vanished", result_path(config, tile.key).string()));
+  nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
+  if (processed) {
+    entry["seconds"] = {{"read", r->seconds_read}, {"detect", r->seconds_detect}, {"mosaic", r->seconds_mosaic}};
+  } else {
+    entry["reused"] = true;
+  }
+  per_tile.push_back(std::move(entry));
+  assembly.add(std::move(*r));
+}
+
 /// The outputs from every tile's result: assembly, labels, the seam pass, mosaic, 3D Tiles and
 /// run.json. `seconds` holds the stages timed so far.
 void write_run_outputs(const Config& config, const TileStore& store, std::uint64_t fingerprint,
@@ -63,18 +77,19 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   Stopwatch total, clock;
   TileAssembly assembly(store, config.output.labels);
   std::vector<nlohmann::json> per_tile;
-  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
-    const TileContents& tile = store.tiles[k];
-    std::optional<TileResult> r = read_tile_result(result_path(config, tile.key), fingerprint, store);
-    if (!r) throw ProcessingError(fmt::format("{}: the tile result vanished", result_path(config, tile.key).string()));
-    nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
-    if (tiles.processed[k] != 0) {
-      entry["seconds"] = {{"read", r->seconds_read}, {"detect", r->seconds_detect}, {"mosaic", r->seconds_mosaic}};
-    } else {
-      entry["reused"] = true;
-    }
-    per_tile.push_back(std::move(entry));
-    assembly.add(std::move(*r));
+  // Results are read (and checked) a few at a time in parallel, then added in tile order; a
+  // read result is several times the piece the assembly keeps of it, so not all at once.
+  constexpr std::size_t kBatch = 4;
+  std::vector<std::optional<TileResult>> batch(kBatch);
+  for (std::size_t first = 0; first < store.tiles.size(); first += kBatch) {
+    const std::size_t count = std::min(kBatch, store.tiles.size() - first);
+    parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store);
+      }
+    });
+    for (std::size_t i = 0; i < count; ++i) add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0,
+                                                            std::move(batch[i]), assembly, per_tile);
   }
   MergedMesh merged = assembly.merged();
   const std::uint64_t selected = merged.mesh.triangle_count();
