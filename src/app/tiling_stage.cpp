@@ -7,6 +7,7 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "run_stages.h"
 
@@ -33,6 +34,20 @@ std::vector<std::uint64_t> tiling_priorities(std::span<const Acquisition> acquis
 }
 
 std::string store_fingerprint(std::uint64_t fingerprint) { return fmt::format("{:016x}", fingerprint); }
+
+/// How many acquisitions a rank tiles at once: one per thread while each fits the budget
+/// with its buffers and its vertices, held whole (about the size of its file). The result
+/// does not depend on it: each acquisition is tiled alone, with the same buffers.
+unsigned tiling_workers(std::span<const Acquisition> acquisitions, std::uint64_t memory, std::uint64_t buffer_bytes) {
+  std::uint64_t largest = 0;
+  for (const Acquisition& a : acquisitions) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(a.path, ec);
+    if (!ec) largest = std::max<std::uint64_t>(largest, size);
+  }
+  const std::uint64_t fits = memory / std::max<std::uint64_t>(buffer_bytes + largest, 1);
+  return static_cast<unsigned>(std::clamp<std::uint64_t>(fits, 1, available_threads()));
+}
 
 }  // namespace
 
@@ -72,9 +87,9 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
                      std::vector<std::vector<std::size_t>>(acquisitions.size()), done);
   }
   {
-    // One acquisition at a time per rank: the tiler holds its vertices whole.
     const auto channel = cluster.share(schedule ? &*schedule : nullptr, nullptr);
-    run_workers(*channel, 1, [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted); });
+    run_workers(*channel, tiling_workers(acquisitions, config.run.memory, params.buffer_bytes),
+                [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted); });
   }
   if (cluster.root()) {
     std::vector<AcquisitionTiling> parts;
