@@ -15,21 +15,24 @@ namespace citymesh::app {
 
 namespace {
 
+/// Each acquisition's file size in bytes (0 when it cannot be read: the tiler says why).
+std::vector<std::uint64_t> file_sizes(std::span<const Acquisition> acquisitions) {
+  std::vector<std::uint64_t> sizes;
+  for (const Acquisition& a : acquisitions) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(a.path, ec);
+    sizes.push_back(ec ? 0 : size);
+  }
+  return sizes;
+}
+
 /// Which acquisition comes first: the largest file (a cluster), or the subset's own share
 /// first, then the others in turn (a subset beside unknown others).
-std::vector<std::uint64_t> tiling_priorities(std::span<const Acquisition> acquisitions,
-                                             const std::optional<Subset>& subset) {
-  const std::size_t n = acquisitions.size();
+std::vector<std::uint64_t> tiling_priorities(std::span<const std::uint64_t> sizes, const std::optional<Subset>& subset) {
+  if (!subset) return {sizes.begin(), sizes.end()};
+  const std::size_t n = sizes.size(), start = (subset->index - 1) * n / subset->count;
   std::vector<std::uint64_t> priority(n);
-  for (std::size_t k = 0; k < n; ++k) {
-    if (subset) {
-      const std::size_t start = (subset->index - 1) * n / subset->count;
-      priority[k] = n - (k + n - start) % n;
-    } else {
-      std::error_code ec;
-      priority[k] = std::filesystem::file_size(acquisitions[k].path, ec);
-    }
-  }
+  for (std::size_t k = 0; k < n; ++k) priority[k] = n - (k + n - start) % n;
   return priority;
 }
 
@@ -38,13 +41,8 @@ std::string store_fingerprint(std::uint64_t fingerprint) { return fmt::format("{
 /// How many acquisitions a rank tiles at once: one per thread while each fits the budget
 /// with its buffers and its vertices, held whole (about the size of its file). The result
 /// does not depend on it: each acquisition is tiled alone, with the same buffers.
-unsigned tiling_workers(std::span<const Acquisition> acquisitions, std::uint64_t memory, std::uint64_t buffer_bytes) {
-  std::uint64_t largest = 0;
-  for (const Acquisition& a : acquisitions) {
-    std::error_code ec;
-    const std::uintmax_t size = std::filesystem::file_size(a.path, ec);
-    if (!ec) largest = std::max<std::uint64_t>(largest, size);
-  }
+unsigned tiling_workers(std::span<const std::uint64_t> sizes, std::uint64_t memory, std::uint64_t buffer_bytes) {
+  const std::uint64_t largest = sizes.empty() ? 0 : *std::max_element(sizes.begin(), sizes.end());
   const std::uint64_t fits = memory / std::max<std::uint64_t>(buffer_bytes + largest, 1);
   return static_cast<unsigned>(std::clamp<std::uint64_t>(fits, 1, available_threads()));
 }
@@ -69,6 +67,7 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
   }
   Stopwatch clock;
   const std::vector<Acquisition> acquisitions = config.acquisition_list();
+  const std::vector<std::uint64_t> sizes = file_sizes(acquisitions);
   // Only a run that owns the folder removes unfinished staging: subsets may be tiling there.
   if (cluster.root()) prune_tile_store(dir, acquisitions.size(), wanted, !subset);
 
@@ -83,12 +82,12 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
     for (std::size_t k = 0; k < acquisitions.size(); ++k) {
       done[k] = read_acquisition_tiling(dir, static_cast<std::uint32_t>(k), wanted).has_value() ? 1 : 0;
     }
-    schedule.emplace(tiling_priorities(acquisitions, subset),
+    schedule.emplace(tiling_priorities(sizes, subset),
                      std::vector<std::vector<std::size_t>>(acquisitions.size()), done);
   }
   {
     const auto channel = cluster.share(schedule ? &*schedule : nullptr, nullptr);
-    run_workers(*channel, tiling_workers(acquisitions, config.run.memory, params.buffer_bytes),
+    run_workers(*channel, tiling_workers(sizes, config.run.memory, params.buffer_bytes),
                 [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted); });
   }
   if (cluster.root()) {

@@ -168,15 +168,6 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   return std::vector<std::uint8_t>(colour.begin(), colour.end());
 }
 
-BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
-  BinaryEnergy f = e;
-  for (std::size_t i = 0; i < f.size(); ++i) {
-    if (flips[i] != 0) std::swap(f.unary[i][0], f.unary[i][1]);
-  }
-  for (BinaryEnergy::Pair& p : f.pairs) p = flip_pair(p, flips[p.i] != 0, flips[p.j] != 0);
-  return f;
-}
-
 std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
   MaxFlow g = max_flow_of(cut_graph(e, /*doubled=*/false, flips));
   g.solve();

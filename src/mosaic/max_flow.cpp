@@ -38,6 +38,7 @@ void MaxFlow::add_terminal(Node i, double from_source, double to_sink) {
 
 void MaxFlow::add_edge(Node i, Node j, double cap, double rev_cap) {
   if (i == j) throw ProcessingError("max-flow: an edge from a node to itself");
+  if (solved_) throw ProcessingError("max-flow: an edge added after solve()");
   largest_ = std::max({largest_, cap, rev_cap});
   if (staged_.size() + 2 >= kOrphan) throw ProcessingError("max-flow: too many edges");
   staged_.push_back({j, cap});
@@ -252,6 +253,8 @@ void MaxFlow::adopt(Node i) {
 double MaxFlow::solve() {
   // Sums of pushes leave rounding crumbs on arcs that are saturated in exact arithmetic:
   // residuals this far below the largest capacity count as zero, or the cut would leak.
+  if (solved_) throw ProcessingError("max-flow: solve() called twice");
+  solved_ = true;
   zero_ = largest_ * kRelativeZero;
   lay_out_arcs();
   push_two_arc_paths();

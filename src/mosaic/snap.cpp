@@ -13,7 +13,8 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
-using Topology = MeshTopology;  // every operation keeps a directed edge used by at most one triangle
+// Every operation keeps each directed edge used by at most one triangle (MeshTopology's
+// edges_free before any change).
 
 Vec3d normal_of(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return cross(b - a, c - a); }
 
@@ -28,7 +29,7 @@ struct DirectedEdge {
 };
 
 /// The directed edges whose reverse no triangle uses, in triangle order.
-std::vector<DirectedEdge> boundary_half_edges(const Topology& topo) {
+std::vector<DirectedEdge> boundary_half_edges(const MeshTopology& topo) {
   const std::vector<Triangle>& triangles = topo.merged().mesh.triangles;
   constexpr std::size_t kGrain = 1 << 16;
   std::vector<std::vector<DirectedEdge>> per_block((triangles.size() + kGrain - 1) / kGrain);
@@ -60,7 +61,7 @@ std::vector<std::uint32_t> vertices_of(std::span<const DirectedEdge> edges) {
 
 /// Makes w one with v at their midpoint, unless a triangle of either would flip or
 /// degenerate or a directed edge would be used twice.
-bool try_merge(Topology& topo, std::uint32_t v, std::uint32_t w) {
+bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   const Vec3d mid = (topo.position(v) + topo.position(w)) * 0.5;
   const auto moved = [&](std::uint32_t u) { return u == v || u == w ? mid : topo.position(u); };
   std::vector<Triangle> renamed;
@@ -90,7 +91,7 @@ bool try_merge(Topology& topo, std::uint32_t v, std::uint32_t w) {
 }
 
 /// Stage 1: boundary vertices of different sources within the tolerance become one.
-void merge_close_vertices(Topology& topo, double tolerance, SnapStats& stats) {
+void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<std::uint32_t> vertices = vertices_of(boundary_half_edges(topo));
   std::vector<Vec3f> points;
   for (const std::uint32_t v : vertices) points.push_back(topo.merged().mesh.positions[v]);
@@ -132,14 +133,14 @@ struct Insertion {
 };
 
 /// True when a triangle around v comes from `source`.
-bool touches_source(const Topology& topo, std::uint32_t v, std::int32_t source) {
+bool touches_source(const MeshTopology& topo, std::uint32_t v, std::int32_t source) {
   const std::span<const std::uint32_t> around = topo.triangles_of(v);
   return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return topo.merged().source_acq[t] == source; });
 }
 
 /// For every boundary vertex, the nearest boundary edge of another source passing within the
 /// tolerance, where the vertex projects well inside the edge.
-std::vector<Insertion> find_insertions(const Topology& topo, std::span<const DirectedEdge> edges, double tolerance) {
+std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const DirectedEdge> edges, double tolerance) {
   std::vector<Box3f> boxes;
   const auto pad = static_cast<float>(tolerance);
   for (const DirectedEdge& e : edges) {
@@ -178,7 +179,7 @@ std::vector<Insertion> find_insertions(const Topology& topo, std::span<const Dir
 
 /// Splits the triangle on directed edge from -> to into a fan through the inserted vertices
 /// (in order along the edge), unless a piece would flip or degenerate or reuse a directed edge.
-bool try_split(Topology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
+bool try_split(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
   const std::optional<std::uint32_t> found = topo.triangle_with(from, to);
   if (!found) return false;
   const std::uint32_t t = *found;
@@ -218,7 +219,7 @@ bool try_split(Topology& topo, std::uint32_t from, std::uint32_t to, const std::
 }
 
 /// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
-void split_edges_at_vertices(Topology& topo, double tolerance, SnapStats& stats) {
+void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<DirectedEdge> edges = boundary_half_edges(topo);
   const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
   for (std::size_t i = 0; i < insertions.size();) {

@@ -52,22 +52,22 @@ Boundary find_boundary(const mosaic_detail::MeshTopology& topo) {
 }
 
 struct StitchContext {
-  MergedMesh& merged;
   const StitchParams& params;
-  mosaic_detail::MeshTopology& topo;  ///< which directed edges are in use
+  mosaic_detail::MeshTopology& topo;  ///< the mesh, and which directed edges are in use
   Boundary boundary;
   std::unordered_map<std::uint32_t, std::uint32_t> partner;  ///< boundary vertex -> matched vertex of another source
   std::unordered_set<std::uint32_t> consumed;                 ///< boundary half-edges (by their start) joined
   StitchStats stats;
 
+  [[nodiscard]] MergedMesh& merged() const { return topo.merged(); }
   [[nodiscard]] std::int32_t source(std::uint32_t v) const {
-    return merged.source_acq[boundary.triangle_of.at(v)];
+    return merged().source_acq[boundary.triangle_of.at(v)];
   }
 };
 
 /// For every boundary vertex, the nearest boundary vertex of another source within reach.
 void match_vertices(StitchContext& c) {
-  const Mesh& m = c.merged.mesh;
+  const Mesh& m = c.merged().mesh;
   std::vector<Vec3f> points;
   for (const std::uint32_t v : c.boundary.vertices) points.push_back(m.positions[v]);
   const PointKdTree tree(points);
@@ -111,18 +111,18 @@ std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from
 /// Adds the strip triangle (a, b, c) unless it is degenerate, faces against `reference` or
 /// uses a directed edge already in use (which would fold the mesh or break its manifoldness).
 bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std::uint32_t d, const Vec3d& reference) {
-  const Mesh& m = c.merged.mesh;
+  const Mesh& m = c.merged().mesh;
   const Vec3d n = face_normal(m, a, b, d);
   const double len = norm(n);
   if (!(len > 1e-10) || dot(n, reference) <= 0 || c.topo.has(a, b) || c.topo.has(b, d) || c.topo.has(d, a)) {
     ++c.stats.rejected;
     return false;
   }
-  c.merged.mesh.triangles.push_back({a, b, d});
-  c.merged.mesh.triangle_ids.push_back({});
-  c.merged.source_acq.push_back(kNoSource);
-  c.merged.source_triangle.push_back(kNoSource);
-  c.topo.add_triangle(static_cast<std::uint32_t>(c.merged.mesh.triangle_count() - 1));
+  c.merged().mesh.triangles.push_back({a, b, d});
+  c.merged().mesh.triangle_ids.push_back({});
+  c.merged().source_acq.push_back(kNoSource);
+  c.merged().source_triangle.push_back(kNoSource);
+  c.topo.add_triangle(static_cast<std::uint32_t>(c.merged().mesh.triangle_count() - 1));
   ++c.stats.triangles_added;
   return true;
 }
@@ -130,7 +130,7 @@ bool add_strip_triangle(StitchContext& c, std::uint32_t a, std::uint32_t b, std:
 /// Zippers P's run a (oriented as P's boundary) with Q's facing run b (oriented the same way
 /// along the seam): one new triangle per step, advancing the side with the shorter diagonal.
 void zip(StitchContext& c, const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
-  const Mesh& m = c.merged.mesh;
+  const Mesh& m = c.merged().mesh;
   std::size_t i = 0, j = 0;
   while (i + 1 < a.size() || j + 1 < b.size()) {
     const bool advance_a =
@@ -186,12 +186,12 @@ void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_set<std::
 
 /// Merges strip corners closer than the weld tolerance and drops the triangles that collapse.
 void weld(StitchContext& c) {
-  Mesh& m = c.merged.mesh;
+  Mesh& m = c.merged().mesh;
   std::vector<std::uint32_t> target(m.vertex_count());
   std::iota(target.begin(), target.end(), 0);
   const double tol_sq = c.params.weld * c.params.weld;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    if (c.merged.source_acq[t] != kNoSource) continue;
+    if (c.merged().source_acq[t] != kNoSource) continue;
     for (int k = 0; k < 3; ++k) {
       std::uint32_t u = m.triangles[t][k], v = m.triangles[t][(k + 1) % 3];
       while (target[u] != u) u = target[u];
@@ -213,14 +213,14 @@ void weld(StitchContext& c) {
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) continue;
     m.triangles[kept] = tri;
     m.triangle_ids[kept] = m.triangle_ids[t];
-    c.merged.source_acq[kept] = c.merged.source_acq[t];
-    c.merged.source_triangle[kept] = c.merged.source_triangle[t];
+    c.merged().source_acq[kept] = c.merged().source_acq[t];
+    c.merged().source_triangle[kept] = c.merged().source_triangle[t];
     ++kept;
   }
   m.triangles.resize(kept);
   m.triangle_ids.resize(kept);
-  c.merged.source_acq.resize(kept);
-  c.merged.source_triangle.resize(kept);
+  c.merged().source_acq.resize(kept);
+  c.merged().source_triangle.resize(kept);
 }
 
 }  // namespace
@@ -242,7 +242,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   mosaic_detail::MeshTopology topo(merged);
   const double before = length_of(merged.mesh, topo.boundary_edges());
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
-  StitchContext c{merged, params, topo, find_boundary(topo), {}, {}, {}};
+  StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
   c.stats.vertices_snapped = snapped.vertices_merged;
   c.stats.edges_split = snapped.edges_split;

@@ -101,12 +101,17 @@ TEST(MaxFlow, EqualsEdmondsKarpAndItsCutOnRandomGraphs) {
   }
 }
 
-TEST(MaxFlow, ChainAndParallelPaths) {
-  // s -> 0 (5), 0 -> 1 (3), 1 -> t (4), plus 0 -> t (1): max flow 4.
+/// s -> 0 (5), 0 -> 1 (3), 1 -> t (4), plus 0 -> t (1): max flow 4.
+MaxFlow chain_and_parallel_paths() {
   MaxFlow g(2);
   g.add_terminal(0, 5, 1);
   g.add_edge(0, 1, 3, 0);
   g.add_terminal(1, 0, 4);
+  return g;
+}
+
+TEST(MaxFlow, ChainAndParallelPaths) {
+  MaxFlow g = chain_and_parallel_paths();
   EXPECT_DOUBLE_EQ(g.solve(), 4.0);
   const auto side = g.source_side();
   EXPECT_EQ(side[0], 1);
@@ -116,6 +121,14 @@ TEST(MaxFlow, ChainAndParallelPaths) {
 TEST(MaxFlow, RefusesSelfLoops) {
   MaxFlow g(1);
   EXPECT_ANY_THROW(g.add_edge(0, 0, 1, 1));
+}
+
+TEST(MaxFlow, RefusesASecondSolveAndEdgesAfterIt) {
+  // solve() lays the arcs out once: a second call or a later edge would be silently lost.
+  MaxFlow g = chain_and_parallel_paths();
+  EXPECT_DOUBLE_EQ(g.solve(), 4.0);
+  EXPECT_ANY_THROW(g.solve());
+  EXPECT_ANY_THROW(g.add_edge(1, 0, 1, 0));
 }
 
 }  // namespace

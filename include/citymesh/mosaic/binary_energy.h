@@ -42,9 +42,6 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
 /// test submodular_flips() applies to the set it finds): a cheap check of a known candidate.
 bool flips_make_submodular(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
 
-/// The energy with the variables in `flips` flipped (x -> 1 - x): same minimum, relabelled.
-BinaryEnergy flipped(const BinaryEnergy& e, std::span<const std::uint8_t> flips);
-
 /// The s-t graph whose minimum cut minimises an energy: node i is x_i (source side: 0); with
 /// `doubled`, node n + i is its negation (QPBO's construction), else every term must be
 /// submodular. Terms are split so that unary parts stay balanced (fewer augmentations).

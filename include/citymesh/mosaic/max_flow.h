@@ -28,7 +28,8 @@ class MaxFlow {
   /// (both >= 0). i != j.
   void add_edge(Node i, Node j, double cap, double rev_cap);
 
-  /// Computes a maximum flow and returns its value. Call once, after every node and edge.
+  /// Computes a maximum flow and returns its value. Call once, after every node and edge
+  /// (it lays the arcs out for the search; a second call or a later edge throws).
   double solve();
 
   /// After solve(): the nodes reachable from the source in the residual graph (the source side
@@ -90,6 +91,7 @@ class MaxFlow {
   double zero_ = 0;     ///< residuals at or below this count as saturated
   static constexpr double kRelativeZero = 1e-12;
   std::uint64_t augmentations_ = 0;
+  bool solved_ = false;
 };
 
 }  // namespace citymesh
