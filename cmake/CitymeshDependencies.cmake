@@ -27,6 +27,8 @@ endif()
 
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
+# xxHash (libxxhash-dev): the checksum of the bulk binary files (tile store, tile results).
+pkg_check_modules(XXHASH REQUIRED IMPORTED_TARGET libxxhash)
 
 # Optional: OpenMPI (libopenmpi-dev) for runs across machines; tools/setup installs it.
 # Only the C API is used (cluster_mpi.cpp), through the C++ compiler wrapper's flags.

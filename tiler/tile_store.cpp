@@ -19,7 +19,8 @@ namespace citymesh {
 namespace {
 
 constexpr char kMagic[8] = {'C', 'M', 'T', 'I', 'L', 'E', '0', '1'};
-constexpr std::uint32_t kVersion = 1;
+// Version 2: the checksum is XXH3 (version 1: FNV-1a, a tenth of the tiler's time on a city).
+constexpr std::uint32_t kVersion = 2;
 constexpr std::uint32_t kHasIntensity = 1, kHasColor = 2;
 
 struct BlockHeader {
@@ -28,7 +29,7 @@ struct BlockHeader {
   std::uint32_t flags;
   std::uint64_t vertices;
   std::uint64_t triangles;
-  std::uint64_t checksum;  ///< FNV-1a of the payload
+  std::uint64_t checksum;  ///< bulk_checksum (XXH3) of the payload
 };
 static_assert(sizeof(BlockHeader) == 40);
 
@@ -109,8 +110,9 @@ struct BlockParts {
                                         bytes_of(piece.triangle_index), bytes_of(piece.roles)}) {
       parts.push_back(part);
     }
-    header.checksum = fnv1a(nullptr, 0);
-    for (const std::string_view part : parts) header.checksum = fnv1a(part.data(), part.size(), header.checksum);
+    BulkChecksum sum;
+    for (const std::string_view part : parts) sum.add(part.data(), part.size());
+    header.checksum = sum.value();
     parts.insert(parts.begin(), std::string_view(reinterpret_cast<const char*>(&header), sizeof header));
   }
   BlockParts(const BlockParts&) = delete;
@@ -192,7 +194,7 @@ TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::u
     }
     const char* payload = bytes.data() + at + sizeof h;
     const std::uint64_t size = h.vertices * vertex_bytes(h.flags) + h.triangles * kTriangleBytes;
-    if (fnv1a(payload, size) != h.checksum) throw fail("checksum mismatch");
+    if (bulk_checksum(payload, size) != h.checksum) throw fail("checksum mismatch");
     PayloadReader r(payload);
     const std::size_t v0 = ids.size(), t0 = triangles.size(), nv = h.vertices, nt = h.triangles;
     r.take(ids, nv);

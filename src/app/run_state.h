@@ -13,8 +13,8 @@ namespace citymesh::app {
 
 inline constexpr const char* kRunConfigFile = "run-config.json";
 /// Bumped whenever what the tiler stores or what a tile result means changes.
-inline constexpr int kTileStoreVersion = 2;  // 2: one folder per acquisition
-inline constexpr int kTileResultVersion = 2;
+inline constexpr int kTileStoreVersion = 3;  // 2: one folder per acquisition; 3: XXH3 checksums
+inline constexpr int kTileResultVersion = 3;  // 3: XXH3 checksum
 
 /// A hash of the result-affecting keys (tiling_only: those that change the tile store).
 std::uint64_t fingerprint(const std::map<std::string, std::string>& keys, bool tiling_only);

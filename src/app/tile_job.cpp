@@ -21,7 +21,8 @@ namespace {
 
 // Version 02: a version 01 result may have been cut short by a failing worker (fixed in
 // parallel_workers); such folders are processed again rather than trusted.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '2'};
+// Version 03: the checksum is XXH3 (bulk_checksum) instead of FNV-1a.
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '3'};
 
 struct ResultHeader {
   char magic[8];
@@ -168,7 +169,7 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
     bytes.append(reinterpret_cast<const char*>(&size), sizeof size);
     bytes += block;
   }
-  const std::uint64_t sum = fnv1a(bytes.data(), bytes.size());
+  const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size());
   bytes.append(reinterpret_cast<const char*>(&sum), sizeof sum);
   write_file_atomically(file, bytes);
 }
@@ -186,7 +187,7 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   };
   if (bytes.size() < sizeof h + sizeof sum) return stale("truncated");
   std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
-  if (fnv1a(bytes.data(), bytes.size() - sizeof sum) != sum) return stale("checksum mismatch");
+  if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale("checksum mismatch");
   std::memcpy(&h, bytes.data(), sizeof h);
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return stale("not a tile result");
   if (h.fingerprint != fingerprint) return std::nullopt;  // made with another config: --force was given

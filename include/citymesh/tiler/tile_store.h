@@ -35,7 +35,7 @@ struct TilePiece {
   void clear();
 };
 
-/// `piece` as one checksummed block: header (magic, version, attribute flags, counts, FNV-1a
+/// `piece` as one checksummed block: header (magic, version, attribute flags, counts, XXH3
 /// of the payload) and payload (vertex ids, positions, sensor positions, attributes, triangles,
 /// faces, fans, triangle indices, roles).
 std::string encode_tile_block(const TilePiece& piece);
