@@ -13,11 +13,14 @@ namespace citymesh {
 
 namespace {
 std::int32_t cell(double coordinate, double origin, double size) {
-  const double c = std::floor((coordinate - origin) / size);
+  const double c = (coordinate - origin) / size;
   if (!(std::abs(c) < std::numeric_limits<std::int32_t>::max())) {
     throw InputError(fmt::format("tiling: coordinate {} is too far from the grid origin {}", coordinate, origin));
   }
-  return static_cast<std::int32_t>(c);
+  // floor() by truncation (the same value for every c in range): std::floor is a library call
+  // without SSE4.1, and the tiler calls this a dozen times per triangle.
+  const auto truncated = static_cast<std::int32_t>(c);
+  return static_cast<double>(truncated) > c ? truncated - 1 : truncated;
 }
 /// Whether the x-y convex hull of `points` meets the rectangle [lo, hi], by separating axes:
 /// the rectangle's two axes and the normal of every segment between two points (the hull's
@@ -81,16 +84,25 @@ std::vector<TileKey> TileGrid::halo_tiles(const Box3d& box, TileKey owner_key) c
   return tiles_near(box, [&](TileKey k) { return k != owner_key; });
 }
 
+bool TileGrid::within_one_tile(const Box3d& box) const {
+  const Vec3d grow{params_.halo, params_.halo, 0};
+  return owner(box.min - grow) == owner(box.max + grow);
+}
+
 std::vector<TileKey> TileGrid::tiles_crossed(std::span<const Vec3d> points) const {
   Box3d box;
   for (const Vec3d& p : points) box.extend(p);
   const double h = params_.halo, s = params_.tile_size;
-  const TileKey lo = owner(box.min - Vec3d{h, h, 0}), hi = owner(box.max + Vec3d{h, h, 0});
   // The shape grown by the halo inside one tile (the common case): no exact test needed.
-  if (lo == hi) return {lo};
+  if (within_one_tile(box)) return {owner(box.min)};
   return tiles_near(box, [&](TileKey k) {
     const Vec3d c = corner(k);
-    return hull_meets_rectangle(points, c.x - h, c.y - h, c.x + s + h, c.y + s + h);
+    const double x0 = c.x - h, y0 = c.y - h, x1 = c.x + s + h, y1 = c.y + s + h;
+    // A point inside settles it (most tiles a tetrahedron meets hold one of its corners).
+    const bool holds_a_point = std::any_of(points.begin(), points.end(), [&](const Vec3d& p) {
+      return p.x >= x0 && p.x <= x1 && p.y >= y0 && p.y <= y1;
+    });
+    return holds_a_point || hull_meets_rectangle(points, x0, y0, x1, y1);
   });
 }
 

@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <atomic>
 #include <map>
 #include <unordered_map>
 
@@ -10,6 +12,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "store_files.h"
 
@@ -35,12 +38,17 @@ struct AcquisitionVertices {
 struct TileBuffer {
   TilePiece piece;
   std::array<std::uint64_t, 3> counts{};  ///< triangles per role since the last flush
-  std::unordered_map<std::uint32_t, std::uint32_t> local;  ///< vertex id -> index in the piece
+  std::uint32_t serial = 0;               ///< unique within the acquisition's run, never 0
+  /// vertex id -> index in the piece, for the vertices whose cache slot (see
+  /// AcquisitionTiler::slots_) went to another buffer: the slot and this map together know
+  /// every vertex of the piece.
+  std::unordered_map<std::uint32_t, std::uint32_t> local;
 };
 
 std::string chunk_name(TileKey key);
 
-/// Hash-map overhead per buffered vertex, on top of the block bytes.
+/// Hash-map overhead per buffered vertex, on top of the block bytes: an upper bound since
+/// most vertices sit in the cache slots instead (see local_vertex).
 constexpr std::uint64_t kMapBytesPerVertex = 32;
 
 class AcquisitionTiler {
@@ -63,6 +71,7 @@ class AcquisitionTiler {
       if (kind == PlyReader::ChunkKind::end) break;
       if (kind == PlyReader::ChunkKind::vertices) {
         vertices_.append(vertices);
+        slots_.resize(vertices_.positions.size(), 0);
         continue;
       }
       for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
@@ -92,11 +101,16 @@ class AcquisitionTiler {
     Box3d box;
     for (const Vec3d& p : c) box.extend(p);
     add_to(owner, tri, id, index, TileRole::owned);
+    const Vec3d viewpoint =
+        (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
+    Box3d reach = box;
+    reach.extend(viewpoint);
+    // Most triangles and their viewpoints lie well inside one tile (then it is the owner): no
+    // halo copy and no other tile crossed, as halo_tiles and tiles_crossed would find.
+    if (grid_.within_one_tile(reach)) return;
     const std::vector<TileKey> halo = grid_.halo_tiles(box, owner);
     for (const TileKey k : halo) add_to(k, tri, id, index, TileRole::halo);
     out_.stats.halo_copies += halo.size();
-    const Vec3d viewpoint =
-        (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
     const std::array<Vec3d, 4> tetrahedron{c[0], c[1], c[2], viewpoint};
     for (const TileKey k : grid_.tiles_crossed(tetrahedron)) {
       if (k == owner || std::binary_search(halo.begin(), halo.end(), k)) continue;
@@ -110,6 +124,10 @@ class AcquisitionTiler {
     if (last_ == nullptr || key != last_key_) {
       last_ = &buffers_[key];
       last_key_ = key;
+      if (last_->serial == 0) {
+        last_->serial = next_serial_++;
+        live_.push_back(last_);
+      }
     }
     TileBuffer& b = *last_;
     if (b.piece.mesh.positions.empty() && b.piece.mesh.triangles.empty()) b.piece.mesh.origin = grid_.corner(key);
@@ -123,9 +141,19 @@ class AcquisitionTiler {
     ++b.counts[static_cast<std::size_t>(role)];
   }
 
+  /// v's index in b's piece, added to the piece the first time. Each vertex has one cache
+  /// slot (buffer serial, index) that answers nearly every lookup, since a vertex's triangles
+  /// mostly go to one tile; when another buffer takes the slot, the entry moves to its
+  /// buffer's map. A map per buffer alone took three hash lookups per triangle.
   std::uint32_t local_vertex(TileBuffer& b, std::uint32_t v) {
-    const auto [it, added] = b.local.try_emplace(v, static_cast<std::uint32_t>(b.piece.vertex_ids.size()));
-    if (!added) return it->second;
+    std::uint64_t& slot = slots_[v];
+    if (slot >> 32 == b.serial) return static_cast<std::uint32_t>(slot);
+    if (const auto it = b.local.find(v); it != b.local.end()) return it->second;
+    if (slot >> 32 >= first_live_serial_) {
+      live_[(slot >> 32) - first_live_serial_]->local.emplace(v, static_cast<std::uint32_t>(slot));
+    }
+    const auto index = static_cast<std::uint32_t>(b.piece.vertex_ids.size());
+    slot = std::uint64_t{b.serial} << 32 | index;
     Mesh& m = b.piece.mesh;
     b.piece.vertex_ids.push_back(v);
     m.positions.push_back(to_local(vertices_.positions[v], m.origin));
@@ -133,7 +161,7 @@ class AcquisitionTiler {
     if (!vertices_.intensities.empty()) m.intensities.push_back(vertices_.intensities[v]);
     if (!vertices_.colors.empty()) m.colors.push_back(vertices_.colors[v]);
     buffered_ += 28 + kMapBytesPerVertex;
-    return it->second;
+    return index;
   }
 
   void flush() {
@@ -147,6 +175,8 @@ class AcquisitionTiler {
       out_.stats.bytes_written += b.piece.byte_size();
     }
     buffers_.clear();
+    live_.clear();
+    first_live_serial_ = next_serial_;  // every slot now names a flushed buffer
     last_ = nullptr;
     buffered_ = 0;
   }
@@ -158,6 +188,9 @@ class AcquisitionTiler {
   std::uint64_t buffer_bytes_;
   AcquisitionVertices vertices_;
   std::map<TileKey, TileBuffer> buffers_;
+  std::vector<std::uint64_t> slots_;  ///< per vertex: buffer serial << 32 | index in its piece
+  std::vector<TileBuffer*> live_;     ///< the buffers since the last flush, by serial
+  std::uint32_t first_live_serial_ = 1, next_serial_ = 1;
   TileBuffer* last_ = nullptr;  ///< the buffer of last_key_ (map nodes do not move)
   TileKey last_key_;
   std::uint64_t buffered_ = 0;
@@ -243,13 +276,19 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
   return store;
 }
 
-TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params) {
+TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params,
+                            unsigned at_once) {
   std::error_code ec;
   std::filesystem::remove_all(params.dir, ec);
   std::filesystem::create_directories(params.dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", params.dir.string(), ec.message()));
-  std::vector<AcquisitionTiling> parts;
-  for (const Acquisition& a : acquisitions) parts.push_back(tile_acquisition(a, params, ""));
+  std::vector<AcquisitionTiling> parts(acquisitions.size());
+  std::atomic<std::size_t> next{0};
+  parallel_workers(std::max(at_once, 1u), [&](unsigned) {
+    for (std::size_t k = next++; k < acquisitions.size(); k = next++) {
+      parts[k] = tile_acquisition(acquisitions[k], params, "");
+    }
+  });
   return assemble_tile_store(params.dir, params.grid, parts, "");
 }
 

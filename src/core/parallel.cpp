@@ -5,6 +5,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/partitioner.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
@@ -27,6 +28,8 @@ unsigned available_threads() {
   return static_cast<unsigned>(
       tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
+
+void parallel_sort(std::span<std::uint64_t> values) { tbb::parallel_sort(values.begin(), values.end()); }
 
 void parallel_for_blocks(std::size_t count, std::size_t grain,
                          const std::function<void(std::size_t, std::size_t)>& body) {

@@ -15,18 +15,29 @@ std::string TileNode::name() const { return fmt::format("t{}_{}_{}", level, key.
 
 namespace {
 
-/// A tile mesh from triangles in global vertex indices: vertices ascending, triangle order kept.
-TileMesh compact(std::span<const Triangle> global) {
+/// A tile mesh from triangles in global vertex indices (< vertex_count): vertices ascending,
+/// triangle order kept. Each thread keeps one slot per global vertex (its index in the tile
+/// being built, reset after use), so only the tile's distinct vertices are sorted and each
+/// corner is found in one step; sorting every corner and binary-searching them was an eighth
+/// of the export's time on a city.
+TileMesh compact(std::span<const Triangle> global, std::size_t vertex_count) {
+  constexpr std::uint32_t kAbsent = UINT32_MAX;
+  thread_local std::vector<std::uint32_t> slot;
+  if (slot.size() < vertex_count) slot.resize(vertex_count, kAbsent);
   TileMesh m;
-  m.vertices.reserve(global.size() * 3);
-  for (const Triangle& t : global) m.vertices.insert(m.vertices.end(), t.begin(), t.end());
-  std::sort(m.vertices.begin(), m.vertices.end());
-  m.vertices.erase(std::unique(m.vertices.begin(), m.vertices.end()), m.vertices.end());
   m.triangles.reserve(global.size());
-  auto local = [&](std::uint32_t v) {
-    return static_cast<std::uint32_t>(std::lower_bound(m.vertices.begin(), m.vertices.end(), v) - m.vertices.begin());
-  };
-  for (const Triangle& t : global) m.triangles.push_back({local(t[0]), local(t[1]), local(t[2])});
+  for (const Triangle& t : global) {
+    for (const std::uint32_t v : t) {
+      if (slot[v] == kAbsent) {
+        slot[v] = 0;
+        m.vertices.push_back(v);
+      }
+    }
+  }
+  std::sort(m.vertices.begin(), m.vertices.end());
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) slot[m.vertices[i]] = static_cast<std::uint32_t>(i);
+  for (const Triangle& t : global) m.triangles.push_back({slot[t[0]], slot[t[1]], slot[t[2]]});
+  for (const std::uint32_t v : m.vertices) slot[v] = kAbsent;
   return m;
 }
 
@@ -53,7 +64,7 @@ void build_parent(const TilesetVertices& vertices, TileTree& tree, TileNode& par
     child_error = std::max(child_error, tree.nodes[c].geometric_error);
     parent.box.extend(tree.nodes[c].box);
   }
-  const TileMesh whole = compact(merged);
+  const TileMesh whole = compact(merged, vertices.positions.size());
   std::vector<Vec3f> positions;
   positions.reserve(whole.vertices.size());
   for (const std::uint32_t v : whole.vertices) positions.push_back(vertices.positions[v]);
@@ -63,7 +74,7 @@ void build_parent(const TilesetVertices& vertices, TileTree& tree, TileNode& par
   for (const Triangle& t : simplified.triangles) {
     kept.push_back({whole.vertices[t[0]], whole.vertices[t[1]], whole.vertices[t[2]]});
   }
-  parent.mesh = compact(kept);
+  parent.mesh = compact(kept, vertices.positions.size());
   parent.geometric_error = std::max(child_error + simplified.error, params.min_geometric_error);
 }
 
@@ -79,7 +90,7 @@ TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triang
   parallel_for_blocks(tree.nodes.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t n = begin; n < end; ++n) {
       TileNode& leaf = tree.nodes[n];
-      leaf.mesh = compact(leaves.at(leaf.key));
+      leaf.mesh = compact(leaves.at(leaf.key), vertices.positions.size());
       leaf.box = mesh_box(vertices, leaf.mesh);
     }
   });

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <thread>
 #include <mutex>
+#include <random>
 #include <set>
 #include <vector>
 
@@ -77,6 +78,26 @@ TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
 TEST(ThreadLimit, BoundsTheAvailableThreads) {
   ThreadLimit limit(1);
   EXPECT_EQ(available_threads(), 1u);
+}
+
+}  // namespace
+}  // namespace citymesh
+
+namespace citymesh {
+namespace {
+
+TEST(ParallelSort, EqualsStdSortWithDuplicatesOnOneAndTwoThreads) {
+  std::mt19937_64 rng(11);
+  std::vector<std::uint64_t> values(300000);
+  for (std::uint64_t& v : values) v = rng() % 50000;  // many duplicates
+  std::vector<std::uint64_t> expected = values;
+  std::sort(expected.begin(), expected.end());
+  for (const unsigned threads : {1u, 2u}) {
+    const ThreadLimit limit(threads);
+    std::vector<std::uint64_t> sorted = values;
+    parallel_sort(sorted);
+    EXPECT_EQ(sorted, expected) << threads << " threads";
+  }
 }
 
 }  // namespace

@@ -33,6 +33,7 @@ TEST(TileGrid, HaloTilesEqualBruteForce) {
   const TileGrid grid({.tile_size = 10, .halo = 1.5, .origin = {0, 0}});
   std::mt19937 rng(4);
   std::uniform_real_distribution<double> u(-30, 30), e(0, 3);
+  std::size_t within = 0;
   for (int n = 0; n < 2000; ++n) {
     Box3d box;
     const Vec3d a{u(rng), u(rng), 0};
@@ -40,15 +41,22 @@ TEST(TileGrid, HaloTilesEqualBruteForce) {
     box.extend(a + Vec3d{e(rng), e(rng), 1});
     const TileKey owner = grid.owner(a);
     std::vector<TileKey> expected;
+    std::size_t bands_met = 0;
     for (int i = -5; i <= 5; ++i) {
       for (int j = -5; j <= 5; ++j) {
         const double x0 = i * 10 - 1.5, x1 = (i + 1) * 10 + 1.5, y0 = j * 10 - 1.5, y1 = (j + 1) * 10 + 1.5;
         const bool meets = box.min.x < x1 && box.max.x >= x0 && box.min.y < y1 && box.max.y >= y0;
+        bands_met += meets ? 1 : 0;
         if (meets && TileKey{i, j} != owner) expected.push_back({i, j});
       }
     }
     ASSERT_EQ(grid.halo_tiles(box, owner), expected) << n;
+    // The tiler's shortcut: one tile's band holds the box exactly when no other band meets it.
+    ASSERT_EQ(grid.within_one_tile(box), bands_met == 1) << n;
+    within += bands_met == 1 ? 1 : 0;
   }
+  EXPECT_GT(within, 200u);  // both answers occur
+  EXPECT_LT(within, 1800u);
 }
 
 /// Brute force: two convex sets in the plane meet when a point of one lies in the other or

@@ -116,6 +116,16 @@ TEST(Tiler, EveryTriangleIsOwnedOnceAndCopiedWhereBruteForceSays) {
       }
       EXPECT_EQ(per_role, tile.triangles[a]);
       owned += per_role[0];
+      // One block per chunk (large buffers) holding each vertex once: its size counts only
+      // the distinct vertices its triangles use (40-byte header, 32 bytes per vertex with an
+      // intensity, 29 per triangle), so a vertex written twice would show.
+      if (p.triangle_count() == 0) continue;
+      std::set<std::uint32_t> used;
+      for (const Triangle& tri : p.mesh.triangles) {
+        for (const std::uint32_t v : tri) used.insert(p.vertex_ids[v]);
+      }
+      EXPECT_EQ(std::filesystem::file_size(tile_chunk_path(store.dir, tile.key, a)),
+                40 + 32 * used.size() + 29 * p.triangle_count());
     }
   }
   EXPECT_EQ(owned, 6000u);

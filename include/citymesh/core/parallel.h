@@ -33,6 +33,10 @@ class ThreadLimit {
 void parallel_for_blocks(std::size_t count, std::size_t grain,
                          const std::function<void(std::size_t, std::size_t)>& body);
 
+/// Sorts `values` ascending on the pool. Plain integers: the result is the same on 1 or N
+/// threads.
+void parallel_sort(std::span<std::uint64_t> values);
+
 /// Runs `body(w)` for every w in [0, workers) on the pool, as long-lived worker loops. Each
 /// body runs isolated: while it waits for its own nested parallel loops, its thread runs only
 /// their tasks, never another worker loop, so a body may block until another body's work is

@@ -42,6 +42,9 @@ class TileGrid {
   /// Tiles other than `owner` whose halo band (tile grown by `halo`) meets the x-y extent of
   /// `box`, in (i, j) order. A triangle is copied into these tiles as context.
   [[nodiscard]] std::vector<TileKey> halo_tiles(const Box3d& box, TileKey owner) const;
+  /// Whether the x-y extent of `box` grown by the halo lies in one tile: then that tile is the
+  /// only one halo_tiles, tiles_crossed and owner can name for anything inside the box.
+  [[nodiscard]] bool within_one_tile(const Box3d& box) const;
   /// Every tile whose halo band (tile grown by `halo`) the x-y shadow of the convex hull of
   /// `points` truly meets (not only its bounding box), in (i, j) order. An empty-space
   /// tetrahedron (a triangle and its viewpoint) goes to these tiles, so that a conflict is
