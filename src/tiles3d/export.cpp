@@ -55,7 +55,8 @@ SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source
   std::vector<std::uint64_t> keys(n * 3);
   parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
-      for (std::size_t k = 0; k < 3; ++k) keys[3 * t + k] = key(mesh.triangles[t][k], feature_of(source_acq[t]));
+      const std::uint16_t f = feature_of(source_acq[t]);
+      for (std::size_t k = 0; k < 3; ++k) keys[3 * t + k] = key(mesh.triangles[t][k], f);
     }
   });
   parallel_sort(keys);
@@ -75,15 +76,15 @@ SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source
       if (!vx.colors.empty()) vx.colors[i] = mesh.colors[v];
     }
   });
-  auto index = [&](std::uint32_t v, std::int32_t source) {
-    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), key(v, feature_of(source))) -
-                                      keys.begin());
+  auto index = [&](std::uint32_t v, std::uint16_t f) {
+    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), key(v, f)) - keys.begin());
   };
   out.triangles.resize(n);
   parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
       const Triangle& tri = mesh.triangles[t];
-      out.triangles[t] = {index(tri[0], source_acq[t]), index(tri[1], source_acq[t]), index(tri[2], source_acq[t])};
+      const std::uint16_t f = feature_of(source_acq[t]);
+      out.triangles[t] = {index(tri[0], f), index(tri[1], f), index(tri[2], f)};
     }
   });
   return out;
