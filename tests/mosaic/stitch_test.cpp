@@ -53,6 +53,8 @@ TEST(Stitch, ClosesTheGapBetweenTwoPiecesOfDifferentSources) {
   EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
   // The two facing sides (about 1 m each) are no longer open; the outer boundary stays.
   EXPECT_LT(s.open_boundary_after, before - 1.7);
+  // The figure reported (from the incidence lists) is the one a sort of every edge gives.
+  EXPECT_EQ(s.open_boundary_after, open_boundary_length(m.mesh));
   for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
     if (m.source_acq[t] != kNoSource) continue;
     const Triangle& tri = m.mesh.triangles[t];
@@ -86,6 +88,7 @@ TEST(Stitch, SnapsNearlyCoincidentBoundariesIntoSharedEdges) {
   // Outer boundary: 2 x (1 + 1) + 2 x 1 ... of the union, a 2 m x 1 m rectangle, about 6 m.
   EXPECT_LT(s.open_boundary_after, 6.1);
   EXPECT_NEAR(s.open_boundary_after, before - 2.0, 0.1);
+  EXPECT_EQ(s.open_boundary_after, open_boundary_length(m.mesh));
   std::size_t provenance_kept = 0;
   for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
     const Triangle& tri = m.mesh.triangles[t];
