@@ -226,6 +226,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(bool_key(mosaic, "fill_holes",
       "after the energy mosaic, add back kept triangles with nothing selected within distance_threshold (newest first)",
       [](auto& c) -> auto& { return c.mosaic.fill_holes; }));
+  keys.push_back(bool_key(mosaic, "clip_overlaps",
+      "before stitching, cut pieces back where they lie over a larger source's surface, so that boundaries meet",
+      [](auto& c) -> auto& { return c.mosaic.clip_overlaps; }));
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));

@@ -9,6 +9,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
+#include "clip.h"
 #include "snap.h"
 
 namespace citymesh {
@@ -239,11 +240,15 @@ double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
+  const double before = length_of(merged.mesh, mosaic_detail::MeshTopology(merged).boundary_edges());
+  const mosaic_detail::ClipStats clipped =
+      params.clip > 0 ? mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip}) : mosaic_detail::ClipStats{};
   mosaic_detail::MeshTopology topo(merged);
-  const double before = length_of(merged.mesh, topo.boundary_edges());
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
+  c.stats.triangles_uncovered = clipped.triangles_removed;
+  c.stats.triangles_clipped = clipped.triangles_cut;
   c.stats.vertices_snapped = snapped.vertices_merged;
   c.stats.edges_split = snapped.edges_split;
   c.stats.rejected = snapped.rejected;

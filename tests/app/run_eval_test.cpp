@@ -79,6 +79,7 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   // face says where it came from.
   const nlohmann::json s = read_json(dir / "sim/out/mosaic/summary.json");
   EXPECT_LT(s["stitch"]["open_boundary_after_m"].get<double>(), s["stitch"]["open_boundary_before_m"].get<double>());
+  EXPECT_GT(s["stitch"]["triangles_clipped"].get<std::uint64_t>(), 0u);  // pieces cut back where they overlapped
   const auto [non_manifold, sources] = inspect(dir / "sim/out/mosaic/mosaic.ply");
   EXPECT_EQ(non_manifold, 0u);
   EXPECT_GT(sources.count(-1), 0u);  // stitch triangles

@@ -7,6 +7,9 @@
 #include <map>
 #include <random>
 
+#include "citymesh/core/geometry.h"
+#include "clip.h"
+
 namespace citymesh {
 namespace {
 
@@ -110,6 +113,112 @@ TEST(Stitch, LeavesPiecesOfOneSourceAndFarPiecesAlone) {
   EXPECT_EQ(s.vertices_snapped + s.edges_split, 0u);
   EXPECT_EQ(m.mesh.triangle_count(), triangles);
   EXPECT_NEAR(s.open_boundary_after, s.open_boundary_before, 1e-9);
+}
+
+/// Area of the triangles of `source`.
+double area_of(const MergedMesh& m, std::int32_t source) {
+  double total = 0;
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_acq[t] != source) continue;
+    const TriangleCorners c = m.mesh.corners(t);
+    total += 0.5 * norm(cross(c[1] - c[0], c[2] - c[0]));
+  }
+  return total;
+}
+
+/// A 1 m x 1 m grid of source 1 and, 5 cm above it, a 0.6 m x 0.4 m grid of source 0 (fewer
+/// triangles: it yields) reaching 15 cm over its side x = 1.
+MergedMesh overlapping_pieces() {
+  MergedMesh m;
+  add_grid(m, 0, 0, 10, 10, 0.1f, 1);
+  add_grid(m, 0.85f, 0.2f, 6, 4, 0.1f, 0, 0.05f);
+  for (const Vec3f& p : m.mesh.positions) {
+    m.mesh.sensor_positions.push_back(p + Vec3f{0, 0, 10});
+    m.mesh.times.push_back(100.0 + p.x);
+  }
+  return m;
+}
+
+TEST(Clip, CutsTheSmallerPieceBackToWhereTheLargerEnds) {
+  MergedMesh m = overlapping_pieces();
+  const std::size_t large = 200;
+  const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.1});
+  EXPECT_GT(s.triangles_cut, 0u);
+  EXPECT_EQ(s.triangles_removed, 8u);  // the column of cells between x = 0.85 and 0.95
+  EXPECT_EQ(std::count(m.source_acq.begin(), m.source_acq.end(), 1), static_cast<std::ptrdiff_t>(large));
+  EXPECT_NEAR(area_of(m, 1), 1.0, 1e-5);
+  // Ground truth: what is left of source 0 is the rectangle [1, 1.45] x [0.2, 0.6].
+  EXPECT_NEAR(area_of(m, 0), 0.45 * 0.4, 1e-4);
+  MergedMesh small;
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_acq[t] != 0) continue;
+    small.mesh.triangles.push_back(m.mesh.triangles[t]);
+    for (const std::uint32_t v : m.mesh.triangles[t]) {
+      EXPECT_GE(m.mesh.positions[v].x, 1.0f - 1e-4f) << "a corner is still over the larger piece";
+    }
+  }
+  small.mesh.positions = m.mesh.positions;
+  // Conforming: the neighbours of a cut edge cut it at the same vertex, so the part left has
+  // no crack inside: its open boundary is the rectangle's perimeter.
+  EXPECT_NEAR(open_boundary_length(small.mesh), 2 * (0.45 + 0.4), 1e-3);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    EXPECT_GT(cross(c[1] - c[0], c[2] - c[0]).z, 1e-6) << "triangle " << t << " is flipped or flat";
+  }
+  // New vertices interpolate every attribute.
+  ASSERT_NO_THROW(m.mesh.check_invariants());
+  for (std::size_t v = 0; v < m.mesh.vertex_count(); ++v) {
+    EXPECT_NEAR(m.mesh.sensor_positions[v].z - m.mesh.positions[v].z, 10.0f, 1e-4f);
+    EXPECT_NEAR(m.mesh.times[v], 100.0 + m.mesh.positions[v].x, 1e-5);
+  }
+}
+
+TEST(Clip, OnEqualSizesTheEarlierSourceYields) {
+  MergedMesh m;
+  add_grid(m, 0, 0, 4, 4, 0.1f, 3);
+  add_grid(m, 0.35f, 0, 4, 4, 0.1f, 2, 0.03f);
+  mosaic_detail::clip_overlaps(m, {.tolerance = 0.1});
+  EXPECT_NEAR(area_of(m, 3), 0.16, 1e-5);
+  EXPECT_NEAR(area_of(m, 2), 0.35 * 0.4, 1e-4);
+}
+
+TEST(Clip, LeavesCrossingAndDistantSurfacesAlone) {
+  MergedMesh m;
+  add_grid(m, 0, 0, 10, 10, 0.1f, 1);
+  add_grid(m, 0.3f, 0.3f, 3, 3, 0.1f, 0, 0.15f);  // parallel but farther than the tolerance
+  // A wall standing on the grid: covered corners would need a parallel surface.
+  const auto base = static_cast<std::uint32_t>(m.mesh.positions.size());
+  for (const Vec3f p : {Vec3f{0.5f, 0.1f, 0.0f}, Vec3f{0.5f, 0.9f, 0.0f}, Vec3f{0.5f, 0.9f, 0.5f}, Vec3f{0.5f, 0.1f, 0.5f}}) {
+    m.mesh.positions.push_back(p);
+  }
+  for (const Triangle& t : {Triangle{base, base + 1, base + 2}, Triangle{base, base + 2, base + 3}}) {
+    m.mesh.triangles.push_back(t);
+    m.mesh.triangle_ids.push_back({});
+    m.source_acq.push_back(0);
+    m.source_triangle.push_back(0);
+  }
+  const MergedMesh before = m;
+  const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.1});
+  EXPECT_EQ(s.triangles_cut + s.triangles_removed + s.vertices_added, 0u);
+  EXPECT_EQ(m.mesh.triangles, before.mesh.triangles);
+}
+
+TEST(Stitch, ClippingClosesASeamRunningOverAnotherPiece) {
+  // Without clipping, the smaller piece's side lying over the larger one stays open; with it,
+  // the pieces meet along x = 1 and the zipper joins them: only the union's outline is left.
+  MergedMesh plain = overlapping_pieces(), clipped = overlapping_pieces();
+  const StitchStats p = stitch(plain, {.snap = 0.1, .reach = 0.2, .weld = 0.005});
+  const StitchStats c = stitch(clipped, {.snap = 0.1, .reach = 0.2, .weld = 0.005, .clip = 0.1});
+  EXPECT_EQ(p.triangles_clipped + p.triangles_uncovered, 0u);
+  EXPECT_GT(c.triangles_clipped, 0u);
+  EXPECT_GT(p.open_boundary_after, 5.9);      // 4 + 2 x (0.6 + 0.4)
+  EXPECT_LT(c.open_boundary_after, 4.9 + 0.05);  // 4 - 0.4 + 0.45 + 0.4 + 0.45
+  EXPECT_NEAR(c.open_boundary_before, p.open_boundary_before, 1e-9);
+  EXPECT_EQ(c.open_boundary_after, open_boundary_length(clipped.mesh));
+  EXPECT_EQ(non_manifold_edges(clipped.mesh), 0u);
+  EXPECT_EQ(repeated_directed_edges(clipped.mesh), 0u);
 }
 
 }  // namespace

@@ -38,6 +38,10 @@ struct MosaicParams {
   /// After the energy mosaic, kept triangles with nothing selected within the distance
   /// threshold are added back (newest acquisition first).
   bool fill_holes = true;
+  /// Before stitching, the parts of pieces lying over the surface of a source with more
+  /// triangles in the mosaic (within the distance threshold) are cut away, so that the seam
+  /// between them is a meeting of boundaries the stitching can close.
+  bool clip_overlaps = true;
 };
 
 std::string_view quality_measure_name(QualityMeasure q);

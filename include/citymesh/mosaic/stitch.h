@@ -14,19 +14,26 @@ struct StitchParams {
   double snap = 0.1;    ///< metres: boundaries of different sources closer than this share vertices
   double reach = 0.2;   ///< metres: boundaries of different sources closer than this are joined
   double weld = 0.005;  ///< metres: strip corners closer than this become one vertex
+  /// metres: where a piece lies within this of a later source's surface (normals within
+  /// 30 degrees), the covered part is cut away first so that the boundaries meet; 0: off
+  double clip = 0.0;
 };
 
 struct StitchStats {
   double open_boundary_before = 0, open_boundary_after = 0;  ///< metres of edges used by one triangle
   std::uint64_t vertices_snapped = 0;  ///< boundary vertices of two sources made one
   std::uint64_t edges_split = 0;       ///< boundary edges split at vertices of another source
+  std::uint64_t triangles_uncovered = 0;  ///< covered whole by a later source: removed
+  std::uint64_t triangles_clipped = 0;    ///< covered in part: cut back to the uncovered part
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
   /// Snaps and strip triangles refused (a flip, a degenerate triangle or a reused directed edge).
   std::uint64_t rejected = 0;
   double seconds = 0;
 };
 
-/// Closes the seams between pieces of different sources of `mesh`. Boundaries lying within
+/// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
+/// of pieces lying over a later source's surface are first cut away (Turk and Levoy's
+/// clipping), so that a piece's boundary no longer runs across another's interior. Boundaries lying within
 /// `snap` of each other are first made to share vertices (nearby boundary vertices merged at
 /// their midpoint, then boundary edges split at the other side's vertices: the split pieces
 /// keep their provenance); the boundaries still facing each other within `reach` are then

@@ -1,0 +1,245 @@
+// SPDX-License-Identifier: MIT
+#include "clip.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <unordered_map>
+
+#include "citymesh/core/geometry.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/mosaic/proximity.h"
+
+namespace citymesh::mosaic_detail {
+
+namespace {
+
+constexpr int kBisections = 12;  // 1/4096 of an edge: well under a millimetre for MLS edges
+
+Vec3d unit_or_zero(const Vec3d& v) {
+  const double n = norm(v);
+  return n > 0 ? v / n : Vec3d{};
+}
+
+/// Per vertex: its source (every vertex belongs to one, stitching not having started; -1
+/// when unused) and its normal (area-weighted over its triangles).
+struct VertexFrames {
+  std::vector<std::int32_t> source;
+  std::vector<Vec3f> normal;
+};
+
+VertexFrames vertex_frames(const MergedMesh& merged) {
+  const Mesh& m = merged.mesh;
+  VertexFrames f{std::vector<std::int32_t>(m.vertex_count(), kNoSource), std::vector<Vec3f>(m.vertex_count())};
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const TriangleCorners c = m.corners(t);
+    const Vec3f n(cross(c[1] - c[0], c[2] - c[0]));
+    for (const std::uint32_t v : m.triangles[t]) {
+      f.source[v] = merged.source_acq[t];
+      f.normal[v] += n;
+    }
+  }
+  for (Vec3f& n : f.normal) n = Vec3f(unit_or_zero(Vec3d(n)));
+  return f;
+}
+
+/// Which source yields where two overlap: the one with fewer triangles in the mosaic (the
+/// smaller pieces are cut back to the larger ones), on a tie the earlier acquisition.
+std::vector<std::uint64_t> source_precedence(const MergedMesh& merged) {
+  std::vector<std::uint64_t> count;
+  for (const std::int32_t s : merged.source_acq) {
+    if (s < 0) continue;
+    const auto k = static_cast<std::size_t>(s);
+    if (count.size() <= k) count.resize(k + 1, 0);
+    ++count[k];
+  }
+  std::vector<std::uint64_t> precedence(count.size());
+  for (std::size_t k = 0; k < count.size(); ++k) precedence[k] = count[k] * count.size() + k;
+  return precedence;
+}
+
+/// "Does the surface of a source of higher precedence lie over p?" for a point of source
+/// `source` with normal `n`.
+class Cover {
+ public:
+  Cover(const MergedMesh& merged, const ClipParams& params)
+      : merged_(merged), near_(merged.mesh, params.tolerance), params_(params),
+        min_cos_(std::cos(params.max_angle_deg * std::numbers::pi / 180.0)), precedence_(source_precedence(merged)) {
+    for (std::size_t t = 0; t < merged.mesh.triangle_count(); ++t) {
+      const TriangleCorners c = merged.mesh.corners(t);
+      normal_.push_back(Vec3f(unit_or_zero(cross(c[1] - c[0], c[2] - c[0]))));
+    }
+  }
+
+  [[nodiscard]] bool over(const Vec3d& p, std::int32_t source, const Vec3d& n) const {
+    if (source < 0) return false;
+    const std::uint64_t own = precedence_[static_cast<std::size_t>(source)];
+    return near_.any_over(p, params_.tolerance, [&](std::uint32_t u) {
+      const std::int32_t other = merged_.source_acq[u];
+      return other >= 0 && precedence_[static_cast<std::size_t>(other)] > own && dot(Vec3d(normal_[u]), n) >= min_cos_;
+    });
+  }
+
+ private:
+  const MergedMesh& merged_;
+  MeshProximity near_;
+  const ClipParams& params_;
+  double min_cos_;
+  std::vector<std::uint64_t> precedence_;
+  std::vector<Vec3f> normal_;  ///< per triangle, unit
+};
+
+std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  return (std::uint64_t{std::min(a, b)} << 32) | std::max(a, b);
+}
+
+/// Where the edge from covered vertex c to uncovered vertex u leaves the cover, as a fraction
+/// of the way from c, kept away from both ends so that no part degenerates.
+double cut_fraction(const Mesh& m, const Cover& cover, const VertexFrames& f, std::uint32_t c, std::uint32_t u,
+                    const ClipParams& params) {
+  const Vec3d pc(m.positions[c]), pu(m.positions[u]);
+  const Vec3d n = unit_or_zero(Vec3d(f.normal[c]) + Vec3d(f.normal[u]));
+  double lo = 0, hi = 1;
+  for (int i = 0; i < kBisections; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (cover.over(pc + (pu - pc) * mid, f.source[c], n) ? lo : hi) = mid;
+  }
+  return std::clamp(0.5 * (lo + hi), params.min_edge_fraction, 1.0 - params.min_edge_fraction);
+}
+
+/// Appends the point a fraction s of the way from vertex a to vertex b, with every per-vertex
+/// attribute interpolated.
+std::uint32_t append_between(Mesh& m, std::uint32_t a, std::uint32_t b, double s) {
+  const auto lerp = [s](double x, double y) { return x + (y - x) * s; };
+  const auto lerp3 = [&](const Vec3f& x, const Vec3f& y) { return Vec3f(Vec3d(x) + (Vec3d(y) - Vec3d(x)) * s); };
+  const auto v = static_cast<std::uint32_t>(m.positions.size());
+  m.positions.push_back(lerp3(m.positions[a], m.positions[b]));
+  if (!m.sensor_positions.empty()) m.sensor_positions.push_back(lerp3(m.sensor_positions[a], m.sensor_positions[b]));
+  if (!m.times.empty()) m.times.push_back(lerp(m.times[a], m.times[b]));
+  if (!m.intensities.empty()) m.intensities.push_back(static_cast<float>(lerp(m.intensities[a], m.intensities[b])));
+  if (!m.colors.empty()) {
+    const auto channel = [&](std::uint8_t x, std::uint8_t y) { return static_cast<std::uint8_t>(std::lround(lerp(x, y))); };
+    const Rgb8 ca = m.colors[a], cb = m.colors[b];
+    m.colors.push_back({channel(ca.r, cb.r), channel(ca.g, cb.g), channel(ca.b, cb.b)});
+  }
+  return v;
+}
+
+/// A cut: the edge from covered vertex c to uncovered vertex u leaves the cover at `fraction`.
+struct Cut {
+  std::uint32_t c, u;
+  double fraction;
+};
+
+/// One cut per edge with one covered end, in edge-key order.
+std::vector<Cut> find_cuts(const Mesh& m, const Cover& cover, const VertexFrames& f,
+                           const std::vector<std::uint8_t>& covered, const ClipParams& params) {
+  std::vector<std::uint64_t> keys;
+  for (const Triangle& tri : m.triangles) {
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      if (covered[a] != covered[b]) keys.push_back(edge_key(a, b));
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<Cut> cuts(keys.size());
+  parallel_for_blocks(keys.size(), 256, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      auto c = static_cast<std::uint32_t>(keys[i] >> 32), u = static_cast<std::uint32_t>(keys[i]);
+      if (covered[c] == 0) std::swap(c, u);
+      cuts[i] = {c, u, cut_fraction(m, cover, f, c, u, params)};
+    }
+  });
+  return cuts;
+}
+
+/// Appends the cuts' vertices; returns edge key -> new vertex.
+std::unordered_map<std::uint64_t, std::uint32_t> add_cut_vertices(Mesh& m, const std::vector<Cut>& cuts) {
+  std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;
+  for (const Cut& cut : cuts) vertex_of[edge_key(cut.c, cut.u)] = append_between(m, cut.c, cut.u, cut.fraction);
+  return vertex_of;
+}
+
+/// The uncovered part of a triangle, as a polygon in the triangle's winding: its uncovered
+/// corners and, on each edge with one covered end, the cut.
+std::vector<std::uint32_t> uncovered_part(const Triangle& tri, const std::vector<std::uint8_t>& covered,
+                                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut) {
+  std::vector<std::uint32_t> polygon;
+  for (std::size_t k = 0; k < 3; ++k) {
+    const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+    if (covered[a] == 0) polygon.push_back(a);
+    if (covered[a] != covered[b]) polygon.push_back(cut.at(edge_key(a, b)));
+  }
+  return polygon;
+}
+
+double distance_sq(const Mesh& m, std::uint32_t a, std::uint32_t b) {
+  const Vec3d d = Vec3d(m.positions[a]) - Vec3d(m.positions[b]);
+  return dot(d, d);
+}
+
+/// Triangles of a convex polygon of 3 or 4 vertices (the shorter diagonal for 4).
+std::vector<Triangle> triangulate(const Mesh& m, const std::vector<std::uint32_t>& p) {
+  if (p.size() == 3) return {{p[0], p[1], p[2]}};
+  if (distance_sq(m, p[0], p[2]) <= distance_sq(m, p[1], p[3])) return {{p[0], p[1], p[2]}, {p[0], p[2], p[3]}};
+  return {{p[0], p[1], p[3]}, {p[1], p[2], p[3]}};
+}
+
+/// Replaces each triangle in place by its uncovered part (nothing when covered whole).
+ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& covered,
+                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut) {
+  const Mesh& m = merged.mesh;
+  ClipStats stats;
+  MergedMesh out;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const Triangle& tri = m.triangles[t];
+    const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
+    std::vector<Triangle> parts{tri};
+    if (corners_covered == 3) {
+      parts.clear();
+      ++stats.triangles_removed;
+    } else if (corners_covered > 0) {
+      parts = triangulate(m, uncovered_part(tri, covered, cut));
+      ++stats.triangles_cut;
+    }
+    for (const Triangle& part : parts) {
+      out.mesh.triangles.push_back(part);
+      out.mesh.triangle_ids.push_back(m.triangle_ids[t]);
+      out.source_acq.push_back(merged.source_acq[t]);
+      out.source_triangle.push_back(merged.source_triangle[t]);
+    }
+  }
+  merged.mesh.triangles = std::move(out.mesh.triangles);
+  merged.mesh.triangle_ids = std::move(out.mesh.triangle_ids);
+  merged.source_acq = std::move(out.source_acq);
+  merged.source_triangle = std::move(out.source_triangle);
+  return stats;
+}
+
+}  // namespace
+
+ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params) {
+  Mesh& m = merged.mesh;
+  std::vector<std::uint8_t> covered(m.vertex_count(), 0);
+  std::vector<Cut> cuts;
+  {
+    const VertexFrames frames = vertex_frames(merged);
+    const Cover cover(merged, params);
+    parallel_for_blocks(m.vertex_count(), 4096, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t v = begin; v < end; ++v) {
+        covered[v] = cover.over(Vec3d(m.positions[v]), frames.source[v], Vec3d(frames.normal[v])) ? 1 : 0;
+      }
+    });
+    if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {};
+    cuts = find_cuts(m, cover, frames, covered, params);
+  }  // the index and the normals go before the triangles are rebuilt (a city's peak memory)
+  const std::size_t before = m.vertex_count();
+  const auto vertex_of = add_cut_vertices(m, cuts);
+  covered.resize(m.vertex_count(), 0);  // the cuts are where the cover ends: uncovered
+  ClipStats stats = replace_covered(merged, covered, vertex_of);
+  stats.vertices_added = m.vertex_count() - before;
+  return stats;
+}
+
+}  // namespace citymesh::mosaic_detail

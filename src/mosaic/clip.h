@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+// Clipping (internal to stitching, Turk and Levoy's step before zippering): where a piece of
+// one source lies over the surface of another, the covered part of the other is cut away,
+// so that the two boundaries meet instead of one lying across the other's interior.
+#pragma once
+
+#include <cstdint>
+
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh::mosaic_detail {
+
+struct ClipParams {
+  double tolerance = 0.1;           ///< metres: how far apart two surfaces may be and still be one
+  double max_angle_deg = 30.0;      ///< largest angle between their normals
+  double min_edge_fraction = 0.1;   ///< a cut stays this fraction of an edge away from its ends
+};
+
+struct ClipStats {
+  std::uint64_t triangles_removed = 0;  ///< covered whole
+  std::uint64_t triangles_cut = 0;      ///< covered in part: replaced by their uncovered part
+  std::uint64_t vertices_added = 0;     ///< where cuts cross edges
+};
+
+/// A vertex of source s is covered when it lies within `tolerance` of a triangle of a source
+/// of higher precedence whose normal is within `max_angle_deg` of the vertex's, and projects
+/// inside it. Precedence: more triangles in the mosaic (the small pieces yield to the large
+/// ones), on a tie the later acquisition. Triangles with every corner covered are removed; triangles with one or two are
+/// replaced by their uncovered part, cut where each edge leaves the cover (found by bisection
+/// along the edge, so that the two triangles sharing an edge cut it at the same new vertex and
+/// the mesh stays conforming). The parts keep their triangle's provenance and orientation.
+/// New vertices interpolate every per-vertex attribute. Sources never share vertices here
+/// (stitching has not started). Deterministic: triangles keep their order, each replaced in
+/// place by its parts.
+ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params);
+
+}  // namespace citymesh::mosaic_detail
