@@ -192,22 +192,26 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
   const Mesh& m = merged.mesh;
   ClipStats stats;
   MergedMesh out;
+  out.mesh.triangles.reserve(m.triangle_count());
+  out.mesh.triangle_ids.reserve(m.triangle_count());
+  out.source_acq.reserve(m.triangle_count());
+  out.source_triangle.reserve(m.triangle_count());
+  const auto keep = [&](const Triangle& part, std::size_t t) {
+    out.mesh.triangles.push_back(part);
+    out.mesh.triangle_ids.push_back(m.triangle_ids[t]);
+    out.source_acq.push_back(merged.source_acq[t]);
+    out.source_triangle.push_back(merged.source_triangle[t]);
+  };
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const Triangle& tri = m.triangles[t];
     const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
-    std::vector<Triangle> parts{tri};
-    if (corners_covered == 3) {
-      parts.clear();
+    if (corners_covered == 0) {
+      keep(tri, t);  // nearly every triangle of a city: no polygon built
+    } else if (corners_covered == 3) {
       ++stats.triangles_removed;
-    } else if (corners_covered > 0) {
-      parts = triangulate(m, uncovered_part(tri, covered, cut));
+    } else {
+      for (const Triangle& part : triangulate(m, uncovered_part(tri, covered, cut))) keep(part, t);
       ++stats.triangles_cut;
-    }
-    for (const Triangle& part : parts) {
-      out.mesh.triangles.push_back(part);
-      out.mesh.triangle_ids.push_back(m.triangle_ids[t]);
-      out.source_acq.push_back(merged.source_acq[t]);
-      out.source_triangle.push_back(merged.source_triangle[t]);
     }
   }
   merged.mesh.triangles = std::move(out.mesh.triangles);

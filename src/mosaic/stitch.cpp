@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -240,10 +241,16 @@ double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
-  const double before = length_of(merged.mesh, mosaic_detail::MeshTopology(merged).boundary_edges());
-  const mosaic_detail::ClipStats clipped =
-      params.clip > 0 ? mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip}) : mosaic_detail::ClipStats{};
-  mosaic_detail::MeshTopology topo(merged);
+  // The unstitched boundary is measured before clipping changes it; the topology is built
+  // again only when clipping changed the triangles.
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged);
+  const double before = length_of(merged.mesh, unclipped->boundary_edges());
+  mosaic_detail::ClipStats clipped;
+  if (params.clip > 0) {
+    unclipped.reset();
+    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip});
+  }
+  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
