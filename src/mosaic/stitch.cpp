@@ -11,6 +11,7 @@
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
 #include "clip.h"
+#include "gap_fill.h"
 #include "snap.h"
 
 namespace citymesh {
@@ -229,6 +230,8 @@ void weld(StitchContext& c) {
 
 namespace {
 
+constexpr double kGapPerimeterInWidths = 20.0;  // 2 m around at 10 cm: a crack, not a window
+
 double length_of(const Mesh& m, std::span<const EdgeUse> edges) {
   double total = 0;
   for (const EdgeUse& e : edges) total += norm(position(m, e.lo) - position(m, e.hi));
@@ -268,6 +271,12 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   }
   for (const std::uint32_t v : c.boundary.vertices) {
     if (!visited.contains(v)) stitch_loop(c, v, visited);
+  }
+  if (params.gap > 0) {
+    const mosaic_detail::GapFillStats gaps =
+        mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = kGapPerimeterInWidths * params.gap});
+    c.stats.gaps_filled = gaps.gaps_filled;
+    c.stats.triangles_added += gaps.triangles_added;
   }
   weld(c);
   // From fresh incidence lists (the weld merged vertices and dropped collapsed triangles, so

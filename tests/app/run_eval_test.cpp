@@ -80,6 +80,7 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   const nlohmann::json s = read_json(dir / "sim/out/mosaic/summary.json");
   EXPECT_LT(s["stitch"]["open_boundary_after_m"].get<double>(), s["stitch"]["open_boundary_before_m"].get<double>());
   EXPECT_GT(s["stitch"]["triangles_clipped"].get<std::uint64_t>(), 0u);  // pieces cut back where they overlapped
+  EXPECT_GT(s["stitch"]["gaps_filled"].get<std::uint64_t>(), 0u);        // small holes between sources closed
   const auto [non_manifold, sources] = inspect(dir / "sim/out/mosaic/mosaic.ply");
   EXPECT_EQ(non_manifold, 0u);
   EXPECT_GT(sources.count(-1), 0u);  // stitch triangles

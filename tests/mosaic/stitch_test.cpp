@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <random>
 
 #include "citymesh/core/geometry.h"
 #include "clip.h"
+#include "gap_fill.h"
 
 namespace citymesh {
 namespace {
@@ -188,7 +190,7 @@ TEST(Clip, LeavesCrossingAndDistantSurfacesAlone) {
   MergedMesh m;
   add_grid(m, 0, 0, 10, 10, 0.1f, 1);
   add_grid(m, 0.3f, 0.3f, 3, 3, 0.1f, 0, 0.15f);  // parallel but farther than the tolerance
-  // A wall standing on the grid: covered corners would need a parallel surface.
+  // A wall standing on the grid (90 degrees): it meets the grid; it does not lie over it.
   const auto base = static_cast<std::uint32_t>(m.mesh.positions.size());
   for (const Vec3f p : {Vec3f{0.5f, 0.1f, 0.0f}, Vec3f{0.5f, 0.9f, 0.0f}, Vec3f{0.5f, 0.9f, 0.5f}, Vec3f{0.5f, 0.1f, 0.5f}}) {
     m.mesh.positions.push_back(p);
@@ -205,6 +207,41 @@ TEST(Clip, LeavesCrossingAndDistantSurfacesAlone) {
   EXPECT_EQ(m.mesh.triangles, before.mesh.triangles);
 }
 
+/// A 1 m x 1 m grid of source 1 and a 0.4 m x 0.4 m grid of source 0 rising from it at 45
+/// degrees, from 2 cm above it: another mesh's chamfer over the same corner of a facade.
+MergedMesh slanted_piece() {
+  MergedMesh m;
+  add_grid(m, 0, 0, 10, 10, 0.1f, 1);
+  const std::size_t first = m.mesh.positions.size();
+  add_grid(m, 0.3f, 0.3f, 4, 4, 0.1f, 0);
+  const float slope = std::sqrt(0.5f);
+  for (std::size_t v = first; v < m.mesh.positions.size(); ++v) {
+    Vec3f& p = m.mesh.positions[v];
+    const float along = p.x - 0.3f;
+    p = {0.3f + along * slope, p.y, 0.02f + along * slope};
+  }
+  return m;
+}
+
+TEST(Clip, CutsASlantedPieceBackToTheToleranceAndLeavesSteeperOnesAlone) {
+  MergedMesh steep = slanted_piece();
+  const mosaic_detail::ClipStats none = mosaic_detail::clip_overlaps(steep, {.tolerance = 0.1, .max_angle_deg = 30});
+  EXPECT_EQ(none.triangles_cut + none.triangles_removed, 0u);  // 45 degrees is beyond 30
+  MergedMesh m = slanted_piece();
+  const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.1});
+  EXPECT_EQ(s.triangles_removed, 8u);  // the first row of cells: both ends within 10 cm
+  EXPECT_GT(s.triangles_cut, 0u);
+  // Ground truth: the part of the slope higher than the tolerance, from s = 0.08 / sin 45.
+  const double cut_at = 0.08 / std::sqrt(0.5);
+  EXPECT_NEAR(area_of(m, 0), (0.4 - cut_at) * 0.4, 2e-4);
+  EXPECT_NEAR(area_of(m, 1), 1.0, 1e-6);
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_acq[t] != 0) continue;
+    for (const std::uint32_t v : m.mesh.triangles[t]) EXPECT_GE(m.mesh.positions[v].z, 0.1f - 1e-3f);
+  }
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+}
+
 TEST(Stitch, ClippingClosesASeamRunningOverAnotherPiece) {
   // Without clipping, the smaller piece's side lying over the larger one stays open; with it,
   // the pieces meet along x = 1 and the zipper joins them: only the union's outline is left.
@@ -219,6 +256,90 @@ TEST(Stitch, ClippingClosesASeamRunningOverAnotherPiece) {
   EXPECT_EQ(c.open_boundary_after, open_boundary_length(clipped.mesh));
   EXPECT_EQ(non_manifold_edges(clipped.mesh), 0u);
   EXPECT_EQ(repeated_directed_edges(clipped.mesh), 0u);
+}
+
+/// One welded 1 m x 1 m grid (0.1 m cells, normals +z): the rows below y = 0.5 from source
+/// 0, above from source 1; the cells in `holes` (i, j) left out.
+MergedMesh two_source_grid(const std::vector<std::pair<int, int>>& holes) {
+  MergedMesh m;
+  constexpr int n = 10;
+  for (int j = 0; j <= n; ++j) {
+    for (int i = 0; i <= n; ++i) m.mesh.positions.push_back({0.1f * float(i), 0.1f * float(j), 0});
+  }
+  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (n + 1) + i); };
+  for (int j = 0; j < n; ++j) {
+    for (int i = 0; i < n; ++i) {
+      if (std::find(holes.begin(), holes.end(), std::pair{i, j}) != holes.end()) continue;
+      for (const Triangle& t : {Triangle{id(i, j), id(i + 1, j), id(i + 1, j + 1)}, Triangle{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
+        m.mesh.triangles.push_back(t);
+        m.mesh.triangle_ids.push_back({});
+        m.source_acq.push_back(j < n / 2 ? 0 : 1);
+        m.source_triangle.push_back(static_cast<std::int32_t>(m.source_triangle.size()));
+      }
+    }
+  }
+  return m;
+}
+
+mosaic_detail::GapFillStats fill_gaps(MergedMesh& m) {
+  mosaic_detail::MeshTopology topo(m);
+  return mosaic_detail::fill_seam_gaps(topo, {.max_width = 0.1, .max_perimeter = 2.0});
+}
+
+TEST(GapFill, ClosesASmallHoleBetweenTwoSources) {
+  // The cell under the seam is missing: three of its sides are source 0's, one source 1's.
+  MergedMesh m = two_source_grid({{4, 4}});
+  const std::size_t before = m.mesh.triangle_count();
+  const mosaic_detail::GapFillStats s = fill_gaps(m);
+  EXPECT_EQ(s.gaps_filled, 1u);
+  EXPECT_EQ(s.triangles_added, 2u);
+  ASSERT_EQ(m.mesh.triangle_count(), before + 2);
+  EXPECT_NEAR(open_boundary_length(m.mesh), 4.0, 1e-6);  // only the outline is left
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  double added_area = 0;
+  for (std::size_t t = before; t < m.mesh.triangle_count(); ++t) {
+    EXPECT_EQ(m.source_acq[t], kNoSource);
+    EXPECT_EQ(m.source_triangle[t], kNoSource);
+    const TriangleCorners c = m.mesh.corners(t);
+    const Vec3d n = cross(c[1] - c[0], c[2] - c[0]);
+    EXPECT_GT(n.z, 0) << "a fill triangle faces away from its neighbours";
+    added_area += 0.5 * norm(n);
+  }
+  EXPECT_NEAR(added_area, 0.01, 1e-6);
+}
+
+TEST(GapFill, LeavesHolesOfOneSourceAndWideHolesOpen) {
+  MergedMesh one_source = two_source_grid({{4, 2}});  // inside source 0: a hole of that scan
+  EXPECT_EQ(fill_gaps(one_source).gaps_filled, 0u);
+  // Across the seam, 0.3 m x 0.2 m: 12 cm wide (twice the area over the perimeter).
+  MergedMesh wide = two_source_grid({{3, 4}, {4, 4}, {5, 4}, {3, 5}, {4, 5}, {5, 5}});
+  const std::size_t before = wide.mesh.triangle_count();
+  EXPECT_EQ(fill_gaps(wide).gaps_filled, 0u);
+  EXPECT_EQ(wide.mesh.triangle_count(), before);
+  MergedMesh narrow = two_source_grid({{3, 4}, {4, 4}, {5, 4}, {6, 4}});  // 0.4 m x 0.1 m: 8 cm
+  const mosaic_detail::GapFillStats s = fill_gaps(narrow);
+  EXPECT_EQ(s.gaps_filled, 1u);
+  EXPECT_EQ(s.triangles_added, 8u);  // a polygon of 10 vertices (4 + 1 + 4 + 1), 8 triangles
+  EXPECT_NEAR(open_boundary_length(narrow.mesh), 4.0, 1e-6);
+  EXPECT_EQ(repeated_directed_edges(narrow.mesh), 0u);
+}
+
+TEST(GapFill, ClosesANonConvexGapWithoutFoldingIt) {
+  // An L-shaped gap: ear clipping must not take the reflex corner's diagonal, which would
+  // cover the cell that is still there.
+  MergedMesh m = two_source_grid({{4, 4}, {5, 4}, {5, 5}});
+  const std::size_t before = m.mesh.triangle_count();
+  const mosaic_detail::GapFillStats s = fill_gaps(m);
+  ASSERT_EQ(s.gaps_filled, 1u);
+  double added_area = 0;
+  for (std::size_t t = before; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    added_area += 0.5 * norm(cross(c[1] - c[0], c[2] - c[0]));
+  }
+  EXPECT_NEAR(added_area, 0.03, 1e-6);  // exactly the three cells: nothing folded over
+  EXPECT_NEAR(open_boundary_length(m.mesh), 4.0, 1e-6);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
 }
 
 }  // namespace

@@ -42,6 +42,9 @@ struct MosaicParams {
   /// triangles in the mosaic (within the distance threshold) are cut away, so that the seam
   /// between them is a meeting of boundaries the stitching can close.
   bool clip_overlaps = true;
+  /// After stitching, the small holes still enclosed by boundaries of more than one source
+  /// (at most the distance threshold wide, twenty times it around) are triangulated.
+  bool close_gaps = true;
 };
 
 std::string_view quality_measure_name(QualityMeasure q);

@@ -14,9 +14,12 @@ struct StitchParams {
   double snap = 0.1;    ///< metres: boundaries of different sources closer than this share vertices
   double reach = 0.2;   ///< metres: boundaries of different sources closer than this are joined
   double weld = 0.005;  ///< metres: strip corners closer than this become one vertex
-  /// metres: where a piece lies within this of a later source's surface (normals within
-  /// 30 degrees), the covered part is cut away first so that the boundaries meet; 0: off
+  /// metres: where a piece lies within this of a larger source's surface (normals within
+  /// 60 degrees), the covered part is cut away first so that the boundaries meet; 0: off
   double clip = 0.0;
+  /// metres: small holes left between pieces of several sources, up to this wide (and 20
+  /// times this around), are triangulated last; 0: off
+  double gap = 0.0;
 };
 
 struct StitchStats {
@@ -26,6 +29,7 @@ struct StitchStats {
   std::uint64_t triangles_uncovered = 0;  ///< covered whole by a later source: removed
   std::uint64_t triangles_clipped = 0;    ///< covered in part: cut back to the uncovered part
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
+  std::uint64_t gaps_filled = 0;  ///< small holes between sources closed (their triangles count in triangles_added)
   /// Snaps and strip triangles refused (a flip, a degenerate triangle or a reused directed edge).
   std::uint64_t rejected = 0;
   double seconds = 0;
@@ -38,7 +42,8 @@ struct StitchStats {
 /// their midpoint, then boundary edges split at the other side's vertices: the split pieces
 /// keep their provenance); the boundaries still facing each other within `reach` are then
 /// joined with strips of new triangles (source kNoSource), advancing along both boundaries
-/// and taking the shorter diagonal at each step. No operation may flip or degenerate a
+/// and taking the shorter diagonal at each step. With `gap` > 0, the small holes still
+/// enclosed by boundaries of several sources are then triangulated. No operation may flip or degenerate a
 /// triangle or use a directed edge twice. Deterministic.
 StitchStats stitch(MergedMesh& mesh, const StitchParams& params);
 

@@ -1,0 +1,37 @@
+// SPDX-License-Identifier: MIT
+// Closing the small gaps left between pieces (internal to stitching, after snapping and
+// zippering): where three pieces meet, or a boundary bends away from its neighbour's, the
+// snapped boundaries enclose a small hole that no strip spans. Such a hole is bounded by
+// more than one source; a hole bounded by one source alone is a hole of that scan (a window,
+// a shadow) and stays open.
+#pragma once
+
+#include <cstdint>
+
+#include "mesh_topology.h"
+
+namespace citymesh::mosaic_detail {
+
+struct GapFillParams {
+  double max_width = 0.1;       ///< metres: twice the area over the perimeter (a strip's width)
+  double max_perimeter = 2.0;   ///< metres
+  std::size_t max_vertices = 32;
+};
+
+struct GapFillStats {
+  std::uint64_t gaps_filled = 0;
+  std::uint64_t triangles_added = 0;
+  std::uint64_t gaps_refused = 0;  ///< small mixed-source loops no triangulation could close
+};
+
+/// Fills every boundary loop of `topo`'s mesh that runs along the edges of at least two
+/// sources (stitch triangles count as one) and is small: at most `max_vertices` vertices,
+/// `max_perimeter` long and `max_width` wide. A loop is triangulated by ear clipping in the
+/// plane of its mean normal, shortest diagonal first; it is left open when a loop vertex is
+/// pinched (starts two boundary edges), when no ear is left, or when a new triangle would
+/// turn against the triangle across one of its loop edges, degenerate, or reuse a directed
+/// edge. New triangles have source kNoSource. Deterministic: loops are taken from their
+/// smallest vertex, in increasing order.
+GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params);
+
+}  // namespace citymesh::mosaic_detail
