@@ -17,14 +17,9 @@ struct Outgoing {
 
 std::unordered_map<std::uint32_t, Outgoing> boundary_successors(const MeshTopology& topo) {
   std::unordered_map<std::uint32_t, Outgoing> next;
-  for (const EdgeUse& e : topo.boundary_edges()) {
-    const Triangle& tri = topo.triangle(e.triangle);
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t u = tri[k], v = tri[(k + 1) % 3];
-      if (std::min(u, v) != e.lo || std::max(u, v) != e.hi) continue;
-      Outgoing& o = next[u];
-      if (++o.count == 1) o = {v, e.triangle, 1};
-    }
+  for (const DirectedEdge& e : topo.boundary_half_edges()) {
+    Outgoing& o = next[e.from];
+    if (++o.count == 1) o = {e.to, e.triangle, 1};
   }
   return next;
 }

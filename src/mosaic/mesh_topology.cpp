@@ -109,4 +109,22 @@ std::vector<EdgeUse> MeshTopology::boundary_edges() const {
   return out;
 }
 
+std::vector<DirectedEdge> MeshTopology::boundary_half_edges() const {
+  const std::vector<Triangle>& triangles = merged_.mesh.triangles;
+  constexpr std::size_t kGrain = 1 << 16;
+  std::vector<std::vector<DirectedEdge>> per_block((triangles.size() + kGrain - 1) / kGrain);
+  parallel_for_blocks(triangles.size(), kGrain, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      const Triangle& tri = triangles[t];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
+        if (!has(to, from)) per_block[begin / kGrain].push_back({from, to, static_cast<std::uint32_t>(t)});
+      }
+    }
+  });
+  std::vector<DirectedEdge> out;
+  for (const auto& block : per_block) out.insert(out.end(), block.begin(), block.end());
+  return out;
+}
+
 }  // namespace citymesh::mosaic_detail

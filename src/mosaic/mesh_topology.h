@@ -16,6 +16,11 @@
 
 namespace citymesh::mosaic_detail {
 
+/// A directed edge from -> to, as `triangle` runs it.
+struct DirectedEdge {
+  std::uint32_t from, to, triangle;
+};
+
 class MeshTopology {
  public:
   explicit MeshTopology(MergedMesh& merged);
@@ -43,6 +48,9 @@ class MeshTopology {
   /// The edges used by exactly one triangle, sorted as boundary_edges() sorts them (which
   /// gives the same list, from the lists around each vertex instead of a sort of every edge).
   [[nodiscard]] std::vector<EdgeUse> boundary_edges() const;
+  /// The directed edges whose reverse no triangle uses, oriented as their triangle runs
+  /// them, in triangle order: the boundary that snapping walks and gap closing follows.
+  [[nodiscard]] std::vector<DirectedEdge> boundary_half_edges() const;
 
  private:
   MergedMesh& merged_;

@@ -5,7 +5,6 @@
 #include <optional>
 #include <span>
 
-#include "citymesh/core/parallel.h"
 #include "citymesh/spatial/box_tree.h"
 #include "citymesh/spatial/kd_tree.h"
 
@@ -24,29 +23,6 @@ Vec3d normal_of(const Vec3d& a, const Vec3d& b, const Vec3d& c) { return cross(b
 /// twentieth of its area: no flip, no sliver made from a sound triangle.
 bool acceptable(const Vec3d& before, const Vec3d& after) {
   return dot(before, after) > 0 && norm(after) >= 0.05 * norm(before);
-}
-
-struct DirectedEdge {
-  std::uint32_t from, to, triangle;
-};
-
-/// The directed edges whose reverse no triangle uses, in triangle order.
-std::vector<DirectedEdge> boundary_half_edges(const MeshTopology& topo) {
-  const std::vector<Triangle>& triangles = topo.merged().mesh.triangles;
-  constexpr std::size_t kGrain = 1 << 16;
-  std::vector<std::vector<DirectedEdge>> per_block((triangles.size() + kGrain - 1) / kGrain);
-  parallel_for_blocks(triangles.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) {
-      const Triangle& tri = triangles[t];
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t from = tri[k], to = tri[(k + 1) % 3];
-        if (!topo.has(to, from)) per_block[begin / kGrain].push_back({from, to, static_cast<std::uint32_t>(t)});
-      }
-    }
-  });
-  std::vector<DirectedEdge> out;
-  for (const auto& block : per_block) out.insert(out.end(), block.begin(), block.end());
-  return out;
 }
 
 /// Every vertex that starts or ends one of the boundary edges, in increasing order.
@@ -94,7 +70,7 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
 
 /// Stage 1: boundary vertices of different sources within the tolerance become one.
 void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
-  const std::vector<std::uint32_t> vertices = vertices_of(boundary_half_edges(topo));
+  const std::vector<std::uint32_t> vertices = vertices_of(topo.boundary_half_edges());
   std::vector<Vec3f> points;
   for (const std::uint32_t v : vertices) points.push_back(topo.merged().mesh.positions[v]);
   const PointKdTree tree(points);
@@ -222,7 +198,7 @@ bool try_split(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const s
 
 /// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
 void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
-  const std::vector<DirectedEdge> edges = boundary_half_edges(topo);
+  const std::vector<DirectedEdge> edges = topo.boundary_half_edges();
   const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
   for (std::size_t i = 0; i < insertions.size();) {
     std::size_t j = i;

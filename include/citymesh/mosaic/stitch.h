@@ -26,7 +26,7 @@ struct StitchStats {
   double open_boundary_before = 0, open_boundary_after = 0;  ///< metres of edges used by one triangle
   std::uint64_t vertices_snapped = 0;  ///< boundary vertices of two sources made one
   std::uint64_t edges_split = 0;       ///< boundary edges split at vertices of another source
-  std::uint64_t triangles_uncovered = 0;  ///< covered whole by a later source: removed
+  std::uint64_t triangles_uncovered = 0;  ///< covered whole by a larger source: removed
   std::uint64_t triangles_clipped = 0;    ///< covered in part: cut back to the uncovered part
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
   std::uint64_t gaps_filled = 0;  ///< small holes between sources closed (their triangles count in triangles_added)
@@ -36,7 +36,7 @@ struct StitchStats {
 };
 
 /// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
-/// of pieces lying over a later source's surface are first cut away (Turk and Levoy's
+/// of pieces lying over a larger source's surface are first cut away (Turk and Levoy's
 /// clipping), so that a piece's boundary no longer runs across another's interior. Boundaries lying within
 /// `snap` of each other are first made to share vertices (nearby boundary vertices merged at
 /// their midpoint, then boundary edges split at the other side's vertices: the split pieces
