@@ -47,6 +47,9 @@ std::map<std::string, std::string> result_keys(const Config& config) {
   }
   for (std::size_t k = 0; k < config.acquisitions.size(); ++k) {
     const auto& path = config.acquisitions[k].path;
+    // The file, not the spelling: the same config given as out/config.toml or as
+    // /data/out/config.toml (another working directory) resumes the same work.
+    keys[fmt::format("acquisition[{}].path", k)] = std::filesystem::absolute(path).lexically_normal().generic_string();
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     const auto time = std::filesystem::last_write_time(path, ec).time_since_epoch().count();

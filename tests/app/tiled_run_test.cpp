@@ -90,6 +90,12 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   EXPECT_EQ(changed.exit_code, 1);
   EXPECT_NE(changed.err.find("change.distance_threshold (0.1 -> 0.2)"), std::string::npos) << changed.err;
   EXPECT_NE(changed.err.find("--force"), std::string::npos) << changed.err;
+  // The same config named from another working directory (a relative path) resumes: every
+  // tile is reused.
+  const std::string relative = fmt::format("cd '{}' && {} {} >/dev/null 2>&1", dir.path().string(), CITYMESH_BINARY,
+                                           run_args("sim", "c", "--set tiling.tile_size=10"));
+  EXPECT_EQ(std::system(relative.c_str()), 0);
+  EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], read_json(dir / "sim/c/run.json")["tiles"]);
   // Settings that do not change results (threads, memory, pictures) resume freely.
   EXPECT_EQ(test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --threads 1 --memory 512MiB")).exit_code, 0);
 
