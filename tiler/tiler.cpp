@@ -63,6 +63,7 @@ class AcquisitionTiler {
       throw InputError(fmt::format("{}: {} vertices; the tile store numbers them in 32 bits (split the file)",
                                    file.string(), reader.vertex_count()));
     }
+    reserve_vertices(file, reader.vertex_count());
     PlyVertexChunk vertices;
     PlyFaceChunk faces;
     for (;;) {
@@ -93,6 +94,18 @@ class AcquisitionTiler {
   }
 
  private:
+  /// Room for the header's vertex count at once: growing by doubling touched (and zeroed)
+  /// twice the pages and copied every vertex several times. Never more than the file can
+  /// hold (6 bytes per vertex in ASCII), so that a lying header allocates nothing huge.
+  void reserve_vertices(const std::filesystem::path& file, std::uint64_t declared) {
+    std::error_code ec;
+    const std::uint64_t size = std::filesystem::file_size(file, ec);
+    const auto n = static_cast<std::size_t>(std::min(declared, ec ? 0 : size / 6));
+    vertices_.positions.reserve(n);
+    vertices_.sensors.reserve(n);
+    slots_.reserve(n);
+  }
+
   void add_triangle(const Triangle& tri, const TriangleId& id) {
     const std::uint32_t index = next_index_++;
     const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
