@@ -63,7 +63,7 @@ class AcquisitionTiler {
       throw InputError(fmt::format("{}: {} vertices; the tile store numbers them in 32 bits (split the file)",
                                    file.string(), reader.vertex_count()));
     }
-    reserve_vertices(file, reader.vertex_count());
+    reserve_vertices(reader.vertex_count());
     PlyVertexChunk vertices;
     PlyFaceChunk faces;
     for (;;) {
@@ -95,12 +95,10 @@ class AcquisitionTiler {
 
  private:
   /// Room for the header's vertex count at once: growing by doubling touched (and zeroed)
-  /// twice the pages and copied every vertex several times. Never more than the file can
-  /// hold (6 bytes per vertex in ASCII), so that a lying header allocates nothing huge.
-  void reserve_vertices(const std::filesystem::path& file, std::uint64_t declared) {
-    std::error_code ec;
-    const std::uint64_t size = std::filesystem::file_size(file, ec);
-    const auto n = static_cast<std::size_t>(std::min(declared, ec ? 0 : size / 6));
+  /// twice the pages and copied every vertex several times. The reader has already checked
+  /// the header's counts against the file's size, so a lying header cannot ask for much.
+  void reserve_vertices(std::uint64_t declared) {
+    const auto n = static_cast<std::size_t>(declared);
     vertices_.positions.reserve(n);
     vertices_.sensors.reserve(n);
     slots_.reserve(n);

@@ -95,7 +95,8 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   const std::string relative = fmt::format("cd '{}' && {} {} >/dev/null 2>&1", dir.path().string(), CITYMESH_BINARY,
                                            run_args("sim", "c", "--set tiling.tile_size=10"));
   EXPECT_EQ(std::system(relative.c_str()), 0);
-  EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], read_json(dir / "sim/c/run.json")["tiles"]);
+  const nlohmann::json resumed = read_json(dir / "sim/c/run.json");
+  EXPECT_EQ(resumed["reused_tiles"], resumed["tiles"]);
   // Settings that do not change results (threads, memory, pictures) resume freely.
   EXPECT_EQ(test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --threads 1 --memory 512MiB")).exit_code, 0);
 
