@@ -84,6 +84,8 @@ class AcquisitionTiler {
                                          file.string(), faces.faces[t], v));
           }
         }
+        check_face_extent(file, faces.faces[t], vertices_.positions[tri[0]], vertices_.positions[tri[1]],
+                          vertices_.positions[tri[2]]);
         add_triangle(tri, {acquisition_, faces.fans[t], faces.faces[t]});
         if (buffered_ > buffer_bytes_) flush();
       }

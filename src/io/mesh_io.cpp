@@ -66,6 +66,10 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
     }
   }
   result.stats = reader.stats();
+  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const std::array<Vec3d, 3> c = mesh.corners(t);
+    check_face_extent(path, mesh.triangle_ids[t].face, c[0], c[1], c[2]);
+  }
   result.zero_area_dropped = drop_zero_area(mesh, params.min_doubled_area);
   if (result.zero_area_dropped > 0) {
     log::info("{}: dropped {} zero-area triangles", path.string(), result.zero_area_dropped);

@@ -203,6 +203,11 @@ struct PlyReader::Impl {
       if (!is_finite(s)) {
         fail_row("vertex", index, fmt::format("sensor position is not finite ({}, {}, {})", s.x, s.y, s.z));
       }
+      if (const double range = norm(p - s); range > kMaxReach) {
+        fail_row("vertex", index,
+                 fmt::format("lies {:.0f} m from its sensor position (more than {:.0f} m: corrupt coordinates?)", range,
+                             kMaxReach));
+      }
       out.sensor_positions.push_back(s + header.offset);
     }
     if (layout.has_time) {
@@ -489,6 +494,17 @@ PlyReader::ChunkKind PlyReader::next(PlyVertexChunk& vertices, PlyFaceChunk& fac
     m.stats.bytes = std::filesystem::file_size(m.path);
   }
   return ChunkKind::end;
+}
+
+void check_face_extent(const std::filesystem::path& file, std::uint64_t face, const Vec3d& a, const Vec3d& b,
+                       const Vec3d& c) {
+  // Squared lengths: the tiler checks every face of a city.
+  const auto length_sq = [](const Vec3d& d) { return dot(d, d); };
+  const double longest_sq = std::max({length_sq(b - a), length_sq(c - b), length_sq(a - c)});
+  if (!(longest_sq <= kMaxReach * kMaxReach)) {
+    throw InputError(fmt::format("{}: face {}: an edge of {:.0f} m (longer than {:.0f} m: corrupt coordinates?)",
+                                 file.string(), face, std::sqrt(longest_sq), kMaxReach));
+  }
 }
 
 }  // namespace citymesh

@@ -3,12 +3,14 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <random>
 #include <set>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/tiler/tiler.h"
 #include "test_support.h"
@@ -201,6 +203,35 @@ TEST(Tiler, DamagedChunksAreInputErrorsNamingTheFile) {
   expect_error("a truncated file");
   std::filesystem::resize_file(file, 20);
   expect_error("a truncated header");
+}
+
+/// Moves vertex 3 (used by face 1 only) and its sensor position `dx` metres along x.
+void stretch_face_one(Fixture& f, double dx) {
+  Mesh& m = f.meshes[1];
+  m.positions[3].x += static_cast<float>(dx);
+  m.sensor_positions[3].x += static_cast<float>(dx);
+  write_mesh_ply(f.acquisitions[1].path, m);
+}
+
+TEST(Tiler, AFaceLongerThanTheMaximumReachIsAnInputErrorNamingFileAndFace) {
+  // Without this check one corrupt vertex had the change step fill voxels between Paris and
+  // its copy 1000 km away: a run that never ended.
+  Fixture f;
+  stretch_face_one(f, 0.9 * kMaxReach);  // long, but not beyond belief: tiled as usual
+  EXPECT_NO_THROW((void)tile_acquisitions(f.acquisitions, f.params));
+  EXPECT_NO_THROW((void)read_mesh(f.acquisitions[1].path));
+  stretch_face_one(f, 0.2 * kMaxReach);
+  const auto expect_error = [&](const std::function<void()>& read) {
+    try {
+      read();
+      FAIL() << "no error";
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      EXPECT_NE(what.find(f.acquisitions[1].path.string() + ": face 1: an edge of"), std::string::npos) << what;
+    }
+  };
+  expect_error([&] { (void)tile_acquisitions(f.acquisitions, f.params); });
+  expect_error([&] { (void)read_mesh(f.acquisitions[1].path); });
 }
 
 /// Every file under `dir` by relative path, with its bytes.

@@ -55,6 +55,17 @@ struct PlyVertexChunk {
   void clear();
 };
 
+/// The farthest a point may lie from its sensor position, and the longest edge a face may
+/// have, in metres. No mobile-mapping lidar reaches this far, so beyond it the coordinates are
+/// corrupt; and a face or a line of sight that long would have the tiler and the empty-space
+/// grids visit every cell between its ends (a run that never ends).
+constexpr double kMaxReach = 1000.0;
+
+/// Throws InputError naming `file` and `face` when an edge of the triangle (a, b, c) is longer
+/// than kMaxReach (checked where the faces meet their vertices: the tiler and read_mesh).
+void check_face_extent(const std::filesystem::path& file, std::uint64_t face, const Vec3d& a, const Vec3d& b,
+                       const Vec3d& c);
+
 /// Triangles from consecutive faces; polygons are fan-triangulated, faces that repeat a vertex
 /// are dropped (and counted). Each triangle keeps its face index and fan number.
 struct PlyFaceChunk {

@@ -106,6 +106,8 @@ ply("inf_coordinate_big_endian.ply", inf_hdr.encode() + struct.pack(">6f", 0, 0,
     *INPUT, "vertex 1: position is not finite")
 ply("nan_sensor_origin.ply", ascii_header() + "0 0 0 0 0 2\n1 0 0 1 nan 2\n0 1 0 0 1 2\n", "info", *INPUT,
     "vertex 1: sensor position is not finite")
+ply("sensor_too_far.ply", ascii_header() + "0 0 0 0 0 2\n1 0 0 1 0 2002\n0 1 0 0 1 2\n", "info", *INPUT,
+    "vertex 1: lies 2002 m from its sensor position")
 ply("zero_length_list.ply", ascii_header(faces=2) + V3 + "3 0 1 2\n0\n", "info", *INPUT, "face 1: empty vertex list")
 ply("bad_ascii_value.ply", ascii_header() + "0 0 0 0 0 2\n1 abc 0 1 0 2\n0 1 0 0 1 2\n", "info", *INPUT,
     "'abc' is not a number")
