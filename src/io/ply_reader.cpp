@@ -19,6 +19,10 @@ using namespace ply_detail;
 
 namespace {
 
+/// Whether d is longer than kMaxReach (or not a number), by its squared length: the reader
+/// checks every vertex and the tiler every face of a city, so no square root unless it fails.
+bool beyond_reach(const Vec3d& d) { return !(dot(d, d) <= kMaxReach * kMaxReach); }
+
 // Where a vertex property's value goes: a fixed attribute, or kSlots + e for extra property e.
 using Slot = std::uint16_t;
 enum : Slot { kSkip, kX, kY, kZ, kSX, kSY, kSZ, kTime, kIntensity, kRed, kGreen, kBlue, kSlots };
@@ -203,10 +207,10 @@ struct PlyReader::Impl {
       if (!is_finite(s)) {
         fail_row("vertex", index, fmt::format("sensor position is not finite ({}, {}, {})", s.x, s.y, s.z));
       }
-      if (const double range = norm(p - s); range > kMaxReach) {
+      if (beyond_reach(p - s)) {
         fail_row("vertex", index,
-                 fmt::format("lies {:.0f} m from its sensor position (more than {:.0f} m: corrupt coordinates?)", range,
-                             kMaxReach));
+                 fmt::format("lies {:.0f} m from its sensor position (more than {:.0f} m: corrupt coordinates?)",
+                             norm(p - s), kMaxReach));
       }
       out.sensor_positions.push_back(s + header.offset);
     }
@@ -498,12 +502,10 @@ PlyReader::ChunkKind PlyReader::next(PlyVertexChunk& vertices, PlyFaceChunk& fac
 
 void check_face_extent(const std::filesystem::path& file, std::uint64_t face, const Vec3d& a, const Vec3d& b,
                        const Vec3d& c) {
-  // Squared lengths: the tiler checks every face of a city.
-  const auto length_sq = [](const Vec3d& d) { return dot(d, d); };
-  const double longest_sq = std::max({length_sq(b - a), length_sq(c - b), length_sq(a - c)});
-  if (!(longest_sq <= kMaxReach * kMaxReach)) {
+  if (beyond_reach(b - a) || beyond_reach(c - b) || beyond_reach(a - c)) {
+    const double longest = std::max({norm(b - a), norm(c - b), norm(a - c)});
     throw InputError(fmt::format("{}: face {}: an edge of {:.0f} m (longer than {:.0f} m: corrupt coordinates?)",
-                                 file.string(), face, std::sqrt(longest_sq), kMaxReach));
+                                 file.string(), face, longest, kMaxReach));
   }
 }
 
