@@ -37,7 +37,7 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
   const StitchStats s = stitch(merged, {.snap = reach,
                                         .reach = reach,
                                         .weld = kWeldInThresholds * config.change.distance_threshold,
-                                        .clip = config.mosaic.clip_overlaps ? config.change.distance_threshold : 0.0,
+                                        .clip = config.mosaic.clip_overlaps ? config.mosaic.clip_reach * config.change.distance_threshold : 0.0,
                                         .gap = config.mosaic.close_gaps ? config.change.distance_threshold : 0.0});
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "

@@ -229,6 +229,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(bool_key(mosaic, "clip_overlaps",
       "before stitching, cut pieces back where they lie over a larger source's surface, so that boundaries meet",
       [](auto& c) -> auto& { return c.mosaic.clip_overlaps; }));
+  keys.push_back(real_key(mosaic, "clip_reach",
+      "clipping cuts a piece where a larger source's surface lies within this times distance_threshold",
+      [](auto& c) -> auto& { return c.mosaic.clip_reach; }, 0.1, 10));
   keys.push_back(bool_key(mosaic, "close_gaps",
       "after stitching, triangulate the small holes left between pieces of several sources (up to distance_threshold wide)",
       [](auto& c) -> auto& { return c.mosaic.close_gaps; }));

@@ -2,26 +2,60 @@
 #include "gap_fill.h"
 
 #include <algorithm>
+#include <cmath>
+#include <numbers>
 #include <unordered_map>
 #include <unordered_set>
+
+#include "snap.h"
 
 namespace citymesh::mosaic_detail {
 
 namespace {
 
-/// A boundary half-edge from -> to (as its triangle runs it) and that triangle.
-struct Outgoing {
-  std::uint32_t to = 0, triangle = 0;
-  int count = 0;  ///< boundary half-edges leaving `from`: more than one is a pinched vertex
-};
+/// The boundary half-edges leaving each vertex (as their triangles run them): more than one
+/// at a pinched vertex, where pieces touch at a corner (often a vertex snapping merged).
+using Successors = std::unordered_map<std::uint32_t, std::vector<DirectedEdge>>;
 
-std::unordered_map<std::uint32_t, Outgoing> boundary_successors(const MeshTopology& topo) {
-  std::unordered_map<std::uint32_t, Outgoing> next;
-  for (const DirectedEdge& e : topo.boundary_half_edges()) {
-    Outgoing& o = next[e.from];
-    if (++o.count == 1) o = {e.to, e.triangle, 1};
-  }
+Successors boundary_successors(const MeshTopology& topo) {
+  Successors next;
+  for (const DirectedEdge& e : topo.boundary_half_edges()) next[e.from].push_back(e);
   return next;
+}
+
+std::uint64_t half_edge_key(const DirectedEdge& e) { return (std::uint64_t{e.from} << 32) | e.to; }
+
+/// Area-weighted normal of the triangles around v.
+Vec3d vertex_normal(const MeshTopology& topo, std::uint32_t v) {
+  Vec3d n{};
+  for (const std::uint32_t t : topo.triangles_of(v)) {
+    const Triangle& tri = topo.triangle(t);
+    const Vec3d a = topo.position(tri[0]);
+    n += cross(topo.position(tri[1]) - a, topo.position(tri[2]) - a);
+  }
+  return n;
+}
+
+/// At a pinched vertex v reached from `from`, the boundary half-edge that bounds the same
+/// hole: the hole lies right of the incoming edge, so it is the first outgoing edge met
+/// turning counter-clockwise (about v's normal) from the ray back to `from`.
+const DirectedEdge& continue_hole(const MeshTopology& topo, std::uint32_t from, std::uint32_t v,
+                                  const std::vector<DirectedEdge>& out) {
+  const Vec3d n = vertex_normal(topo, v);
+  const auto in_plane = [&](const Vec3d& d) { return d - n * (dot(d, n) / std::max(dot(n, n), 1e-300)); };
+  const Vec3d back = in_plane(topo.position(from) - topo.position(v));
+  const DirectedEdge* best = &out.front();
+  double best_angle = 10;
+  for (const DirectedEdge& e : out) {
+    const Vec3d w = in_plane(topo.position(e.to) - topo.position(v));
+    double angle = std::atan2(dot(cross(back, w), n) / std::max(norm(n), 1e-300), dot(back, w));
+    if (angle <= 0) angle += 2 * std::numbers::pi;
+    if (angle < best_angle) {
+      best_angle = angle;
+      best = &e;
+    }
+  }
+  return *best;
 }
 
 /// A loop of boundary half-edges: vertices[i] -> vertices[i + 1] belongs to triangles[i].
@@ -29,23 +63,25 @@ struct Loop {
   std::vector<std::uint32_t> vertices, triangles;
 };
 
-/// The closed loop through `start`, empty when it is longer than `limit`, open or pinched.
-Loop trace_loop(const std::unordered_map<std::uint32_t, Outgoing>& next, std::uint32_t start, std::size_t limit,
-                std::unordered_set<std::uint32_t>& visited) {
+/// The closed loop of boundary half-edges from `first`, empty when it is longer than
+/// `limit`, open or not simple. At a pinched vertex the loop follows the hole it is on.
+/// Its half-edges are marked `used` either way.
+Loop trace_loop(const MeshTopology& topo, const Successors& next, const DirectedEdge& first, std::size_t limit,
+                std::unordered_set<std::uint64_t>& used) {
   Loop loop;
-  std::uint32_t v = start;
-  do {
-    const auto it = next.find(v);
-    if (it == next.end() || it->second.count != 1 || loop.vertices.size() >= limit || visited.contains(v)) {
-      for (const std::uint32_t u : loop.vertices) visited.insert(u);
+  std::unordered_set<std::uint32_t> on_loop;
+  const DirectedEdge* e = &first;
+  for (;;) {
+    if (loop.vertices.size() >= limit || !on_loop.insert(e->from).second || !used.insert(half_edge_key(*e)).second) {
       return {};
     }
-    loop.vertices.push_back(v);
-    loop.triangles.push_back(it->second.triangle);
-    v = it->second.to;
-  } while (v != start);
-  for (const std::uint32_t u : loop.vertices) visited.insert(u);
-  return loop;
+    loop.vertices.push_back(e->from);
+    loop.triangles.push_back(e->triangle);
+    const auto it = next.find(e->to);
+    if (it == next.end()) return {};
+    e = it->second.size() == 1 ? &it->second.front() : &continue_hole(topo, e->from, e->to, it->second);
+    if (e->from == first.from && e->to == first.to) return loop;
+  }
 }
 
 Vec3d normal_of(const MeshTopology& topo, const Triangle& t) {
@@ -131,19 +167,44 @@ std::vector<Triangle> triangulate(const MeshTopology& topo, const Loop& loop, co
   return fill;
 }
 
+/// Closes the loop by splitting its longest edge at the loop's other vertices, so that the
+/// triangle on that edge takes the loop's other edges (reversed) as its own. This closes the
+/// loops no fill can: the slivers where two sources' boundaries cross, so that the loop
+/// winds the wrong way round (an overlap, not a hole) and any fill would face backwards.
+bool close_by_split(MeshTopology& topo, const Loop& loop) {
+  const std::size_t n = loop.vertices.size();
+  std::size_t longest = 0;
+  double longest_length = -1;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double length = norm(topo.position(loop.vertices[(i + 1) % n]) - topo.position(loop.vertices[i]));
+    if (length > longest_length) {
+      longest = i;
+      longest_length = length;
+    }
+  }
+  // The loop runs from -> to along the longest edge, then back through the others: in the
+  // edge's own order they come reversed.
+  const std::uint32_t from = loop.vertices[longest], to = loop.vertices[(longest + 1) % n];
+  std::vector<std::uint32_t> inserted;
+  for (std::size_t k = n - 1; k >= 2; --k) inserted.push_back(loop.vertices[(longest + k) % n]);
+  return split_boundary_edge(topo, from, to, inserted);
+}
+
 }  // namespace
 
 GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params) {
   GapFillStats stats;
-  const std::unordered_map<std::uint32_t, Outgoing> next = boundary_successors(topo);
-  std::vector<std::uint32_t> starts;
-  for (const auto& [v, o] : next) starts.push_back(v);
-  std::sort(starts.begin(), starts.end());
-  std::unordered_set<std::uint32_t> visited;
+  const Successors next = boundary_successors(topo);
+  std::vector<DirectedEdge> starts;
+  for (const auto& [v, out] : next) starts.insert(starts.end(), out.begin(), out.end());
+  std::sort(starts.begin(), starts.end(), [](const DirectedEdge& a, const DirectedEdge& b) {
+    return half_edge_key(a) < half_edge_key(b);
+  });
+  std::unordered_set<std::uint64_t> used;
   MergedMesh& m = topo.merged();
-  for (const std::uint32_t start : starts) {
-    if (visited.contains(start)) continue;
-    const Loop loop = trace_loop(next, start, params.max_vertices, visited);
+  for (const DirectedEdge& start : starts) {
+    if (used.contains(half_edge_key(start))) continue;
+    const Loop loop = trace_loop(topo, next, start, params.max_vertices, used);
     if (loop.vertices.size() < 3) continue;
     // Of the fill (the loop reversed), about the first vertex: small loops far from the
     // frame's origin would lose the area to cancellation.
@@ -155,7 +216,11 @@ GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params) {
     if (!(norm(newell) > 0) || !is_seam_gap(topo, loop, newell, params)) continue;
     const std::vector<Triangle> fill = triangulate(topo, loop, newell);
     if (fill.empty()) {
-      ++stats.gaps_refused;
+      if (close_by_split(topo, loop)) {
+        ++stats.gaps_split;
+      } else {
+        ++stats.gaps_refused;
+      }
       continue;
     }
     for (const Triangle& t : fill) {

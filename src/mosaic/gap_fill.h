@@ -21,6 +21,7 @@ struct GapFillParams {
 struct GapFillStats {
   std::uint64_t gaps_filled = 0;
   std::uint64_t triangles_added = 0;
+  std::uint64_t gaps_split = 0;    ///< closed by splitting the loop's longest edge instead
   std::uint64_t gaps_refused = 0;  ///< small mixed-source loops no triangulation could close
 };
 

@@ -155,9 +155,27 @@ std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const
   return out;
 }
 
-/// Splits the triangle on directed edge from -> to into a fan through the inserted vertices
-/// (in order along the edge), unless a piece would flip or degenerate or reuse a directed edge.
-bool try_split(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
+/// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
+void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
+  const std::vector<DirectedEdge> edges = topo.boundary_half_edges();
+  const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
+  for (std::size_t i = 0; i < insertions.size();) {
+    std::size_t j = i;
+    std::vector<std::uint32_t> inserted;
+    for (; j < insertions.size() && insertions[j].edge == insertions[i].edge; ++j) inserted.push_back(insertions[j].vertex);
+    const DirectedEdge& e = edges[insertions[i].edge];
+    if (split_boundary_edge(topo, e.from, e.to, inserted)) {
+      ++stats.edges_split;
+    } else {
+      ++stats.rejected;
+    }
+    i = j;
+  }
+}
+
+}  // namespace
+
+bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
   const std::optional<std::uint32_t> found = topo.triangle_with(from, to);
   if (!found) return false;
   const std::uint32_t t = *found;
@@ -195,26 +213,6 @@ bool try_split(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const s
   std::erase(topo.edit(to), t);
   return true;
 }
-
-/// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
-void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
-  const std::vector<DirectedEdge> edges = topo.boundary_half_edges();
-  const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
-  for (std::size_t i = 0; i < insertions.size();) {
-    std::size_t j = i;
-    std::vector<std::uint32_t> inserted;
-    for (; j < insertions.size() && insertions[j].edge == insertions[i].edge; ++j) inserted.push_back(insertions[j].vertex);
-    const DirectedEdge& e = edges[insertions[i].edge];
-    if (try_split(topo, e.from, e.to, inserted)) {
-      ++stats.edges_split;
-    } else {
-      ++stats.rejected;
-    }
-    i = j;
-  }
-}
-
-}  // namespace
 
 SnapStats snap_boundaries(MeshTopology& topo, double tolerance) {
   SnapStats stats;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <vector>
 
 #include "mesh_topology.h"
 
@@ -16,6 +17,11 @@ struct SnapStats {
   std::uint64_t edges_split = 0;      ///< boundary edges split at a vertex of another source
   std::uint64_t rejected = 0;  ///< merges and splits refused (a flip, a degenerate or a non-manifold result)
 };
+
+/// Splits the triangle on the directed edge from -> to into a fan through `inserted` (in
+/// order from `from` to `to`), unless a piece would flip or degenerate against the triangle
+/// or reuse a directed edge; the pieces keep its provenance. Returns whether it did.
+bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted);
 
 /// First merges each boundary vertex with the nearest boundary vertex of another source
 /// within `tolerance` (both move to their midpoint), then splits each boundary edge at the

@@ -275,7 +275,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   if (params.gap > 0) {
     const mosaic_detail::GapFillStats gaps =
         mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = kGapPerimeterInWidths * params.gap});
-    c.stats.gaps_filled = gaps.gaps_filled;
+    c.stats.gaps_filled = gaps.gaps_filled + gaps.gaps_split;
     c.stats.triangles_added += gaps.triangles_added;
   }
   weld(c);

@@ -342,5 +342,59 @@ TEST(GapFill, ClosesANonConvexGapWithoutFoldingIt) {
   EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
 }
 
+TEST(GapFill, ClosesTwoGapsMeetingAtAPinchedVertex) {
+  // Two missing cells touching at one corner, (0.4, 0.5) on the seam: that vertex starts two
+  // boundary edges, and each loop must follow its own hole through it.
+  MergedMesh m = two_source_grid({{3, 4}, {4, 5}});
+  const std::size_t before = m.mesh.triangle_count();
+  const mosaic_detail::GapFillStats s = fill_gaps(m);
+  EXPECT_EQ(s.gaps_filled, 2u);
+  EXPECT_NEAR(open_boundary_length(m.mesh), 4.0, 1e-6);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  double added_area = 0;
+  for (std::size_t t = before; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    const Vec3d n = cross(c[1] - c[0], c[2] - c[0]);
+    EXPECT_GT(n.z, 0) << "a fill triangle faces away from its neighbours";
+    added_area += 0.5 * norm(n);
+  }
+  EXPECT_NEAR(added_area, 0.02, 1e-6);  // the two cells, nothing across the pinch
+}
+
+TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
+  // Source 0 above y = 0, source 1 below, joined along the seam except between a and b,
+  // where source 1's boundary bends 1 cm up into source 0 through x: the loop a -> b -> x
+  // winds the wrong way (two layers, not a hole), so a fill would face down. Splitting
+  // source 0's edge a -> b at x closes it with every triangle still facing up.
+  MergedMesh m;
+  m.mesh.positions = {{-0.5f, 0, 0},   {0, 0, 0},     {0.5f, 0, 0},  {1, 0, 0},  // p0 a b p3
+                      {0.25f, 0.01f, 0},                                     // x
+                      {-0.25f, 0.5f, 0}, {0.25f, 0.5f, 0}, {0.75f, 0.5f, 0},  // c0 c1 c2
+                      {-0.25f, -0.5f, 0}, {0.25f, -0.5f, 0}, {0.75f, -0.5f, 0}};  // d0 d1 d2
+  const auto add = [&](std::int32_t source, std::initializer_list<Triangle> tris) {
+    for (const Triangle& t : tris) {
+      m.mesh.triangles.push_back(t);
+      m.mesh.triangle_ids.push_back({});
+      m.source_acq.push_back(source);
+      m.source_triangle.push_back(static_cast<std::int32_t>(m.source_triangle.size()));
+    }
+  };
+  add(0, {{0, 1, 5}, {1, 2, 6}, {2, 3, 7}, {1, 6, 5}, {2, 7, 6}});
+  add(1, {{1, 0, 8}, {2, 4, 9}, {4, 1, 9}, {3, 2, 10}, {1, 8, 9}, {2, 9, 10}});
+  const double outline = open_boundary_length(m.mesh) - 0.5 - 2 * std::hypot(0.25, 0.01);
+  const mosaic_detail::GapFillStats s = fill_gaps(m);
+  EXPECT_EQ(s.gaps_filled, 0u);
+  EXPECT_EQ(s.gaps_split, 1u);
+  EXPECT_NEAR(open_boundary_length(m.mesh), outline, 1e-6);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  EXPECT_EQ(m.mesh.triangle_count(), 12u);  // source 0's a -> b triangle became two
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    EXPECT_GT(cross(c[1] - c[0], c[2] - c[0]).z, 0) << "triangle " << t << " faces down";
+  }
+  EXPECT_EQ(std::count(m.source_acq.begin(), m.source_acq.end(), 0), 6);  // the split keeps provenance
+}
+
 }  // namespace
 }  // namespace citymesh
