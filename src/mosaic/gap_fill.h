@@ -28,11 +28,13 @@ struct GapFillStats {
 /// Fills every boundary loop of `topo`'s mesh that runs along the edges of at least two
 /// sources (stitch triangles count as one) and is small: at most `max_vertices` vertices,
 /// `max_perimeter` long and `max_width` wide. A loop is triangulated by ear clipping in the
-/// plane of its mean normal, shortest diagonal first; it is left open when a loop vertex is
-/// pinched (starts two boundary edges), when no ear is left, or when a new triangle would
-/// turn against the triangle across one of its loop edges, degenerate, or reuse a directed
-/// edge. New triangles have source kNoSource. Deterministic: loops are taken from their
-/// smallest vertex, in increasing order.
+/// plane of its mean normal, shortest diagonal first. At a pinched vertex (one that starts
+/// two boundary edges) a loop follows its own hole. When the fill would turn against the
+/// triangle across one of its loop edges (a loop winding the wrong way, where two boundaries
+/// cross), degenerate or reuse a directed edge, the loop is closed instead by splitting its
+/// longest edge at its other vertices (split_boundary_edge), or left open when that would
+/// flip a triangle. New fill triangles have source kNoSource; split ones keep theirs.
+/// Deterministic: loops are taken from their smallest half-edge, in increasing order.
 GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params);
 
 }  // namespace citymesh::mosaic_detail
