@@ -23,17 +23,21 @@ Successors boundary_successors(const MeshTopology& topo) {
   return next;
 }
 
-std::uint64_t half_edge_key(const DirectedEdge& e) { return (std::uint64_t{e.from} << 32) | e.to; }
+std::uint64_t directed_key(std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; }
+std::uint64_t half_edge_key(const DirectedEdge& e) { return directed_key(e.from, e.to); }
 
-/// Area-weighted normal of the triangles around v.
+/// Twice the area times the unit normal of triangle t.
+Vec3d normal_of(const MeshTopology& topo, const Triangle& t) {
+  const Vec3d a = topo.position(t[0]);
+  return cross(topo.position(t[1]) - a, topo.position(t[2]) - a);
+}
+
+/// Unit area-weighted normal of the triangles around v (zero when they have no area).
 Vec3d vertex_normal(const MeshTopology& topo, std::uint32_t v) {
   Vec3d n{};
-  for (const std::uint32_t t : topo.triangles_of(v)) {
-    const Triangle& tri = topo.triangle(t);
-    const Vec3d a = topo.position(tri[0]);
-    n += cross(topo.position(tri[1]) - a, topo.position(tri[2]) - a);
-  }
-  return n;
+  for (const std::uint32_t t : topo.triangles_of(v)) n += normal_of(topo, topo.triangle(t));
+  const double length = norm(n);
+  return length > 0 ? n / length : n;
 }
 
 /// At a pinched vertex v reached from `from`, the boundary half-edge that bounds the same
@@ -42,13 +46,13 @@ Vec3d vertex_normal(const MeshTopology& topo, std::uint32_t v) {
 const DirectedEdge& continue_hole(const MeshTopology& topo, std::uint32_t from, std::uint32_t v,
                                   const std::vector<DirectedEdge>& out) {
   const Vec3d n = vertex_normal(topo, v);
-  const auto in_plane = [&](const Vec3d& d) { return d - n * (dot(d, n) / std::max(dot(n, n), 1e-300)); };
+  const auto in_plane = [&](const Vec3d& d) { return d - n * dot(d, n); };
   const Vec3d back = in_plane(topo.position(from) - topo.position(v));
   const DirectedEdge* best = &out.front();
   double best_angle = 10;
   for (const DirectedEdge& e : out) {
     const Vec3d w = in_plane(topo.position(e.to) - topo.position(v));
-    double angle = std::atan2(dot(cross(back, w), n) / std::max(norm(n), 1e-300), dot(back, w));
+    double angle = std::atan2(dot(cross(back, w), n), dot(back, w));
     if (angle <= 0) angle += 2 * std::numbers::pi;
     if (angle < best_angle) {
       best_angle = angle;
@@ -82,11 +86,6 @@ Loop trace_loop(const MeshTopology& topo, const Successors& next, const Directed
     e = it->second.size() == 1 ? &it->second.front() : &continue_hole(topo, e->from, e->to, it->second);
     if (e->from == first.from && e->to == first.to) return loop;
   }
-}
-
-Vec3d normal_of(const MeshTopology& topo, const Triangle& t) {
-  const Vec3d a = topo.position(t[0]);
-  return cross(topo.position(t[1]) - a, topo.position(t[2]) - a);
 }
 
 /// True when the loop is small enough and runs along more than one source.
@@ -151,15 +150,14 @@ std::vector<Triangle> triangulate(const MeshTopology& topo, const Loop& loop, co
   const std::vector<Triangle> fill = ear_clip(topo, polygon, newell / norm(newell));
   if (fill.empty()) return {};
   std::unordered_map<std::uint64_t, std::uint32_t> across;  ///< reversed loop edge -> its triangle
-  const auto key = [](std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; };
   for (std::size_t i = 0; i < loop.vertices.size(); ++i) {
-    across[key(loop.vertices[(i + 1) % loop.vertices.size()], loop.vertices[i])] = loop.triangles[i];
+    across[directed_key(loop.vertices[(i + 1) % loop.vertices.size()], loop.vertices[i])] = loop.triangles[i];
   }
   for (const Triangle& t : fill) {
     const Vec3d n = normal_of(topo, t);
     if (!(norm(n) > 1e-10)) return {};
     for (int k = 0; k < 3; ++k) {
-      const auto it = across.find(key(t[k], t[(k + 1) % 3]));
+      const auto it = across.find(directed_key(t[k], t[(k + 1) % 3]));
       if (it != across.end() && dot(n, normal_of(topo, topo.triangle(it->second))) <= 0) return {};
     }
   }
@@ -187,6 +185,8 @@ bool close_by_split(MeshTopology& topo, const Loop& loop) {
   const std::uint32_t from = loop.vertices[longest], to = loop.vertices[(longest + 1) % n];
   std::vector<std::uint32_t> inserted;
   for (std::size_t k = n - 1; k >= 2; --k) inserted.push_back(loop.vertices[(longest + k) % n]);
+  // The split moves the edge to -> apex to a new triangle, while the successor lists still
+  // name the old one. Only its source and facing are read later, and the fan keeps both.
   return split_boundary_edge(topo, from, to, inserted);
 }
 
