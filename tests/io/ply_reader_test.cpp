@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: MIT
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "citymesh/core/error.h"
@@ -128,6 +129,39 @@ TEST(PlyReader, ChunksAreBoundedAndInFileOrder) {
   EXPECT_EQ(next_vertex, 102u);
   EXPECT_EQ(reader.stats().faces, 50u);
   EXPECT_EQ(reader.stats().triangles, 100u);
+}
+
+/// One triangle at (x, y) in the CRS, after an unused first vertex at (first_x, y): ASCII, with
+/// sensor positions 2 m above each point.
+std::string triangle_after_unused_vertex(double first_x, double x, double y) {
+  std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty double x\nproperty double y\nproperty double z\n"
+      "property double x_origin\nproperty double y_origin\nproperty double z_origin\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const auto row = [](double px, double py) { return fmt::format("{:.3f} {:.3f} 30 {:.3f} {:.3f} 32\n", px, py, px, py); };
+  ply += row(first_x, y) + row(x, y) + row(x + 1, y) + row(x, y + 1);
+  return ply + "3 1 2 3\n";
+}
+
+TEST(PlyReader, UsedVerticesFarFromTheFrameOriginAreAnError) {
+  // A corrupt first vertex, unused, sets the frame origin a million kilometres away: the
+  // triangle's floats would have no metres left, and it was read all the same.
+  try {
+    read_text(triangle_after_unused_vertex(1e9, 650000, 6860000));
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("m.ply: face 0: vertex 1 lies"), std::string::npos) << what;
+    EXPECT_NE(what.find("frame origin"), std::string::npos) << what;
+  }
+  // An acquisition in another CRS than the frame it is read into (origin given, 1 400 km off).
+  MeshReadParams other_frame;
+  other_frame.origin = Vec3d{650000, 6860000, 0};
+  EXPECT_THROW(read_text(triangle_after_unused_vertex(450000, 450000, 5400000), other_frame), InputError);
+  // Within the limit (an unused vertex 90 km away still sets the origin): read, to the millimetre.
+  const Mesh m = read_text(triangle_after_unused_vertex(560000, 650000, 6860000)).mesh;
+  ASSERT_EQ(m.triangle_count(), 1u);
+  EXPECT_NEAR(m.world_position(2).x, 650001.0, 0.01);
 }
 
 TEST(PlyReader, IgnOffsetCommentsMakeCoordinatesAbsolute) {

@@ -11,6 +11,11 @@
 
 namespace citymesh {
 
+/// How far from the frame origin a used vertex may lie, in metres. Floats keep about a
+/// centimetre there; farther, the coordinates are corrupt or from another CRS than the
+/// frame's (read_mesh refuses them).
+constexpr double kMaxFrameReach = 100'000.0;
+
 struct MeshReadParams {
   PlyReadParams ply;
   std::uint32_t acquisition = 0;  ///< written into every TriangleId
@@ -26,7 +31,8 @@ struct MeshReadResult {
   std::uint64_t zero_area_dropped = 0;
 };
 
-/// Reads every vertex and triangle of `path`. Throws InputError naming the file and row.
+/// Reads every vertex and triangle of `path`. Throws InputError naming the file and row, also
+/// when a vertex a face uses lies beyond kMaxFrameReach of the origin.
 MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams& params = {});
 
 }  // namespace citymesh
