@@ -45,22 +45,25 @@ std::uint64_t drop_zero_area(Mesh& mesh, double min_doubled_area) {
   return dropped;
 }
 
-/// Throws InputError when a vertex used by a face lies farther than kMaxFrameReach from the
-/// frame origin: its float position has lost its millimetres (or is infinite), which is what
-/// a corrupt first vertex (the origin) or an acquisition in another CRS than the first looks
-/// like. Unused vertices are not checked: they never reach a result.
-void check_frame(const std::filesystem::path& path, const Mesh& mesh) {
-  constexpr double kLimitSq = kMaxFrameReach * kMaxFrameReach;
+/// Throws InputError naming the file and face when a face uses a vertex farther than
+/// kMaxFrameReach from the frame origin (its float position has lost its millimetres, or is
+/// infinite: a corrupt first vertex, which sets the origin, or an acquisition in another CRS
+/// than the first), or has an edge longer than kMaxReach. Unused vertices are not checked:
+/// they never reach a result. The frame comes first: beyond it the corners are not the file's.
+void check_faces(const std::filesystem::path& path, const Mesh& mesh) {
+  constexpr double kFrameSq = kMaxFrameReach * kMaxFrameReach;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const std::uint64_t face = mesh.triangle_ids[t].face;
     for (const std::uint32_t v : mesh.triangles[t]) {
       const Vec3d local(mesh.positions[v]);
-      if (dot(local, local) <= kLimitSq) continue;
+      if (dot(local, local) <= kFrameSq) continue;
       throw InputError(fmt::format(
           "{}: face {}: vertex {} lies {:.0f} m from the frame origin ({:.3f}, {:.3f}, {:.3f}), beyond the {:.0f} m "
           "one frame of floats holds (a corrupt first vertex, or acquisitions in different CRSs?)",
-          path.string(), mesh.triangle_ids[t].face, v, norm(local), mesh.origin.x, mesh.origin.y, mesh.origin.z,
-          kMaxFrameReach));
+          path.string(), face, v, norm(local), mesh.origin.x, mesh.origin.y, mesh.origin.z, kMaxFrameReach));
     }
+    const std::array<Vec3d, 3> c = mesh.corners(t);
+    check_face_extent(path, face, c[0], c[1], c[2]);
   }
 }
 
@@ -88,11 +91,7 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
     }
   }
   result.stats = reader.stats();
-  check_frame(path, mesh);
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const std::array<Vec3d, 3> c = mesh.corners(t);
-    check_face_extent(path, mesh.triangle_ids[t].face, c[0], c[1], c[2]);
-  }
+  check_faces(path, mesh);
   result.zero_area_dropped = drop_zero_area(mesh, params.min_doubled_area);
   if (result.zero_area_dropped > 0) {
     log::info("{}: dropped {} zero-area triangles", path.string(), result.zero_area_dropped);

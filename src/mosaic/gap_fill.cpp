@@ -26,16 +26,10 @@ Successors boundary_successors(const MeshTopology& topo) {
 std::uint64_t directed_key(std::uint32_t from, std::uint32_t to) { return (std::uint64_t{from} << 32) | to; }
 std::uint64_t half_edge_key(const DirectedEdge& e) { return directed_key(e.from, e.to); }
 
-/// Twice the area times the unit normal of triangle t.
-Vec3d normal_of(const MeshTopology& topo, const Triangle& t) {
-  const Vec3d a = topo.position(t[0]);
-  return cross(topo.position(t[1]) - a, topo.position(t[2]) - a);
-}
-
 /// Unit area-weighted normal of the triangles around v (zero when they have no area).
 Vec3d vertex_normal(const MeshTopology& topo, std::uint32_t v) {
   Vec3d n{};
-  for (const std::uint32_t t : topo.triangles_of(v)) n += normal_of(topo, topo.triangle(t));
+  for (const std::uint32_t t : topo.triangles_of(v)) n += topo.winding(topo.triangle(t));
   const double length = norm(n);
   return length > 0 ? n / length : n;
 }
@@ -154,11 +148,11 @@ std::vector<Triangle> triangulate(const MeshTopology& topo, const Loop& loop, co
     across[directed_key(loop.vertices[(i + 1) % loop.vertices.size()], loop.vertices[i])] = loop.triangles[i];
   }
   for (const Triangle& t : fill) {
-    const Vec3d n = normal_of(topo, t);
+    const Vec3d n = topo.winding(t);
     if (!(norm(n) > 1e-10)) return {};
     for (int k = 0; k < 3; ++k) {
       const auto it = across.find(directed_key(t[k], t[(k + 1) % 3]));
-      if (it != across.end() && dot(n, normal_of(topo, topo.triangle(it->second))) <= 0) return {};
+      if (it != across.end() && dot(n, topo.winding(topo.triangle(it->second))) <= 0) return {};
     }
   }
   if (!topo.edges_free(fill, {})) return {};

@@ -28,6 +28,11 @@ class MeshTopology {
   [[nodiscard]] MergedMesh& merged() const { return merged_; }
   [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
   [[nodiscard]] Vec3d position(std::uint32_t v) const { return Vec3d(merged_.mesh.positions[v]); }
+  /// Twice the area times the unit normal of the triangle (a, b, c) of this mesh's vertices.
+  [[nodiscard]] Vec3d winding(const Triangle& t) const {
+    const Vec3d a = position(t[0]);
+    return cross(position(t[1]) - a, position(t[2]) - a);
+  }
 
   /// The triangles using vertex v, in the order they were added.
   [[nodiscard]] std::span<const std::uint32_t> triangles_of(std::uint32_t v) const;

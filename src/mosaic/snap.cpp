@@ -53,7 +53,7 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   for (const std::uint32_t u : {v, w}) {
     for (const std::uint32_t t : topo.triangles_of(u)) {
       const Triangle& tri = topo.triangle(t);
-      const Vec3d before = normal_of(topo.position(tri[0]), topo.position(tri[1]), topo.position(tri[2]));
+      const Vec3d before = topo.winding(tri);
       if (!acceptable(before, normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
     }
   }
@@ -183,7 +183,7 @@ bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t t
   int k = 0;
   while (old[k] != from) ++k;
   const std::uint32_t apex = old[(k + 2) % 3];
-  const Vec3d before = normal_of(topo.position(old[0]), topo.position(old[1]), topo.position(old[2]));
+  const Vec3d before = topo.winding(old);
   std::vector<std::uint32_t> chain{from};
   chain.insert(chain.end(), inserted.begin(), inserted.end());
   chain.push_back(to);
@@ -191,7 +191,7 @@ bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t t
   for (std::size_t i = 0; i + 1 < chain.size(); ++i) {
     if (chain[i + 1] == apex) return false;
     fan.push_back({chain[i], chain[i + 1], apex});
-    const Vec3d after = normal_of(topo.position(chain[i]), topo.position(chain[i + 1]), topo.position(apex));
+    const Vec3d after = topo.winding(fan.back());
     if (dot(before, after) <= 0 || norm(after) < 1e-3 * norm(before)) return false;
   }
   if (!topo.edges_free(fan, std::span(&t, 1))) return false;
