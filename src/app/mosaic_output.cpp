@@ -84,6 +84,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
     summary["acquisitions"].push_back(std::move(entry));
   }
   summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected}, {"filled", s.filled},
+                       {"fill_seen_through", s.fill_seen_through},
                        {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
                        {"overlap_terms", s.overlap_terms}, {"seam_terms", s.seam_terms}};
   summary["energy"] = {{"total", s.energy},

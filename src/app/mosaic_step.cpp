@@ -67,7 +67,10 @@ void report(const std::filesystem::path& dir, const MergedMesh& merged, const Mo
     std::cout << fmt::format("; energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f})",
                              s.energy, s.quality, s.boundary, s.seam, s.overlap);
   }
-  if (s.filled > 0) std::cout << fmt::format("; {} added by the hole fill", s.filled);
+  if (s.filled + s.fill_seen_through > 0) {
+    std::cout << fmt::format("; {} added by the hole fill ({} left out: another pass saw through them)", s.filled,
+                             s.fill_seen_through);
+  }
   std::cout << fmt::format("\n  {:.3f} s: energy {:.3f}, solve {:.3f}, fill {:.3f}\n",
                            s.seconds_build + s.seconds_solve + s.seconds_fill, s.seconds_build, s.seconds_solve,
                            s.seconds_fill);

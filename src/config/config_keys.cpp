@@ -224,7 +224,8 @@ std::vector<KeyDef> make_keys() {
       "stitching joins boundaries of pieces from different sources closer than this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.stitch_reach; }, 0.1, 100));
   keys.push_back(bool_key(mosaic, "fill_holes",
-      "after the energy mosaic, add back kept triangles with nothing selected within distance_threshold (newest first)",
+      "after the energy mosaic, add back kept triangles with nothing selected within distance_threshold (newest first), "
+      "unless another pass saw through them (in its empty space, more than distance_threshold and at most 1 m in front of it)",
       [](auto& c) -> auto& { return c.mosaic.fill_holes; }));
   keys.push_back(bool_key(mosaic, "clip_overlaps",
       "before stitching, cut pieces back where they lie over a larger source's surface, so that boundaries meet",

@@ -222,7 +222,11 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   out.selected.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
   account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
-  if (params.fill_holes) out.stats.filled = fill_holes(input, out.selected);
+  if (params.fill_holes) {
+    const HoleFillCounts fill = fill_holes(input, out.selected);
+    out.stats.filled = fill.added;
+    out.stats.fill_seen_through = fill.seen_through;
+  }
   out.stats.seconds_fill = clock.restart();
   return out;
 }

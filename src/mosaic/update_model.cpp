@@ -10,45 +10,91 @@
 #include "citymesh/mosaic/mosaic.h"
 #include "citymesh/mosaic/proximity.h"
 #include "internal.h"
+#include "seen_through.h"
 
 namespace citymesh {
 
 namespace {
 
-/// Visits the acquisitions in `order`; in each, selects the kept triangles with no selected
-/// triangle within the distance threshold of their centroid (what is selected at the start of
-/// the acquisition: its own triangles never hide each other). Returns how many were added.
-/// The triangles selected at the start are indexed once; the ones added on the way are
-/// indexed again per acquisition (few, for the hole fill).
-std::uint64_t add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected) {
+/// Per global triangle: 1 when the change step kept it, it is not selected and no selected
+/// triangle lies within the distance threshold of its centroid.
+std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const std::vector<std::uint8_t>& selected) {
   const ChangeResult& change = *input.change;
   const GlobalTriangles& index = change.index;
   const double reach = input.distance_threshold;
   const MergedMesh initial = merge_selection(input.meshes, index, selected);
   const MeshProximity near_initial(initial.mesh, reach);
-  std::vector<std::uint8_t> added_so_far(selected.size(), 0);
-  std::uint64_t added = 0;
-  for (const std::size_t a : order) {
-    const MergedMesh later = merge_selection(input.meshes, index, added_so_far);
-    const MeshProximity near_later(later.mesh, reach);
+  std::vector<std::uint8_t> open(index.size(), 0);
+  for (std::size_t a = 0; a < input.meshes.size(); ++a) {
     const Mesh& mesh = input.meshes[a];
     const std::size_t base = index.offsets[a];
-    std::vector<std::uint8_t> add(mesh.triangle_count(), 0);
     parallel_for_blocks(mesh.triangle_count(), 4096, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
         if (change.kept[base + t] == 0 || selected[base + t] != 0) continue;
         const auto [p, q, r] = mesh.corners(t);
-        const Vec3d centroid = (p + q + r) / 3.0;
-        add[t] = near_initial.any_within(centroid, reach) || near_later.any_within(centroid, reach) ? 0 : 1;
+        open[base + t] = near_initial.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
+      }
+    });
+  }
+  return open;
+}
+
+/// Clears open[g] where another pass saw through triangle g; returns how many.
+std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::SeenThroughParams& params,
+                                std::vector<std::uint8_t>& open) {
+  std::vector<std::uint32_t> ids;
+  for (std::size_t g = 0; g < open.size(); ++g) {
+    if (open[g] != 0) ids.push_back(static_cast<std::uint32_t>(g));
+  }
+  const std::vector<std::uint8_t> seen = mosaic_detail::seen_through(input.meshes, input.change->index, ids, params);
+  std::uint64_t dropped = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (seen[i] != 0) {
+      open[ids[i]] = 0;
+      ++dropped;
+    }
+  }
+  return dropped;
+}
+
+/// Visits the acquisitions in `order`; in each, selects the kept triangles with no selected
+/// triangle within the distance threshold of their centroid (what is selected at the start of
+/// the acquisition: its own triangles never hide each other), unless, with `visibility`,
+/// another pass saw through them. The triangles selected at the start are indexed once; the
+/// ones added on the way are indexed again per acquisition (few, for the hole fill).
+HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected,
+                             const mosaic_detail::SeenThroughParams* visibility) {
+  const GlobalTriangles& index = input.change->index;
+  const double reach = input.distance_threshold;
+  std::vector<std::uint8_t> open = uncovered_by_selection(input, selected);
+  HoleFillCounts counts;
+  // Seen through or not does not depend on the selection: asked once, for every candidate.
+  if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, open);
+  std::vector<std::uint8_t> added_so_far(selected.size(), 0);
+  for (const std::size_t a : order) {
+    const std::size_t base = index.offsets[a], end = index.offsets[a + 1];
+    if (std::find(open.begin() + static_cast<std::ptrdiff_t>(base), open.begin() + static_cast<std::ptrdiff_t>(end), 1) ==
+        open.begin() + static_cast<std::ptrdiff_t>(end)) {
+      continue;
+    }
+    const MergedMesh later = merge_selection(input.meshes, index, added_so_far);
+    const MeshProximity near_later(later.mesh, reach);
+    const Mesh& mesh = input.meshes[a];
+    std::vector<std::uint8_t> add(mesh.triangle_count(), 0);
+    parallel_for_blocks(mesh.triangle_count(), 4096, [&](std::size_t begin, std::size_t stop) {
+      for (std::size_t t = begin; t < stop; ++t) {
+        if (open[base + t] == 0) continue;
+        const auto [p, q, r] = mesh.corners(t);
+        add[t] = near_later.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
       }
     });
     for (std::size_t t = 0; t < add.size(); ++t) {
       selected[base + t] |= add[t];
       added_so_far[base + t] |= add[t];
-      added += add[t];
+      counts.added += add[t];
     }
   }
-  return added;
+  return counts;
 }
 
 /// Acquisition indices by date (config order on equal dates).
@@ -67,18 +113,22 @@ MosaicSelection select_update_model(const MosaicInput& input) {
   const ChangeResult& change = *input.change;
   MosaicSelection out;
   out.selected.assign(change.index.size(), 0);
-  add_uncovered(input, date_order(input), out.selected);
+  (void)add_uncovered(input, date_order(input), out.selected, nullptr);
   out.stats.candidates = static_cast<std::uint64_t>(std::count(change.kept.begin(), change.kept.end(), 1));
   out.stats.selected = static_cast<std::uint64_t>(std::count(out.selected.begin(), out.selected.end(), 1));
   out.stats.seconds_solve = clock.seconds();
   return out;
 }
 
-std::uint64_t fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected) {
+HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected) {
   mosaic_detail::check_mosaic_input(input);
   std::vector<std::size_t> order = date_order(input);
   std::reverse(order.begin(), order.end());
-  return add_uncovered(input, order, selected);
+  // What another pass saw through is not put back: mostly facets one pass strung across a
+  // window recess that another pass saw into (they lie on no surface), which the fill would
+  // otherwise add as a second sheet standing in front of the selection.
+  const mosaic_detail::SeenThroughParams visibility{.margin = input.distance_threshold, .depth = 1.0};
+  return add_uncovered(input, order, selected, &visibility);
 }
 
 }  // namespace citymesh

@@ -38,7 +38,7 @@ TEST(FillHoles, AddsNewestTrianglesWhereNothingSelectedIsNear) {
   const MosaicInput input{meshes, dates, &change, 0.1, {}};
   std::vector<std::uint8_t> selected(328, 0);
   std::fill(selected.begin(), selected.begin() + 200, 1);
-  const std::uint64_t added = fill_holes(input, selected);
+  const std::uint64_t added = fill_holes(input, selected).added;
 
   std::uint64_t expected = 0;
   for (std::size_t t = 0; t < 64; ++t) {
@@ -63,7 +63,7 @@ TEST(FillHoles, NeverAddsWhatTheChangeStepDropped) {
   change.kept.assign(16, 1);
   std::fill(change.kept.begin() + 8, change.kept.end(), 0);
   std::vector<std::uint8_t> selected(16, 0);
-  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, selected), 8u);
+  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, selected).added, 8u);
   for (std::size_t g = 0; g < 16; ++g) EXPECT_EQ(selected[g], g < 8 ? 1 : 0);
 }
 

@@ -34,6 +34,7 @@ struct MosaicStats {
   /// Weighted energy terms of the selection (the quality term is negative).
   double quality = 0, boundary = 0, overlap = 0, seam = 0, energy = 0;
   std::uint64_t filled = 0;  ///< triangles added by the hole fill
+  std::uint64_t fill_seen_through = 0;  ///< triangles the hole fill left out: another pass saw through them
   MinimiseStats solver;  ///< solver.exact: the whole energy was solved by one flipped cut
   GroupMoveStats moves;  ///< otherwise: the group moves (one group per acquisition)
   double seconds_build = 0, seconds_solve = 0, seconds_fill = 0;
@@ -67,11 +68,18 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
 /// distance threshold of its centroid.
 MosaicSelection select_update_model(const MosaicInput& input);
 
+struct HoleFillCounts {
+  std::uint64_t added = 0;
+  std::uint64_t seen_through = 0;  ///< left out: another pass saw through them
+};
+
 /// Hole fill after the energy mosaic: the acquisitions newest first; a kept triangle is added
 /// to `selected` when no selected triangle lies within the distance threshold of its centroid
-/// (the update model's rule, from the mosaic's selection). Where the mosaic's pieces leave a
-/// gap wider than the threshold (a piece's edge falls short of its neighbour's), this puts the
-/// input surface back. Returns the number of triangles added.
-std::uint64_t fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected);
+/// (the update model's rule, from the mosaic's selection) and no other pass saw through its
+/// centroid (it lies in the empty space of another mesh's triangle, more than the threshold
+/// and at most 1 m in front of it; meshes without sensor positions see nothing). Where the
+/// mosaic's pieces leave a gap wider than the threshold (a piece's edge falls short of its
+/// neighbour's), this puts the input surface back.
+HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected);
 
 }  // namespace citymesh
