@@ -132,9 +132,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
         f.corner[g] = {m.positions[tri[0]], m.positions[tri[1]], m.positions[tri[2]]};
         const Vec3d p0(f.corner[g][0]), p1(f.corner[g][1]), p2(f.corner[g][2]);
         const Vec3d c = (p0 + p1 + p2) / 3.0;
-        const Vec3d v = (Vec3d(m.sensor_positions[tri[0]]) + Vec3d(m.sensor_positions[tri[1]]) +
-                         Vec3d(m.sensor_positions[tri[2]])) /
-                        3.0;
+        const Vec3d v = m.viewpoint(t);
         Vec3d normal = cross(p1 - p0, p2 - p0);
         const double len = norm(normal);
         normal = len > 0 ? normal / len : Vec3d{0, 0, 0};

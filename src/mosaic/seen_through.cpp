@@ -13,7 +13,9 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
-/// p inside the tetrahedron (viewpoint v, triangle q), between margin and depth from q's plane.
+/// p inside the tetrahedron (viewpoint v, triangle q), between margin and depth from q's plane:
+/// the change step's margin-reduced empty space, cut at the depth. For a point the ray through
+/// it answers directly; the triangle-tetrahedron test's separating axes are not needed.
 bool in_empty_space(const Vec3d& p, const Vec3d& v, const TriangleCorners& q, const SeenThroughParams& params) {
   const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
   const double len = norm(winding);
@@ -67,9 +69,7 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         const TriangleCorners q = other.corners(t);
         tree.overlapping(padded_box(q, params.depth), hits);
         if (hits.empty()) continue;
-        const Triangle& tri = other.triangles[t];
-        const Vec3d v = (Vec3d(other.sensor_positions[tri[0]]) + Vec3d(other.sensor_positions[tri[1]]) +
-                         Vec3d(other.sensor_positions[tri[2]])) / 3.0;
+        const Vec3d v = other.viewpoint(t);
         for (const std::uint32_t i : hits) {
           // Flags are only raised: any order of raising gives the same result.
           if (mesh_of[i] != b && in_empty_space(centroid[i], v, q, params)) {

@@ -72,11 +72,9 @@ HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size
   if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, open);
   std::vector<std::uint8_t> added_so_far(selected.size(), 0);
   for (const std::size_t a : order) {
-    const std::size_t base = index.offsets[a], end = index.offsets[a + 1];
-    if (std::find(open.begin() + static_cast<std::ptrdiff_t>(base), open.begin() + static_cast<std::ptrdiff_t>(end), 1) ==
-        open.begin() + static_cast<std::ptrdiff_t>(end)) {
-      continue;
-    }
+    const std::size_t base = index.offsets[a];
+    const std::span<const std::uint8_t> open_here(open.data() + base, index.offsets[a + 1] - base);
+    if (std::none_of(open_here.begin(), open_here.end(), [](std::uint8_t o) { return o != 0; })) continue;
     const MergedMesh later = merge_selection(input.meshes, index, added_so_far);
     const MeshProximity near_later(later.mesh, reach);
     const Mesh& mesh = input.meshes[a];
@@ -127,7 +125,7 @@ HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& s
   // What another pass saw through is not put back: mostly facets one pass strung across a
   // window recess that another pass saw into (they lie on no surface), which the fill would
   // otherwise add as a second sheet standing in front of the selection.
-  const mosaic_detail::SeenThroughParams visibility{.margin = input.distance_threshold, .depth = 1.0};
+  const mosaic_detail::SeenThroughParams visibility{.margin = input.distance_threshold};
   return add_uncovered(input, order, selected, &visibility);
 }
 

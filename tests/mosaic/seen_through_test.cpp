@@ -123,10 +123,7 @@ TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
       bool expected = false;
       for (std::size_t m = 1; m < meshes.size() && !expected; ++m) {
         for (std::size_t t = 0; t < meshes[m].triangle_count() && !expected; ++t) {
-          const Triangle& tri = meshes[m].triangles[t];
-          const Vec3d v = (Vec3d(meshes[m].sensor_positions[tri[0]]) + Vec3d(meshes[m].sensor_positions[tri[1]]) +
-                           Vec3d(meshes[m].sensor_positions[tri[2]])) / 3.0;
-          expected = brute_force_seen(p, v, meshes[m].corners(t), params);
+          expected = brute_force_seen(p, meshes[m].viewpoint(t), meshes[m].corners(t), params);
         }
       }
       EXPECT_EQ(seen[i] != 0, expected) << "scene " << scene << ", triangle " << i;

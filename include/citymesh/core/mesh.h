@@ -70,6 +70,12 @@ struct Mesh {
     const Triangle& tri = triangles[t];
     return {Vec3d(positions[tri[0]]), Vec3d(positions[tri[1]]), Vec3d(positions[tri[2]])};
   }
+  /// Triangle t's viewpoint in the local frame: the barycentre of its corners' sensor
+  /// positions (its empty space is the tetrahedron between it and this point).
+  [[nodiscard]] Vec3d viewpoint(std::size_t t) const {
+    const Triangle& tri = triangles[t];
+    return (Vec3d(sensor_positions[tri[0]]) + Vec3d(sensor_positions[tri[1]]) + Vec3d(sensor_positions[tri[2]])) / 3.0;
+  }
   [[nodiscard]] Vec3d world_sensor_position(std::size_t v) const {
     return origin + Vec3d(sensor_positions[v]);
   }

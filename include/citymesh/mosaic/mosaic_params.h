@@ -36,7 +36,8 @@ struct MosaicParams {
   /// times the change step's distance threshold.
   double stitch_reach = 2.0;
   /// After the energy mosaic, kept triangles with nothing selected within the distance
-  /// threshold are added back (newest acquisition first).
+  /// threshold are added back (newest acquisition first), unless another pass saw through
+  /// them (fill_holes() in mosaic.h).
   bool fill_holes = true;
   /// Before stitching, the parts of pieces lying over the surface of a source with more
   /// triangles in the mosaic (within clip_reach times the distance threshold) are cut away,
