@@ -163,7 +163,7 @@ std::vector<Triangle> triangulate(const MeshTopology& topo, const Loop& loop, co
 /// triangle on that edge takes the loop's other edges (reversed) as its own. This closes the
 /// loops no fill can: the slivers where two sources' boundaries cross, so that the loop
 /// winds the wrong way round (an overlap, not a hole) and any fill would face backwards.
-bool close_by_split(MeshTopology& topo, const Loop& loop) {
+bool close_by_split(MeshTopology& topo, const Loop& loop, double max_move) {
   const std::size_t n = loop.vertices.size();
   std::size_t longest = 0;
   double longest_length = -1;
@@ -181,7 +181,7 @@ bool close_by_split(MeshTopology& topo, const Loop& loop) {
   for (std::size_t k = n - 1; k >= 2; --k) inserted.push_back(loop.vertices[(longest + k) % n]);
   // The split moves the edge to -> apex to a new triangle, while the successor lists still
   // name the old one. Only its source and facing are read later, and the fan keeps both.
-  return split_boundary_edge(topo, from, to, inserted);
+  return split_boundary_edge_onto(topo, from, to, inserted, max_move);
 }
 
 }  // namespace
@@ -210,7 +210,7 @@ GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params) {
     if (!(norm(newell) > 0) || !is_seam_gap(topo, loop, newell, params)) continue;
     const std::vector<Triangle> fill = triangulate(topo, loop, newell);
     if (fill.empty()) {
-      if (close_by_split(topo, loop)) {
+      if (close_by_split(topo, loop, params.max_width)) {
         ++stats.gaps_split;
       } else {
         ++stats.gaps_refused;

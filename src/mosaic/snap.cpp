@@ -155,6 +155,17 @@ std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const
   return out;
 }
 
+/// Moves v to q unless one of its triangles would flip or degenerate.
+bool try_move(MeshTopology& topo, std::uint32_t v, const Vec3d& q) {
+  const auto moved = [&](std::uint32_t u) { return u == v ? q : topo.position(u); };
+  for (const std::uint32_t t : topo.triangles_of(v)) {
+    const Triangle& tri = topo.triangle(t);
+    if (!acceptable(topo.winding(tri), normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
+  }
+  topo.merged().mesh.positions[v] = Vec3f(q);
+  return true;
+}
+
 /// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
 void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<DirectedEdge> edges = topo.boundary_half_edges();
@@ -164,7 +175,7 @@ void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& st
     std::vector<std::uint32_t> inserted;
     for (; j < insertions.size() && insertions[j].edge == insertions[i].edge; ++j) inserted.push_back(insertions[j].vertex);
     const DirectedEdge& e = edges[insertions[i].edge];
-    if (split_boundary_edge(topo, e.from, e.to, inserted)) {
+    if (split_boundary_edge_onto(topo, e.from, e.to, inserted, tolerance)) {
       ++stats.edges_split;
     } else {
       ++stats.rejected;
@@ -212,6 +223,26 @@ bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t t
   topo.edit(chain[1]).push_back(t);
   std::erase(topo.edit(to), t);
   return true;
+}
+
+bool split_boundary_edge_onto(MeshTopology& topo, std::uint32_t from, std::uint32_t to,
+                              const std::vector<std::uint32_t>& inserted, double max_move) {
+  if (split_boundary_edge(topo, from, to, inserted)) return true;
+  std::vector<std::pair<std::uint32_t, Vec3f>> saved;
+  const Vec3d a = topo.position(from), ab = topo.position(to) - a;
+  const double len2 = dot(ab, ab);
+  bool moved = len2 > 0;
+  for (std::size_t k = 0; k < inserted.size() && moved; ++k) {
+    const std::uint32_t v = inserted[k];
+    const Vec3d p = topo.position(v);
+    const double t = dot(p - a, ab) / len2;
+    const Vec3d q = a + ab * t;
+    saved.emplace_back(v, topo.merged().mesh.positions[v]);
+    moved = t > 0 && t < 1 && norm(q - p) <= max_move && try_move(topo, v, q);
+  }
+  if (moved && split_boundary_edge(topo, from, to, inserted)) return true;
+  for (const auto& [v, p] : saved) topo.merged().mesh.positions[v] = p;
+  return false;
 }
 
 SnapStats snap_boundaries(MeshTopology& topo, double tolerance) {

@@ -23,10 +23,18 @@ struct SnapStats {
 /// or reuse a directed edge; the pieces keep its provenance. Returns whether it did.
 bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted);
 
+/// As split_boundary_edge; when that fails (typically where two boundaries cross, so that the
+/// vertices lie inside the triangle and the fan would fold back), the vertices are first moved
+/// onto the edge, by at most `max_move` each and only if none of their own triangles flips or
+/// degenerates. The moves are undone if the split still fails. Returns whether it split.
+bool split_boundary_edge_onto(MeshTopology& topo, std::uint32_t from, std::uint32_t to,
+                              const std::vector<std::uint32_t>& inserted, double max_move);
+
 /// First merges each boundary vertex with the nearest boundary vertex of another source
 /// within `tolerance` (both move to their midpoint), then splits each boundary edge at the
 /// boundary vertices of other sources within `tolerance` of it (the edge's triangle becomes a
-/// fan; the new triangles keep its provenance). An operation is skipped when a triangle would
+/// fan; the new triangles keep its provenance; where that fan would fold, as over a sliver cut
+/// triangle, the vertices are moved onto the edge first: split_boundary_edge_onto). An operation is skipped when a triangle would
 /// flip or degenerate, or a directed edge would be used twice (the mesh stays edge-manifold
 /// and consistently oriented). Deterministic: vertices and edges in index order. The mesh is
 /// topo's, which is kept up to date.

@@ -11,6 +11,7 @@
 #include "citymesh/core/geometry.h"
 #include "clip.h"
 #include "gap_fill.h"
+#include "snap.h"
 
 namespace citymesh {
 namespace {
@@ -32,6 +33,16 @@ void add_grid(MergedMesh& out, float x0, float y0, int nx, int ny, float step, s
         out.source_triangle.push_back(static_cast<std::int32_t>(out.source_triangle.size()));
       }
     }
+  }
+}
+
+/// Appends `tris` (indices into m's positions) with source `source`.
+void add_triangles(MergedMesh& m, std::int32_t source, std::initializer_list<Triangle> tris) {
+  for (const Triangle& t : tris) {
+    m.mesh.triangles.push_back(t);
+    m.mesh.triangle_ids.push_back({});
+    m.source_acq.push_back(source);
+    m.source_triangle.push_back(static_cast<std::int32_t>(m.source_triangle.size()));
   }
 }
 
@@ -371,16 +382,8 @@ TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
                       {0.25f, 0.01f, 0},                                     // x
                       {-0.25f, 0.5f, 0}, {0.25f, 0.5f, 0}, {0.75f, 0.5f, 0},  // c0 c1 c2
                       {-0.25f, -0.5f, 0}, {0.25f, -0.5f, 0}, {0.75f, -0.5f, 0}};  // d0 d1 d2
-  const auto add = [&](std::int32_t source, std::initializer_list<Triangle> tris) {
-    for (const Triangle& t : tris) {
-      m.mesh.triangles.push_back(t);
-      m.mesh.triangle_ids.push_back({});
-      m.source_acq.push_back(source);
-      m.source_triangle.push_back(static_cast<std::int32_t>(m.source_triangle.size()));
-    }
-  };
-  add(0, {{0, 1, 5}, {1, 2, 6}, {2, 3, 7}, {1, 6, 5}, {2, 7, 6}});
-  add(1, {{1, 0, 8}, {2, 4, 9}, {4, 1, 9}, {3, 2, 10}, {1, 8, 9}, {2, 9, 10}});
+  add_triangles(m, 0, {{0, 1, 5}, {1, 2, 6}, {2, 3, 7}, {1, 6, 5}, {2, 7, 6}});
+  add_triangles(m, 1, {{1, 0, 8}, {2, 4, 9}, {4, 1, 9}, {3, 2, 10}, {1, 8, 9}, {2, 9, 10}});
   const double outline = open_boundary_length(m.mesh) - 0.5 - 2 * std::hypot(0.25, 0.01);
   const mosaic_detail::GapFillStats s = fill_gaps(m);
   EXPECT_EQ(s.gaps_filled, 0u);
@@ -394,6 +397,49 @@ TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
     EXPECT_GT(cross(c[1] - c[0], c[2] - c[0]).z, 0) << "triangle " << t << " faces down";
   }
   EXPECT_EQ(std::count(m.source_acq.begin(), m.source_acq.end(), 0), 6);  // the split keeps provenance
+}
+
+/// Source 0 (above y = 0) ends in a sliver cut triangle a -> b -> s, its apex s 5 mm above
+/// the edge; source 1 (below) reaches 1 cm above the edge at x, past the apex, as where two
+/// clipped boundaries zigzag across each other.
+MergedMesh sliver_and_crossing_vertex() {
+  MergedMesh m;
+  m.mesh.positions = {{0, 0, 0},     {0.5f, 0, 0},    {0.25f, 0.005f, 0}, {0, 0.5f, 0}, {0.5f, 0.5f, 0},  // a b s c0 c1
+                      {0, 0, 0},     {0.25f, 0.01f, 0}, {0.5f, 0, 0},                                     // a1 x b1
+                      {0, -0.5f, 0}, {0.5f, -0.5f, 0}};                                                  // d0 d1
+  add_triangles(m, 0, {{0, 1, 2}, {0, 2, 3}, {2, 1, 4}, {2, 4, 3}});
+  add_triangles(m, 1, {{5, 8, 6}, {8, 9, 6}, {6, 9, 7}});
+  return m;
+}
+
+TEST(Snap, MovesAVertexOntoTheEdgeWhenSplittingAroundItWouldFlipASliver) {
+  MergedMesh plain = sliver_and_crossing_vertex();
+  mosaic_detail::MeshTopology plain_topo(plain);
+  EXPECT_FALSE(mosaic_detail::split_boundary_edge(plain_topo, 0, 1, {6}));  // (a, x, s) would face down
+
+  MergedMesh m = sliver_and_crossing_vertex();
+  mosaic_detail::MeshTopology topo(m);
+  const mosaic_detail::SnapStats s = mosaic_detail::snap_boundaries(topo, 0.05);
+  EXPECT_EQ(s.vertices_merged, 2u);  // a and b with their twins
+  EXPECT_EQ(s.edges_split, 1u);
+  EXPECT_EQ(m.mesh.positions[6], (Vec3f{0.25f, 0, 0}));  // x moved onto a -> b
+  EXPECT_NEAR(open_boundary_length(m.mesh), 3.0, 1e-6);  // only the outline of the union
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    EXPECT_GT(cross(c[1] - c[0], c[2] - c[0]).z, 0) << "triangle " << t << " faces down";
+  }
+}
+
+TEST(Snap, LeavesAVertexWhereMovingItOntoTheEdgeWouldFlipItsOwnTriangle) {
+  MergedMesh m = sliver_and_crossing_vertex();
+  m.mesh.positions[8] = {0.24f, 0.005f, 0};  // d0 just beside x, below its line: moving x down flips (d0, d1, x)
+  m.mesh.positions[9] = {0.5f, -0.5f, 0};
+  mosaic_detail::MeshTopology topo(m);
+  const Vec3f x = m.mesh.positions[6];
+  EXPECT_FALSE(mosaic_detail::split_boundary_edge_onto(topo, 0, 1, {6}, 0.05));
+  EXPECT_EQ(m.mesh.positions[6], x);  // the move is undone
+  EXPECT_EQ(m.mesh.triangle_count(), 7u);
 }
 
 }  // namespace
