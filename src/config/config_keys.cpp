@@ -234,8 +234,11 @@ std::vector<KeyDef> make_keys() {
       "clipping cuts a piece where a larger source's surface lies within this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.clip_reach; }, 0.1, 10));
   keys.push_back(bool_key(mosaic, "close_gaps",
-      "after stitching, triangulate the small holes left between pieces of several sources (up to distance_threshold wide)",
+      "after stitching, triangulate the small holes left between pieces of several sources (up to gap_width wide)",
       [](auto& c) -> auto& { return c.mosaic.close_gaps; }));
+  keys.push_back(real_key(mosaic, "gap_width",
+      "gap closing takes holes up to this times distance_threshold wide (twice the area over the perimeter) and twenty times that around",
+      [](auto& c) -> auto& { return c.mosaic.gap_width; }, 0.1, 10));
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));

@@ -49,8 +49,13 @@ struct MosaicParams {
   /// (99.97 %, as at 1x; within 10 cm: 99.90 -> 99.85 %). docs/mosaic.md has the sweep.
   double clip_reach = 2.0;
   /// After stitching, the small holes still enclosed by boundaries of more than one source
-  /// (at most the distance threshold wide, twenty times it around) are triangulated.
+  /// (at most gap_width times the distance threshold wide, twenty times that around) are
+  /// triangulated.
   bool close_gaps = true;
+  /// Three times the threshold: the gaps left between clipped boundaries are up to about
+  /// two clip reaches wide; on the demo street 1x leaves 163 m of open seams, 2x 155 m, 3x
+  /// 151 m and 5x the same (every fill triangle lies within 5 cm of an input surface).
+  double gap_width = 3.0;
 };
 
 std::string_view quality_measure_name(QualityMeasure q);
