@@ -32,8 +32,9 @@ struct GapFillStats {
 /// two boundary edges) a loop follows its own hole. When the fill would turn against the
 /// triangle across one of its loop edges (a loop winding the wrong way, where two boundaries
 /// cross), degenerate or reuse a directed edge, the loop is closed instead by splitting its
-/// longest edge at its other vertices (split_boundary_edge), or left open when that would
-/// flip a triangle. New fill triangles have source kNoSource; split ones keep theirs.
+/// longest edge at its other vertices (split_boundary_edge_onto: moved onto it if need be,
+/// by at most max_width), or left open when that would flip a triangle. New fill triangles
+/// have source kNoSource; split ones keep theirs.
 /// Deterministic: loops are taken from their smallest half-edge, in increasing order.
 GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params);
 
