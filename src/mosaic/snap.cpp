@@ -37,11 +37,24 @@ std::vector<std::uint32_t> vertices_of(std::span<const DirectedEdge> edges) {
   return out;
 }
 
+/// Whether every triangle around `movers` stays acceptable when all of them move to q.
+bool moves_acceptable(const MeshTopology& topo, std::initializer_list<std::uint32_t> movers, const Vec3d& q) {
+  const auto moved = [&](std::uint32_t u) {
+    return std::find(movers.begin(), movers.end(), u) != movers.end() ? q : topo.position(u);
+  };
+  for (const std::uint32_t u : movers) {
+    for (const std::uint32_t t : topo.triangles_of(u)) {
+      const Triangle& tri = topo.triangle(t);
+      if (!acceptable(topo.winding(tri), normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
+    }
+  }
+  return true;
+}
+
 /// Makes w one with v at their midpoint, unless a triangle of either would flip or
 /// degenerate or a directed edge would be used twice.
 bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   const Vec3d mid = (topo.position(v) + topo.position(w)) * 0.5;
-  const auto moved = [&](std::uint32_t u) { return u == v || u == w ? mid : topo.position(u); };
   std::vector<Triangle> renamed;
   const std::vector<std::uint32_t> around_w(topo.triangles_of(w).begin(), topo.triangles_of(w).end());
   for (const std::uint32_t t : around_w) {
@@ -50,14 +63,7 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
     if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) return false;  // v and w share it
     renamed.push_back(tri);
   }
-  for (const std::uint32_t u : {v, w}) {
-    for (const std::uint32_t t : topo.triangles_of(u)) {
-      const Triangle& tri = topo.triangle(t);
-      const Vec3d before = topo.winding(tri);
-      if (!acceptable(before, normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
-    }
-  }
-  if (!topo.edges_free(renamed, around_w)) return false;
+  if (!moves_acceptable(topo, {v, w}, mid) || !topo.edges_free(renamed, around_w)) return false;
   std::vector<std::uint32_t>& around_v = topo.edit(v);
   for (std::size_t i = 0; i < renamed.size(); ++i) {
     topo.merged().mesh.triangles[around_w[i]] = renamed[i];
@@ -157,11 +163,7 @@ std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const
 
 /// Moves v to q unless one of its triangles would flip or degenerate.
 bool try_move(MeshTopology& topo, std::uint32_t v, const Vec3d& q) {
-  const auto moved = [&](std::uint32_t u) { return u == v ? q : topo.position(u); };
-  for (const std::uint32_t t : topo.triangles_of(v)) {
-    const Triangle& tri = topo.triangle(t);
-    if (!acceptable(topo.winding(tri), normal_of(moved(tri[0]), moved(tri[1]), moved(tri[2])))) return false;
-  }
+  if (!moves_acceptable(topo, {v}, q)) return false;
   topo.merged().mesh.positions[v] = Vec3f(q);
   return true;
 }
@@ -186,9 +188,15 @@ void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& st
 
 }  // namespace
 
-bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
+namespace {
+
+/// How a split went: only a fan that folds (a vertex on the wrong side of a thin triangle)
+/// can be mended by moving the vertices; the other refusals depend on the topology alone.
+enum class Split { done, folds, refused };
+
+Split split_fan(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
   const std::optional<std::uint32_t> found = topo.triangle_with(from, to);
-  if (!found) return false;
+  if (!found) return Split::refused;
   const std::uint32_t t = *found;
   const Triangle old = topo.triangle(t);
   int k = 0;
@@ -200,12 +208,12 @@ bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t t
   chain.push_back(to);
   std::vector<Triangle> fan;
   for (std::size_t i = 0; i + 1 < chain.size(); ++i) {
-    if (chain[i + 1] == apex) return false;
+    if (chain[i + 1] == apex) return Split::refused;
     fan.push_back({chain[i], chain[i + 1], apex});
     const Vec3d after = topo.winding(fan.back());
-    if (dot(before, after) <= 0 || norm(after) < 1e-3 * norm(before)) return false;
+    if (dot(before, after) <= 0 || norm(after) < 1e-3 * norm(before)) return Split::folds;
   }
-  if (!topo.edges_free(fan, std::span(&t, 1))) return false;
+  if (!topo.edges_free(fan, std::span(&t, 1))) return Split::refused;
   MergedMesh& m = topo.merged();
   for (std::size_t i = 0; i < fan.size(); ++i) {
     const std::uint32_t slot = i == 0 ? t : static_cast<std::uint32_t>(m.mesh.triangle_count());
@@ -222,12 +230,21 @@ bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t t
   // Triangle t now spans from, the first inserted vertex and the apex.
   topo.edit(chain[1]).push_back(t);
   std::erase(topo.edit(to), t);
-  return true;
+  return Split::done;
+}
+
+}  // namespace
+
+bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted) {
+  return split_fan(topo, from, to, inserted) == Split::done;
 }
 
 bool split_boundary_edge_onto(MeshTopology& topo, std::uint32_t from, std::uint32_t to,
                               const std::vector<std::uint32_t>& inserted, double max_move) {
-  if (split_boundary_edge(topo, from, to, inserted)) return true;
+  // A refusal for the topology's sake (an edge in use, the apex among the vertices) would
+  // come again after any move: moving is tried only for a fan that folds.
+  const Split first = split_fan(topo, from, to, inserted);
+  if (first != Split::folds) return first == Split::done;
   std::vector<std::pair<std::uint32_t, Vec3f>> saved;
   const Vec3d a = topo.position(from), ab = topo.position(to) - a;
   const double len2 = dot(ab, ab);

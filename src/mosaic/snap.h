@@ -23,10 +23,11 @@ struct SnapStats {
 /// or reuse a directed edge; the pieces keep its provenance. Returns whether it did.
 bool split_boundary_edge(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const std::vector<std::uint32_t>& inserted);
 
-/// As split_boundary_edge; when that fails (typically where two boundaries cross, so that the
-/// vertices lie inside the triangle and the fan would fold back), the vertices are first moved
-/// onto the edge, by at most `max_move` each and only if none of their own triangles flips or
-/// degenerates. The moves are undone if the split still fails. Returns whether it split.
+/// As split_boundary_edge; when the fan would fold or degenerate (typically the edge's
+/// triangle is a thin cut triangle and a vertex lies beyond its apex, where two clipped
+/// boundaries cross), the vertices are first moved onto the edge, by at most `max_move` each
+/// and only if none of their own triangles flips or degenerates. The moves are undone if the
+/// split still fails. Returns whether it split.
 bool split_boundary_edge_onto(MeshTopology& topo, std::uint32_t from, std::uint32_t to,
                               const std::vector<std::uint32_t>& inserted, double max_move);
 
