@@ -68,7 +68,9 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
   summary["weights"] = {{"quality", config.mosaic.quality_weight},
                         {"boundary", config.mosaic.boundary_weight},
                         {"overlap", config.mosaic.overlap_weight},
-                        {"seam", config.mosaic.seam_weight}};
+                        {"seam", config.mosaic.seam_weight},
+                        {"crease", config.mosaic.crease_weight}};
+  summary["crease_angle"] = config.mosaic.crease_angle;
   std::vector<std::uint64_t> per_source(input.acquisitions.size(), 0);
   std::uint64_t stitched = 0;
   for (const std::int32_t a : merged.source_acq) {

@@ -218,6 +218,12 @@ std::vector<KeyDef> make_keys() {
       [](auto& c) -> auto& { return c.mosaic.overlap_weight; }, 0, 1e9));
   keys.push_back(real_key(mosaic, "seam_weight", "lambda 4: cost per mean edge length of seam inside a mesh",
       [](auto& c) -> auto& { return c.mosaic.seam_weight; }, 0, 1e6));
+  keys.push_back(real_key(mosaic, "crease_angle",
+      "a seam inside a mesh is along a crease where its two triangles' normals are more than this apart (degrees)",
+      [](auto& c) -> auto& { return c.mosaic.crease_angle; }, 0, 180));
+  keys.push_back(real_key(mosaic, "crease_weight",
+      "a seam along a crease costs this times seam_weight, so that pieces end on flat surface rather than at corners (1: off)",
+      [](auto& c) -> auto& { return c.mosaic.crease_weight; }, 0, 1e6));
   keys.push_back(count_key(mosaic, "sweeps", "sweeps of group moves at most (each re-solves every acquisition against what is kept)",
       [](auto& c) -> auto& { return c.mosaic.sweeps; }, 1, 100));
   keys.push_back(real_key(mosaic, "stitch_reach",

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <numbers>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
@@ -49,6 +50,24 @@ struct TriangleShape {
   double area = 0, longest_edge = 0;
   Vec3f centroid;
 };
+
+/// Where a seam inside a mesh costs more: along a crease.
+struct Crease {
+  double cos_angle;  ///< the two triangles' normals are further apart than this cosine
+  double weight;
+};
+
+/// The seam term's factor for the edge two triangles of m share: crease.weight along a
+/// crease, else 1. A seam at a corner leaves each pass's own chamfer to meet the other's.
+double seam_factor(const Mesh& m, const mosaic_detail::SharedEdge& s, const Crease& crease) {
+  const auto normal = [&](std::uint32_t t) {
+    const auto [p, q, r] = m.corners(t);
+    return cross(q - p, r - p);
+  };
+  const Vec3d na = normal(s.a), nb = normal(s.b);
+  const double scale = norm(na) * norm(nb);
+  return scale > 0 && dot(na, nb) < crease.cos_angle * scale ? crease.weight : 1.0;
+}
 
 TriangleShape shape(const Mesh& m, std::size_t t) {
   const auto [a, b, c] = m.corners(t);
@@ -150,9 +169,10 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   std::size_t seam_count = 0;
   for (const MeshEdges& e : edges) seam_count += e.shared.size();
   out.energy.pairs.reserve(seam_count + change.consistent_pairs.size());  // ~50 MB: no regrowth copies
+  const Crease crease{std::cos(params.crease_angle * std::numbers::pi / 180.0), params.crease_weight};
   for (std::size_t a = 0; a < edges.size(); ++a) {
     for (const auto& s : edges[a].shared) {
-      const double w = params.seam_weight * s.length / unit;
+      const double w = params.seam_weight * s.length / unit * seam_factor(input.meshes[a], s, crease);
       out.energy.pairs.push_back({variable_of[index.offsets[a] + s.a], variable_of[index.offsets[a] + s.b], 0, w, w, 0});
     }
   }

@@ -5,25 +5,14 @@
 #include <cmath>
 
 #include "citymesh/mosaic/mosaic.h"
+#include "grid_triangles.h"
 
 namespace citymesh {
 namespace {
 
 /// A flat grid of nx x ny cells of size `step` from (x0, 0) at height z.
 Mesh grid(float x0, int nx, int ny, float step, float z) {
-  Mesh m;
-  for (int j = 0; j <= ny; ++j) {
-    for (int i = 0; i <= nx; ++i) m.positions.push_back({x0 + float(i) * step, float(j) * step, z});
-  }
-  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (nx + 1) + i); };
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
-      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
-    }
-  }
-  m.triangle_ids.resize(m.triangles.size());
-  return m;
+  return test::placed_grid(nx, ny, [=](int i, int j) { return Vec3f{x0 + float(i) * step, float(j) * step, z}; });
 }
 
 TEST(FillHoles, AddsNewestTrianglesWhereNothingSelectedIsNear) {

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-// Triangulated vertex grids, the test meshes of the encode and tiles3d tests.
+// Triangulated vertex grids, the test meshes of the encode, tiles3d and mosaic tests.
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "citymesh/core/mesh.h"
@@ -28,6 +29,26 @@ std::vector<Triangle> grid_triangles(int n, Keep keep) {
 
 inline std::vector<Triangle> grid_triangles(int n) {
   return grid_triangles(n, [](int, int) { return true; });
+}
+
+/// A grid of columns x rows cells whose vertex (i, j) is numbered j (columns + 1) + i and sits
+/// at place(i, j): two triangles per cell, {(i, j), (i + 1, j), (i + 1, j + 1)} then
+/// {(i, j), (i + 1, j + 1), (i, j + 1)}, cells row by row (cell (i, j) holds triangles
+/// 2 (j columns + i) and the next). A flat grid, or one folded wherever place bends.
+inline Mesh placed_grid(int columns, int rows, const std::function<Vec3f(int, int)>& place) {
+  Mesh m;
+  for (int j = 0; j <= rows; ++j) {
+    for (int i = 0; i <= columns; ++i) m.positions.push_back(place(i, j));
+  }
+  const auto id = [&](int i, int j) { return static_cast<std::uint32_t>(j * (columns + 1) + i); };
+  for (int j = 0; j < rows; ++j) {
+    for (int i = 0; i < columns; ++i) {
+      m.triangles.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1)});
+      m.triangles.push_back({id(i, j), id(i + 1, j + 1), id(i, j + 1)});
+    }
+  }
+  m.triangle_ids.resize(m.triangles.size());
+  return m;
 }
 
 }  // namespace citymesh::test
