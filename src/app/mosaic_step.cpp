@@ -38,6 +38,7 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
                                         .reach = reach,
                                         .weld = kWeldInThresholds * config.change.distance_threshold,
                                         .clip = config.mosaic.clip_overlaps ? config.mosaic.clip_reach * config.change.distance_threshold : 0.0,
+                                        .clip_angle = config.mosaic.clip_angle,
                                         .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0});
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "

@@ -239,6 +239,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(real_key(mosaic, "clip_reach",
       "clipping cuts a piece where a larger source's surface lies within this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.clip_reach; }, 0.1, 10));
+  keys.push_back(real_key(mosaic, "clip_angle",
+      "clipping cuts a piece only where its normal is within this of the larger source's (degrees; a wall on the ground, 90, is not cut)",
+      [](auto& c) -> auto& { return c.mosaic.clip_angle; }, 0, 90));
   keys.push_back(bool_key(mosaic, "close_gaps",
       "after stitching, triangulate the small holes left between pieces of several sources (up to gap_width wide)",
       [](auto& c) -> auto& { return c.mosaic.close_gaps; }));

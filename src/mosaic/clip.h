@@ -13,9 +13,10 @@ namespace citymesh::mosaic_detail {
 struct ClipParams {
   double tolerance = 0.1;           ///< metres: how far apart two surfaces may be and still be one
   /// Largest angle between their normals. Two meshes of one corner put their chamfers in
-  /// different places, so a chamfer of one (about 45 degrees) lies over a face of the other;
-  /// steeper surfaces meet the other one (a wall on the ground) and are not cut.
-  double max_angle_deg = 60.0;
+  /// different places, so a chamfer of one (about 45 degrees) lies over a face of the other,
+  /// as do the steep facets one pass strings across a window recess; a wall on the ground
+  /// (90 degrees) meets the other surface and is not cut.
+  double max_angle_deg = 80.0;
   double min_edge_fraction = 0.1;   ///< a cut stays this fraction of an edge away from its ends
 };
 

@@ -251,7 +251,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
     unclipped.reset();
-    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip});
+    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle});
   }
   mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);

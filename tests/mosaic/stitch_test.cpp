@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <random>
 
 #include "citymesh/core/geometry.h"
@@ -218,20 +219,35 @@ TEST(Clip, LeavesCrossingAndDistantSurfacesAlone) {
   EXPECT_EQ(m.mesh.triangles, before.mesh.triangles);
 }
 
-/// A 1 m x 1 m grid of source 1 and a 0.4 m x 0.4 m grid of source 0 rising from it at 45
-/// degrees, from 2 cm above it: another mesh's chamfer over the same corner of a facade.
-MergedMesh slanted_piece() {
+/// A 1 m x 1 m grid of source 1 and a 0.4 m x 0.4 m grid of source 0 rising from it at
+/// `degrees`, from 2 cm above it: another mesh's chamfer over the same corner of a facade (45
+/// degrees), or a facet one pass strung across a recess (steeper).
+MergedMesh slanted_piece(double degrees = 45) {
   MergedMesh m;
   add_grid(m, 0, 0, 10, 10, 0.1f, 1);
   const std::size_t first = m.mesh.positions.size();
   add_grid(m, 0.3f, 0.3f, 4, 4, 0.1f, 0);
-  const float slope = std::sqrt(0.5f);
+  const double angle = degrees * std::numbers::pi / 180.0;
   for (std::size_t v = first; v < m.mesh.positions.size(); ++v) {
     Vec3f& p = m.mesh.positions[v];
-    const float along = p.x - 0.3f;
-    p = {0.3f + along * slope, p.y, 0.02f + along * slope};
+    const double along = p.x - 0.3f;
+    p = {static_cast<float>(0.3 + along * std::cos(angle)), p.y, static_cast<float>(0.02 + along * std::sin(angle))};
   }
   return m;
+}
+
+TEST(Clip, CutsFacetsUpTo80DegreesSteepByDefault) {
+  // A facet at 70 degrees over the grid: left alone at a 60 degree limit, cut back to where it
+  // rises above the tolerance at the default 80.
+  MergedMesh at60 = slanted_piece(70);
+  const mosaic_detail::ClipStats none = mosaic_detail::clip_overlaps(at60, {.tolerance = 0.1, .max_angle_deg = 60});
+  EXPECT_EQ(none.triangles_cut + none.triangles_removed, 0u);
+  MergedMesh m = slanted_piece(70);
+  const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.1});
+  EXPECT_GT(s.triangles_cut, 0u);
+  const double cut_at = 0.08 / std::sin(70 * std::numbers::pi / 180.0);
+  EXPECT_NEAR(area_of(m, 0), (0.4 - cut_at) * 0.4, 2e-4);
+  EXPECT_NEAR(area_of(m, 1), 1.0, 1e-6);
 }
 
 TEST(Clip, CutsASlantedPieceBackToTheToleranceAndLeavesSteeperOnesAlone) {

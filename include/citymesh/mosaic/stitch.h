@@ -15,8 +15,9 @@ struct StitchParams {
   double reach = 0.2;   ///< metres: boundaries of different sources closer than this are joined
   double weld = 0.005;  ///< metres: strip corners closer than this become one vertex
   /// metres: where a piece lies within this of a larger source's surface (normals within
-  /// 60 degrees), the covered part is cut away first so that the boundaries meet; 0: off
+  /// clip_angle), the covered part is cut away first so that the boundaries meet; 0: off
   double clip = 0.0;
+  double clip_angle = 80.0;  ///< degrees
   /// metres: small holes left between pieces of several sources, up to this wide (and 20
   /// times this around), are triangulated last; 0: off
   double gap = 0.0;
