@@ -74,11 +74,15 @@ TEST_F(ClusterRun, ThreeMpiRanksGiveTheBytesOfOneProcess) {
 
 TEST_F(ClusterRun, AKilledRankLosesOnlyItsWorkInFlight) {
   if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
-  // Kill the newest rank (SIGKILL) while the job runs: mpirun ends the job with an error.
+  // Kill the newest rank (SIGKILL) while the job runs, as soon as a first tile is finished
+  // (waiting for it rather than a fixed time: on a loaded machine a fixed sleep killed it
+  // before any tile was done): mpirun ends the job with an error.
   const std::filesystem::path script = *dir_ / "kill.sh";
-  test::write_text(script, fmt::format("{} run {} > /dev/null 2>&1 &\njob=$!\nsleep 2.5\n"
+  const std::string results = (output("work-kill") / "results").string();
+  test::write_text(script, fmt::format("{} run {} > /dev/null 2>&1 &\njob=$!\n"
+                                       "for i in $(seq 1200); do ls {}/*.bin > /dev/null 2>&1 && break; sleep 0.05; done\n"
                                        "pkill -KILL -n -f 'citymesh run .*work-kill'\nwait $job\n",
-                                       mpirun(3), args(sim_, "kill")));
+                                       mpirun(3), args(sim_, "kill"), results));
   EXPECT_NE(std::system(("bash " + script.string()).c_str()), 0) << "the job survived a killed rank";
   ASSERT_FALSE(std::filesystem::exists(output("kill") / "run.json")) << "killed too late to test anything";
   const std::string again =
