@@ -71,6 +71,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                         {"seam", config.mosaic.seam_weight},
                         {"crease", config.mosaic.crease_weight}};
   summary["crease_angle"] = config.mosaic.crease_angle;
+  summary["seen_through_quality"] = config.mosaic.seen_through_quality;
   std::vector<std::uint64_t> per_source(input.acquisitions.size(), 0);
   std::uint64_t stitched = 0;
   for (const std::int32_t a : merged.source_acq) {
@@ -86,6 +87,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
     summary["acquisitions"].push_back(std::move(entry));
   }
   summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected}, {"filled", s.filled},
+                       {"seen_through", s.seen_through},
                        {"fill_seen_through", s.fill_seen_through},
                        {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
                        {"overlap_terms", s.overlap_terms}, {"seam_terms", s.seam_terms}};

@@ -64,6 +64,7 @@ namespace {
 void report(const std::filesystem::path& dir, const MergedMesh& merged, const MosaicStats& s) {
   std::cout << fmt::format("{}: {} triangles kept of {} candidates", dir.string(), merged.mesh.triangle_count(),
                            s.candidates);
+  if (s.seen_through > 0) std::cout << fmt::format(" ({} seen through by another pass)", s.seen_through);
   if (s.seam_terms + s.overlap_terms > 0) {
     std::cout << fmt::format("; energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f})",
                              s.energy, s.quality, s.boundary, s.seam, s.overlap);

@@ -224,6 +224,9 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(real_key(mosaic, "crease_weight",
       "a seam along a crease costs this times seam_weight, so that pieces end on flat surface rather than at corners (1: off)",
       [](auto& c) -> auto& { return c.mosaic.crease_weight; }, 0, 1e6));
+  keys.push_back(real_key(mosaic, "seen_through_quality",
+      "the quality Q of a candidate that another pass saw through (inside its empty space, as for fill_holes) is multiplied by this (1: off)",
+      [](auto& c) -> auto& { return c.mosaic.seen_through_quality; }, 0, 1));
   keys.push_back(count_key(mosaic, "sweeps", "sweeps of group moves at most (each re-solves every acquisition against what is kept)",
       [](auto& c) -> auto& { return c.mosaic.sweeps; }, 1, 100));
   keys.push_back(real_key(mosaic, "stitch_reach",

@@ -11,6 +11,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "internal.h"
 #include "mesh_edges.h"
+#include "seen_through.h"
 
 namespace citymesh {
 
@@ -150,6 +151,14 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   out.coordinate = slab_coordinates(shapes);
   const double mean_area = n > 0 && area_sum > 0 ? area_sum / double(n) : 1.0;
 
+  // Facets another pass saw through are worth less (seen_through_quality): the same check as
+  // the hole fill's, asked of every candidate.
+  std::vector<std::uint8_t> seen(n, 0);
+  if (params.seen_through_quality != 1.0) {
+    seen = mosaic_detail::seen_through(input.meshes, index, out.triangle_of, {.margin = input.distance_threshold});
+  }
+  out.stats.seen_through = static_cast<std::uint64_t>(std::count(seen.begin(), seen.end(), 1));
+
   out.energy.unary.resize(n);
   out.quality.resize(n);
   out.boundary.resize(n);
@@ -161,6 +170,7 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
       if (params.quality == QualityMeasure::resolution) {
         q = shapes[v].area / mean_area * unit / std::max(shapes[v].longest_edge, 1e-9);
       }
+      if (seen[v] != 0) q *= params.seen_through_quality;
       out.quality[v] = -params.quality_weight * q;
       out.boundary[v] = params.boundary_weight * edges[a].boundary_length[g - index.offsets[a]] / unit;
       out.energy.unary[v] = {0.0, out.quality[v] + out.boundary[v]};

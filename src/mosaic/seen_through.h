@@ -27,9 +27,8 @@ struct SeenThroughParams {
 /// space of a triangle of another mesh: inside the tetrahedron between that triangle and its
 /// viewpoint (the barycentre of its corners' sensor positions), more than params.margin and at
 /// most params.depth from the triangle's plane. Another pass then saw through the place where
-/// it stands. Only centroids within params.depth of that triangle's bounding box (on every
-/// axis) are looked at. Meshes without sensor positions see nothing. All meshes share one
-/// local frame. Deterministic whatever the thread count.
+/// it stands. Meshes without sensor positions see nothing. All meshes share one local frame.
+/// Deterministic whatever the thread count.
 std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const GlobalTriangles& index,
                                        std::span<const std::uint32_t> triangles, const SeenThroughParams& params);
 

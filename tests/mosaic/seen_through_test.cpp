@@ -72,8 +72,23 @@ TEST(SeenThrough, CentroidsInFrontOfAnotherPassSurfaceWithinItsEmptySpace) {
   EXPECT_EQ(seen_through(without, index, ids, {})[0], 0);
 }
 
+TEST(SeenThrough, FollowsGrazingRaysFarFromTheSurfaceTheyEndOn) {
+  // Pass 1 saw a floor triangle around the origin from 30 m away, 1 m up: its ray to the
+  // floor passes half a metre over the floor 15 m from it, far beyond the triangle's own box.
+  const std::vector<std::array<Vec3f, 3>> floor{{Vec3f{-1, -1, 0}, Vec3f{1, -1, 0}, Vec3f{0, 1, 0}}};
+  const Vec3f side{30, 0, 1};
+  const std::vector<Mesh> meshes{triangles_seen_from({around({15.0f, 0.0f, 0.5f}), around({15.0f, 3.0f, 0.5f})},
+                                                     {side, side}),
+                                 triangles_seen_from(floor, {side})};
+  GlobalTriangles index;
+  index.offsets = {0, 2, 3};
+  EXPECT_EQ(seen_through(meshes, index, std::vector<std::uint32_t>{0, 1}, {.margin = 0.1, .depth = 1.0}),
+            (std::vector<std::uint8_t>{1, 0}))
+      << "on the ray, and 3 m beside it";
+}
+
 /// Brute force: p inside the tetrahedron (v, q) when its barycentric coordinates are all
-/// positive, and between margin and depth from q's plane, and within depth of q's box.
+/// positive, and between margin and depth from q's plane.
 bool brute_force_seen(const Vec3d& p, const Vec3d& v, const std::array<Vec3d, 3>& q, const SeenThroughParams& params) {
   const auto det = [](const Vec3d& a, const Vec3d& b, const Vec3d& c) { return dot(a, cross(b, c)); };
   const double whole = det(q[0] - v, q[1] - v, q[2] - v);
@@ -83,14 +98,7 @@ bool brute_force_seen(const Vec3d& p, const Vec3d& v, const std::array<Vec3d, 3>
   if (b0 < 0 || b1 < 0 || b2 < 0 || b0 + b1 + b2 > 1) return false;
   const Vec3d n = cross(q[1] - q[0], q[2] - q[0]) / norm(cross(q[1] - q[0], q[2] - q[0]));
   const double h = std::abs(dot(p - q[0], n));
-  if (h <= params.margin || h > params.depth) return false;
-  for (int axis = 0; axis < 3; ++axis) {
-    const auto coord = [axis](const Vec3d& x) { return axis == 0 ? x.x : axis == 1 ? x.y : x.z; };
-    const double lo = std::min({coord(q[0]), coord(q[1]), coord(q[2])}) - params.depth;
-    const double hi = std::max({coord(q[0]), coord(q[1]), coord(q[2])}) + params.depth;
-    if (coord(p) < lo || coord(p) > hi) return false;
-  }
-  return true;
+  return h > params.margin && h <= params.depth;
 }
 
 TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
@@ -133,32 +141,62 @@ TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
   EXPECT_GT(seen_count, 50u) << "the scenes must exercise the positive case";
 }
 
-TEST(FillHoles, LeavesOutWhatAnotherPassSawThrough) {
-  // The selection (pass 1) is a floor seen from above; pass 0 (kept, not selected) has a
-  // floor of its own 0.3 m higher - more than the threshold away, so the fill would take it -
-  // which pass 1 saw through. With sensor positions it stays out; without, the fill takes it.
-  const std::vector<std::array<Vec3f, 3>> floor{{Vec3f{-2, -2, 0}, Vec3f{2, -2, 0}, Vec3f{2, 2, 0}},
-                                                {Vec3f{-2, -2, 0}, Vec3f{2, 2, 0}, Vec3f{-2, 2, 0}}};
-  std::vector<std::array<Vec3f, 3>> raised;
-  for (const Vec3f& p : {Vec3f{0.5f, 0.5f, 0.3f}, Vec3f{-0.5f, 0.2f, 0.3f}, Vec3f{5.0f, 5.0f, 0.3f}}) {
-    raised.push_back(around(p));
-  }
-  const Vec3f above{0, 0, 10};
-  std::vector<Mesh> meshes{triangles_seen_from(raised, std::vector<Vec3f>(3, above)),
-                           triangles_seen_from(floor, {above, above})};
-  const std::vector<TimePoint> dates{TimePoint(std::chrono::days(1)), TimePoint(std::chrono::days(40))};
+/// Pass 0: three small triangles 0.3 m up, the first two over pass 1's 4 m x 4 m floor (in its
+/// empty space, seen from 10 m above), the third beside it. Both passes kept, dates 1 and 40.
+struct RaisedOverFloor {
+  std::vector<Mesh> meshes;
+  std::vector<TimePoint> dates{TimePoint(std::chrono::days(1)), TimePoint(std::chrono::days(40))};
   ChangeResult change;
-  change.index.offsets = {0, 3, 5};
-  change.kept.assign(5, 1);
+  RaisedOverFloor() {
+    const std::vector<std::array<Vec3f, 3>> floor{{Vec3f{-2, -2, 0}, Vec3f{2, -2, 0}, Vec3f{2, 2, 0}},
+                                                  {Vec3f{-2, -2, 0}, Vec3f{2, 2, 0}, Vec3f{-2, 2, 0}}};
+    std::vector<std::array<Vec3f, 3>> raised;
+    for (const Vec3f& p : {Vec3f{0.5f, 0.5f, 0.3f}, Vec3f{-0.5f, 0.2f, 0.3f}, Vec3f{5.0f, 5.0f, 0.3f}}) {
+      raised.push_back(around(p));
+    }
+    const Vec3f above{0, 0, 10};
+    meshes = {triangles_seen_from(raised, std::vector<Vec3f>(3, above)), triangles_seen_from(floor, {above, above})};
+    change.index.offsets = {0, 3, 5};
+    change.kept.assign(5, 1);
+  }
+  [[nodiscard]] MosaicInput input() const { return {meshes, dates, &change, 0.1, {}}; }
+};
+
+TEST(FillHoles, LeavesOutWhatAnotherPassSawThrough) {
+  // The selection (pass 1) is a floor seen from above; pass 0 (kept, not selected) has
+  // triangles 0.3 m higher - more than the threshold away, so the fill would take them - of
+  // which pass 1 saw through the first two. With sensor positions they stay out; without,
+  // the fill takes them.
+  RaisedOverFloor scene;
   std::vector<std::uint8_t> selected{0, 0, 0, 1, 1};
-  const HoleFillCounts counts = fill_holes({meshes, dates, &change, 0.1, {}}, selected);
+  const HoleFillCounts counts = fill_holes(scene.input(), selected);
   EXPECT_EQ(counts.added, 1u);
   EXPECT_EQ(counts.seen_through, 2u);
   EXPECT_EQ(selected, (std::vector<std::uint8_t>{0, 0, 1, 1, 1})) << "only the one beside the floor";
 
-  for (Mesh& m : meshes) m.sensor_positions.clear();
+  for (Mesh& m : scene.meshes) m.sensor_positions.clear();
   std::vector<std::uint8_t> blind{0, 0, 0, 1, 1};
-  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, blind).added, 3u);
+  EXPECT_EQ(fill_holes(scene.input(), blind).added, 3u);
+}
+
+TEST(MosaicEnergy, ScalesTheQualityOfWhatAnotherPassSawThrough) {
+  // Pass 0's first two triangles stand in pass 1's empty space: their quality is multiplied
+  // by seen_through_quality, the others' is not, and with 1 nothing changes.
+  const RaisedOverFloor scene;
+  MosaicParams params;
+  params.quality_weight = 2;
+  params.seen_through_quality = 0.25;
+  const MosaicEnergy scaled = build_mosaic_energy(scene.input(), params);
+  EXPECT_EQ(scaled.stats.seen_through, 2u);
+  EXPECT_EQ(scaled.quality, (std::vector<double>{-0.5, -0.5, -2, -2, -2}));
+  params.seen_through_quality = 1;
+  const MosaicEnergy plain = build_mosaic_energy(scene.input(), params);
+  EXPECT_EQ(plain.stats.seen_through, 0u);
+  EXPECT_EQ(plain.quality, (std::vector<double>(5, -2.0)));
+  for (std::size_t v = 0; v < 5; ++v) {
+    EXPECT_NEAR(scaled.energy.unary[v][1] - scaled.quality[v], plain.energy.unary[v][1] - plain.quality[v], 1e-12)
+        << "the boundary part is untouched";
+  }
 }
 
 }  // namespace

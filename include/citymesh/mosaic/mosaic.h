@@ -33,6 +33,7 @@ struct MosaicStats {
   double length_unit = 0;  ///< metres: the mean edge length of the candidates
   /// Weighted energy terms of the selection (the quality term is negative).
   double quality = 0, boundary = 0, overlap = 0, seam = 0, energy = 0;
+  std::uint64_t seen_through = 0;  ///< candidates another pass saw through (quality scaled down)
   std::uint64_t filled = 0;  ///< triangles added by the hole fill
   std::uint64_t fill_seen_through = 0;  ///< triangles the hole fill left out: another pass saw through them
   MinimiseStats solver;  ///< solver.exact: the whole energy was solved by one flipped cut
