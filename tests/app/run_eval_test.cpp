@@ -55,7 +55,14 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
       "--set project.work=work-base",
       sim));
   ASSERT_EQ(base.exit_code, 0) << base.err;
-  for (const char* out : {"out", "base"}) {
+  // The same mosaic practically unstitched (snapping within 1 cm, no clipping, no gap
+  // closing): the reference for the seams stitching must close.
+  const auto raw = test::run_citymesh(fmt::format(
+      "run {}/config.toml --no-pictures --set mosaic.stitch_reach=0.1 --set mosaic.clip_overlaps=false "
+      "--set mosaic.close_gaps=false --set project.output=raw --set project.work=work-raw",
+      sim));
+  ASSERT_EQ(raw.exit_code, 0) << raw.err;
+  for (const char* out : {"out", "base", "raw"}) {
     const auto eval = test::run_citymesh(fmt::format("eval {}/{} --truth {}", sim, out, sim));
     ASSERT_EQ(eval.exit_code, 0) << eval.err;
     EXPECT_NE(eval.out.find("overlap ratio"), std::string::npos);
@@ -74,6 +81,13 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   EXPECT_LT(m["seam_length"].get<double>(), b["seam_length"].get<double>());
   EXPECT_LT(m["edge_length_ratio"].get<double>(), b["edge_length_ratio"].get<double>());
   EXPECT_LE(m["dynamic_residue"].get<double>(), b["dynamic_residue"].get<double>());
+  // Not asserted, not met yet: static completeness against the baseline's (99.86 % against
+  // 99.92 %; docs/mosaic.md, "What is not done yet").
+
+  // Stitching leaves at most 5 % of the unstitched mosaic's open seams (4.7 % in session 21).
+  const nlohmann::json u = read_json(dir / "sim/raw/eval.json")["mosaic"];
+  EXPECT_LE(m["seam_length"].get<double>(), 0.05 * u["seam_length"].get<double>())
+      << m["seam_length"] << " m left of " << u["seam_length"] << " m unstitched";
 
   // Stitching closed part of the open boundary; the output stays edge-manifold and every
   // face says where it came from.
