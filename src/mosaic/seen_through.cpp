@@ -13,49 +13,62 @@ namespace citymesh::mosaic_detail {
 
 namespace {
 
-/// p inside the tetrahedron (viewpoint v, triangle q), between margin and depth from q's plane:
-/// the change step's margin-reduced empty space, cut at the depth. For a point the ray through
-/// it answers directly; the triangle-tetrahedron test's separating axes are not needed.
-bool in_empty_space(const Vec3d& p, const Vec3d& v, const TriangleCorners& q, const SeenThroughParams& params) {
-  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
-  const double len = norm(winding);
-  if (!(len > 0)) return false;
-  const Vec3d n = winding / len;
-  const double hv = dot(v - q[0], n), hp = dot(p - q[0], n);
-  // Same side as the viewpoint, between the margin and the depth, and short of the viewpoint.
-  if (hv * hp <= 0 || std::abs(hp) <= params.margin || std::abs(hp) > params.depth || std::abs(hp) >= std::abs(hv)) {
-    return false;
-  }
-  // The ray from the viewpoint through p meets q's plane inside q.
-  const Vec3d hit = v + (p - v) * (hv / (hv - hp));
-  for (int k = 0; k < 3; ++k) {
-    if (dot(cross(q[(k + 1) % 3] - q[k], hit - q[k]), winding) < 0) return false;
-  }
-  return true;
-}
-
-/// The box around the part of the tetrahedron (viewpoint v, triangle q) between `margin` and
-/// `depth` from q's plane: the hull of its sections at those two distances, a thin slab in
-/// front of q. Not q grown by the depth in every direction: that box also holds every point
-/// on the surface itself and its neighbours, ten times the candidates on a street, and misses
-/// grazing rays. Grown by a millimetre against rounding; inverted (meets nothing) when v is
-/// no further from q's plane than the margin.
-Box3f empty_space_box(const Vec3d& v, const TriangleCorners& q, const SeenThroughParams& params) {
-  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
-  const double len = norm(winding);
-  const double hv = len > 0 ? std::abs(dot(v - q[0], winding / len)) : 0.0;
-  if (!(hv > params.margin)) return {{1, 1, 1}, {-1, -1, -1}};
-  const double near = params.margin / hv, far = std::min(1.0, params.depth / hv);
-  Vec3d lo = q[0] + (v - q[0]) * near, hi = lo;
-  for (const Vec3d& c : q) {
-    for (const Vec3d& x : {c + (v - c) * near, c + (v - c) * far}) {
-      lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
-      hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+/// The empty space between one triangle q of a pass and its viewpoint v (a tetrahedron), with
+/// q's plane worked out once for every point asked about.
+class EmptySpace {
+ public:
+  EmptySpace(const Vec3d& v, const TriangleCorners& q) : v_(v), q_(q), winding_(cross(q[1] - q[0], q[2] - q[0])) {
+    const double len = norm(winding_);
+    if (len > 0) {
+      n_ = winding_ / len;
+      hv_ = dot(v - q[0], n_);
     }
   }
-  constexpr double kPad = 1e-3;
-  return {Vec3f(lo - Vec3d{kPad, kPad, kPad}), Vec3f(hi + Vec3d{kPad, kPad, kPad})};
-}
+
+  /// p inside the tetrahedron, between margin and depth from q's plane: the change step's
+  /// margin-reduced empty space, cut at the depth. For a point the ray through it answers
+  /// directly; the triangle-tetrahedron test's separating axes are not needed.
+  [[nodiscard]] bool contains(const Vec3d& p, const SeenThroughParams& params) const {
+    const double hp = dot(p - q_[0], n_);
+    // Same side as the viewpoint, between the margin and the depth, and short of the viewpoint.
+    if (hv_ * hp <= 0 || std::abs(hp) <= params.margin || std::abs(hp) > params.depth || std::abs(hp) >= std::abs(hv_)) {
+      return false;
+    }
+    // The ray from the viewpoint through p meets q's plane inside q.
+    const Vec3d hit = v_ + (p - v_) * (hv_ / (hv_ - hp));
+    for (int k = 0; k < 3; ++k) {
+      if (dot(cross(q_[(k + 1) % 3] - q_[k], hit - q_[k]), winding_) < 0) return false;
+    }
+    return true;
+  }
+
+  /// The box around the part between `margin` and `depth` from q's plane: the hull of its
+  /// sections at those two distances, a thin slab in front of q. Not q grown by the depth in
+  /// every direction: that box also holds every point on the surface itself and its
+  /// neighbours, ten times the candidates on a street, and misses grazing rays. Grown by a
+  /// millimetre against rounding; inverted (meets nothing) when v is no further from q's
+  /// plane than the margin.
+  [[nodiscard]] Box3f box(const SeenThroughParams& params) const {
+    const double hv = std::abs(hv_);
+    if (!(hv > params.margin)) return {{1, 1, 1}, {-1, -1, -1}};
+    const double near = params.margin / hv, far = std::min(1.0, params.depth / hv);
+    Vec3d lo = q_[0] + (v_ - q_[0]) * near, hi = lo;
+    for (const Vec3d& c : q_) {
+      for (const Vec3d& x : {c + (v_ - c) * near, c + (v_ - c) * far}) {
+        lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
+        hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
+      }
+    }
+    constexpr double kPad = 1e-3;
+    return {Vec3f(lo - Vec3d{kPad, kPad, kPad}), Vec3f(hi + Vec3d{kPad, kPad, kPad})};
+  }
+
+ private:
+  Vec3d v_;
+  TriangleCorners q_;
+  Vec3d winding_, n_{};
+  double hv_ = 0;  ///< the viewpoint's signed distance from q's plane; 0: degenerate q
+};
 
 }  // namespace
 
@@ -79,14 +92,13 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
     parallel_for_blocks(other.triangle_count(), 8192, [&](std::size_t begin, std::size_t end) {
       std::vector<std::uint32_t> hits;
       for (std::size_t t = begin; t < end; ++t) {
-        const TriangleCorners q = other.corners(t);
-        const Vec3d v = other.viewpoint(t);
-        tree.overlapping(empty_space_box(v, q, params), hits);
-        if (hits.empty()) continue;
+        const EmptySpace space(other.viewpoint(t), other.corners(t));
+        tree.overlapping(space.box(params), hits);
         for (const std::uint32_t i : hits) {
           // Flags are only raised: any order of raising gives the same result.
-          if (mesh_of[i] != b && in_empty_space(centroid[i], v, q, params)) {
-            std::atomic_ref<std::uint8_t>(seen[i]).store(1, std::memory_order_relaxed);
+          std::atomic_ref<std::uint8_t> flag(seen[i]);
+          if (mesh_of[i] != b && flag.load(std::memory_order_relaxed) == 0 && space.contains(centroid[i], params)) {
+            flag.store(1, std::memory_order_relaxed);
           }
         }
       }

@@ -4,6 +4,7 @@
 // unlabelled fraction before and after improvement; and our max-flow against Boost.Graph's
 // boykov_kolmogorov_max_flow on the same two-mesh graphs.
 //   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--threads N] [--mosaic-only 1]
+//                [--seen-through-quality 0.2] [--crease-weight 3]
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -92,6 +93,8 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--threads") == 0) threads = static_cast<unsigned>(std::stoul(argv[i + 1]));
     if (std::strcmp(argv[i], "--mosaic-only") == 0) mosaic_only = std::strcmp(argv[i + 1], "0") != 0;
+    if (std::strcmp(argv[i], "--seen-through-quality") == 0) params.seen_through_quality = std::stod(argv[i + 1]);
+    if (std::strcmp(argv[i], "--crease-weight") == 0) params.crease_weight = std::stod(argv[i + 1]);
   }
   const ThreadLimit limit(threads);
   const bench::BenchScene scene = bench::simulated_street(length, epochs);
