@@ -101,6 +101,12 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                        {"group_moves", s.moves.moves},
                        {"improving_moves", s.moves.improving_moves},
                        {"sweeps", s.moves.sweeps}};
+  if (params.solved_per_tile) {
+    for (const char* per_tile : {"filled", "seen_through", "fill_seen_through", "overlap_terms", "seam_terms"}) {
+      summary["counts"][per_tile] = nullptr;
+    }
+    summary["energy"] = nullptr;
+  }
   summary["stitch"] = params.stitch;
   summary["seconds"] = params.seconds;
   summary["ply"] = kMosaicFile;

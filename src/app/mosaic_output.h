@@ -23,6 +23,10 @@ struct MosaicOutputParams {
   bool pictures = true;
   nlohmann::json seconds;  ///< time per step, for the summary
   nlohmann::json stitch;   ///< stitching figures, for the summary
+  /// The selection was solved tile by tile (citymesh run): the energy, the solver's counts and
+  /// the fill's are per tile and not summed, so the summary writes null for them rather than
+  /// zeros (the run report has each tile's counts and seconds).
+  bool solved_per_tile = false;
 };
 
 /// Writes <dir>/mosaic.ply, mosaic.png and summary.json (last), each atomically. `input` needs

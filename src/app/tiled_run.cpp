@@ -110,7 +110,8 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,
                         .seconds = seconds,
-                        .stitch = stitched});
+                        .stitch = stitched,
+                        .solved_per_tile = true});
   seconds["outputs"] = clock.restart();
   const nlohmann::json exported = write_tileset_outputs(config, merged);
   seconds["export"] = clock.restart();

@@ -95,6 +95,10 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   EXPECT_LT(s["stitch"]["open_boundary_after_m"].get<double>(), s["stitch"]["open_boundary_before_m"].get<double>());
   EXPECT_GT(s["stitch"]["triangles_clipped"].get<std::uint64_t>(), 0u);  // pieces cut back where they overlapped
   EXPECT_GT(s["stitch"]["gaps_filled"].get<std::uint64_t>(), 0u);        // small holes between sources closed
+  // Solved tile by tile: no whole-street energy or fill counts, and null rather than zeros.
+  EXPECT_TRUE(s["energy"].is_null());
+  EXPECT_TRUE(s["counts"]["filled"].is_null());
+  EXPECT_GT(s["counts"]["candidates"].get<std::uint64_t>(), s["counts"]["selected"].get<std::uint64_t>());
   const auto [non_manifold, sources] = inspect(dir / "sim/out/mosaic/mosaic.ply");
   EXPECT_EQ(non_manifold, 0u);
   EXPECT_GT(sources.count(-1), 0u);  // stitch triangles
@@ -115,6 +119,11 @@ TEST(RunEval, DetectThenMosaicGivesTheSameBytesOnOneAndTwoThreads) {
     if (threads == 1) first = bytes;
     EXPECT_TRUE(bytes == first) << "the mosaic differs between 1 and 2 threads";
   }
+  // One solve over the whole street: its energy and counts are in the summary.
+  const nlohmann::json s = read_json(dir / "sim/out/mosaic/summary.json");
+  EXPECT_LT(s["energy"]["total"].get<double>(), 0.0);
+  EXPECT_GT(s["counts"]["seam_terms"].get<std::uint64_t>(), 0u);
+  EXPECT_GT(s["counts"]["filled"].get<std::uint64_t>(), 0u);
 }
 
 TEST(RunEval, MosaicRefusesAMissingOrDamagedDetectOutput) {
