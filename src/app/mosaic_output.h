@@ -25,7 +25,7 @@ struct MosaicOutputParams {
   nlohmann::json stitch;   ///< stitching figures, for the summary
   /// The selection was solved tile by tile (citymesh run): the energy, the solver's counts and
   /// the fill's are per tile and not summed, so the summary writes null for them rather than
-  /// zeros (the run report has each tile's counts and seconds).
+  /// zeros (the run report has each tile's triangle counts and seconds).
   bool solved_per_tile = false;
 };
 
