@@ -46,21 +46,19 @@ class EmptySpace {
   /// sections at those two distances, a thin slab in front of q. Not q grown by the depth in
   /// every direction: that box also holds every point on the surface itself and its
   /// neighbours, ten times the candidates on a street, and misses grazing rays. Grown by a
-  /// millimetre against rounding; inverted (meets nothing) when v is no further from q's
-  /// plane than the margin.
-  [[nodiscard]] Box3f box(const SeenThroughParams& params) const {
+  /// millimetre, which covers the float rounding of the points looked up; empty when v is no
+  /// further from q's plane than the margin.
+  [[nodiscard]] Box3d box(const SeenThroughParams& params) const {
+    Box3d b;
     const double hv = std::abs(hv_);
-    if (!(hv > params.margin)) return {{1, 1, 1}, {-1, -1, -1}};
+    if (!(hv > params.margin)) return b;
     const double near = params.margin / hv, far = std::min(1.0, params.depth / hv);
-    Vec3d lo = q_[0] + (v_ - q_[0]) * near, hi = lo;
     for (const Vec3d& c : q_) {
-      for (const Vec3d& x : {c + (v_ - c) * near, c + (v_ - c) * far}) {
-        lo = {std::min(lo.x, x.x), std::min(lo.y, x.y), std::min(lo.z, x.z)};
-        hi = {std::max(hi.x, x.x), std::max(hi.y, x.y), std::max(hi.z, x.z)};
-      }
+      b.extend(c + (v_ - c) * near);
+      b.extend(c + (v_ - c) * far);
     }
     constexpr double kPad = 1e-3;
-    return {Vec3f(lo - Vec3d{kPad, kPad, kPad}), Vec3f(hi + Vec3d{kPad, kPad, kPad})};
+    return {b.min - Vec3d{kPad, kPad, kPad}, b.max + Vec3d{kPad, kPad, kPad}};
   }
 
  private:
@@ -73,12 +71,8 @@ class EmptySpace {
 /// Triangles of the other pass whose empty spaces share one tree query.
 constexpr std::size_t kRun = 16;
 
-Box3f united(const Box3f& a, const Box3f& b) {
-  return {{std::min(a.min.x, b.min.x), std::min(a.min.y, b.min.y), std::min(a.min.z, b.min.z)},
-          {std::max(a.max.x, b.max.x), std::max(a.max.y, b.max.y), std::max(a.max.z, b.max.z)}};
-}
-
-bool inside(const Vec3f& p, const Box3f& b) {
+/// p in the closed box b.
+bool inside(const Vec3d& p, const Box3d& b) {
   return b.min.x <= p.x && p.x <= b.max.x && b.min.y <= p.y && p.y <= b.max.y && b.min.z <= p.z && p.z <= b.max.z;
 }
 
@@ -104,7 +98,7 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
     parallel_for_blocks(other.triangle_count(), 8192, [&](std::size_t begin, std::size_t end) {
       std::vector<std::uint32_t> hits;
       std::vector<EmptySpace> spaces;
-      std::vector<Box3f> boxes;
+      std::vector<Box3d> boxes;
       // Consecutive triangles of a scan lie side by side: one tree query for a run of them,
       // then each one's own box among the few points found (a query per triangle was most of
       // the check's time: 1.4 points per slab on a street).
@@ -112,20 +106,18 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         const std::size_t stop = std::min(end, run + kRun);
         spaces.clear();
         boxes.clear();
-        Box3f all{{1, 1, 1}, {-1, -1, -1}};
+        Box3d all;
         for (std::size_t t = run; t < stop; ++t) {
           spaces.emplace_back(other.viewpoint(t), other.corners(t));
           boxes.push_back(spaces.back().box(params));
-          if (!(boxes.back().min.x <= boxes.back().max.x)) continue;  // an empty slab
-          all = all.min.x <= all.max.x ? united(all, boxes.back()) : boxes.back();
+          all.extend(boxes.back());
         }
-        if (!(all.min.x <= all.max.x)) continue;
-        tree.overlapping(all, hits);
+        if (all.empty()) continue;
+        tree.overlapping({Vec3f(all.min), Vec3f(all.max)}, hits);
         for (const std::uint32_t i : hits) {
           if (mesh_of[i] == b) continue;
-          const Vec3f p(centroid[i]);
           for (std::size_t k = 0; k < spaces.size(); ++k) {
-            if (!inside(p, boxes[k])) continue;
+            if (!inside(centroid[i], boxes[k])) continue;
             // Flags are only raised: any order of raising gives the same result.
             std::atomic_ref<std::uint8_t> flag(seen[i]);
             if (flag.load(std::memory_order_relaxed) != 0) break;
