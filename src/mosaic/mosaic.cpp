@@ -50,6 +50,7 @@ namespace {
 struct TriangleShape {
   double area = 0, longest_edge = 0;
   Vec3f centroid;
+  Vec3d winding;  ///< twice the area times the unit normal
 };
 
 /// Where a seam inside a mesh costs more: along a crease.
@@ -58,21 +59,18 @@ struct Crease {
   double weight;
 };
 
-/// The seam term's factor for the edge two triangles of m share: crease.weight along a
-/// crease, else 1. A seam at a corner leaves each pass's own chamfer to meet the other's.
-double seam_factor(const Mesh& m, const mosaic_detail::SharedEdge& s, const Crease& crease) {
-  const auto normal = [&](std::uint32_t t) {
-    const auto [p, q, r] = m.corners(t);
-    return cross(q - p, r - p);
-  };
-  const Vec3d na = normal(s.a), nb = normal(s.b);
+/// The seam term's factor for the edge shared by two triangles of windings na and nb:
+/// crease.weight along a crease, else 1. A seam at a corner leaves each pass's own chamfer to
+/// meet the other's.
+double seam_factor(const Vec3d& na, const Vec3d& nb, const Crease& crease) {
   const double scale = norm(na) * norm(nb);
   return scale > 0 && dot(na, nb) < crease.cos_angle * scale ? crease.weight : 1.0;
 }
 
 TriangleShape shape(const Mesh& m, std::size_t t) {
   const auto [a, b, c] = m.corners(t);
-  return {0.5 * doubled_area(a, b, c), std::max({norm(b - a), norm(c - b), norm(a - c)}), Vec3f((a + b + c) / 3.0)};
+  const Vec3d winding = cross(b - a, c - a);
+  return {0.5 * norm(winding), std::max({norm(b - a), norm(c - b), norm(a - c)}), Vec3f((a + b + c) / 3.0), winding};
 }
 
 /// Each variable's centroid along the longer horizontal extent of the scene: where the
@@ -182,8 +180,9 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   const Crease crease{std::cos(params.crease_angle * std::numbers::pi / 180.0), params.crease_weight};
   for (std::size_t a = 0; a < edges.size(); ++a) {
     for (const auto& s : edges[a].shared) {
-      const double w = params.seam_weight * s.length / unit * seam_factor(input.meshes[a], s, crease);
-      out.energy.pairs.push_back({variable_of[index.offsets[a] + s.a], variable_of[index.offsets[a] + s.b], 0, w, w, 0});
+      const std::uint32_t va = variable_of[index.offsets[a] + s.a], vb = variable_of[index.offsets[a] + s.b];
+      const double w = params.seam_weight * s.length / unit * seam_factor(shapes[va].winding, shapes[vb].winding, crease);
+      out.energy.pairs.push_back({va, vb, 0, w, w, 0});
     }
   }
   out.stats.seam_terms = out.energy.pairs.size();
