@@ -151,11 +151,10 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
 
   // Facets another pass saw through are worth less (seen_through_quality): the same check as
   // the hole fill's, asked of every candidate.
-  std::vector<std::uint8_t> seen(n, 0);
   if (params.seen_through_quality != 1.0) {
-    seen = mosaic_detail::seen_through(input.meshes, index, out.triangle_of, {.margin = input.distance_threshold});
+    out.seen_through = mosaic_detail::seen_through(input.meshes, index, out.triangle_of, {.margin = input.distance_threshold});
   }
-  out.stats.seen_through = static_cast<std::uint64_t>(std::count(seen.begin(), seen.end(), 1));
+  out.stats.seen_through = static_cast<std::uint64_t>(std::count(out.seen_through.begin(), out.seen_through.end(), 1));
 
   out.energy.unary.resize(n);
   out.quality.resize(n);
@@ -168,7 +167,7 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
       if (params.quality == QualityMeasure::resolution) {
         q = shapes[v].area / mean_area * unit / std::max(shapes[v].longest_edge, 1e-9);
       }
-      if (seen[v] != 0) q *= params.seen_through_quality;
+      if (!out.seen_through.empty() && out.seen_through[v] != 0) q *= params.seen_through_quality;
       out.quality[v] = -params.quality_weight * q;
       out.boundary[v] = params.boundary_weight * edges[a].boundary_length[g - index.offsets[a]] / unit;
       out.energy.unary[v] = {0.0, out.quality[v] + out.boundary[v]};
@@ -252,7 +251,13 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
   account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
   if (params.fill_holes) {
-    const HoleFillCounts fill = fill_holes(input, out.selected);
+    // The energy already asked every candidate whether another pass saw through it.
+    std::vector<std::uint8_t> seen;
+    if (!e.seen_through.empty()) {
+      seen.assign(input.change->index.size(), 0);
+      for (std::size_t v = 0; v < e.seen_through.size(); ++v) seen[e.triangle_of[v]] = e.seen_through[v];
+    }
+    const HoleFillCounts fill = fill_holes(input, out.selected, seen);
     out.stats.filled = fill.added;
     out.stats.fill_seen_through = fill.seen_through;
   }

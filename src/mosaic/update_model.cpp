@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <numeric>
 
+#include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -39,14 +40,20 @@ std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const
   return open;
 }
 
-/// Clears open[g] where another pass saw through triangle g; returns how many.
+/// Clears open[g] where another pass saw through triangle g (`known`, per global triangle,
+/// when given; else asked now); returns how many.
 std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::SeenThroughParams& params,
-                                std::vector<std::uint8_t>& open) {
+                                std::span<const std::uint8_t> known, std::vector<std::uint8_t>& open) {
   std::vector<std::uint32_t> ids;
   for (std::size_t g = 0; g < open.size(); ++g) {
     if (open[g] != 0) ids.push_back(static_cast<std::uint32_t>(g));
   }
-  const std::vector<std::uint8_t> seen = mosaic_detail::seen_through(input.meshes, input.change->index, ids, params);
+  std::vector<std::uint8_t> seen(ids.size());
+  if (known.empty()) {
+    seen = mosaic_detail::seen_through(input.meshes, input.change->index, ids, params);
+  } else {
+    for (std::size_t i = 0; i < ids.size(); ++i) seen[i] = known[ids[i]];
+  }
   std::uint64_t dropped = 0;
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (seen[i] != 0) {
@@ -63,13 +70,13 @@ std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::S
 /// another pass saw through them. The triangles selected at the start are indexed once; the
 /// ones added on the way are indexed again per acquisition (few, for the hole fill).
 HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected,
-                             const mosaic_detail::SeenThroughParams* visibility) {
+                             const mosaic_detail::SeenThroughParams* visibility, std::span<const std::uint8_t> seen = {}) {
   const GlobalTriangles& index = input.change->index;
   const double reach = input.distance_threshold;
   std::vector<std::uint8_t> open = uncovered_by_selection(input, selected);
   HoleFillCounts counts;
   // Seen through or not does not depend on the selection: asked once, for every candidate.
-  if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, open);
+  if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, seen, open);
   std::vector<std::uint8_t> added_so_far(selected.size(), 0);
   for (const std::size_t a : order) {
     const std::size_t base = index.offsets[a];
@@ -118,7 +125,8 @@ MosaicSelection select_update_model(const MosaicInput& input) {
   return out;
 }
 
-HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected) {
+HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,
+                          std::span<const std::uint8_t> seen_through) {
   mosaic_detail::check_mosaic_input(input);
   std::vector<std::size_t> order = date_order(input);
   std::reverse(order.begin(), order.end());
@@ -126,7 +134,10 @@ HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& s
   // window recess that another pass saw into (they lie on no surface), which the fill would
   // otherwise add as a second sheet standing in front of the selection.
   const mosaic_detail::SeenThroughParams visibility{.margin = input.distance_threshold};
-  return add_uncovered(input, order, selected, &visibility);
+  if (!seen_through.empty() && seen_through.size() != input.change->index.size()) {
+    throw ProcessingError("fill_holes: the seen-through flags do not cover every triangle");
+  }
+  return add_uncovered(input, order, selected, &visibility, seen_through);
 }
 
 }  // namespace citymesh

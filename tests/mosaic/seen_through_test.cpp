@@ -6,6 +6,7 @@
 #include <cmath>
 #include <random>
 
+#include "citymesh/core/error.h"
 #include "citymesh/mosaic/mosaic.h"
 #include "seen_through.h"
 
@@ -173,6 +174,17 @@ TEST(FillHoles, LeavesOutWhatAnotherPassSawThrough) {
   EXPECT_EQ(counts.added, 1u);
   EXPECT_EQ(counts.seen_through, 2u);
   EXPECT_EQ(selected, (std::vector<std::uint8_t>{0, 0, 1, 1, 1})) << "only the one beside the floor";
+
+  // Flags already known (as the energy's) give the same fill; all clear, nothing is left out.
+  const std::vector<std::uint8_t> known = seen_through(scene.meshes, scene.change.index, std::vector<std::uint32_t>{0, 1, 2, 3, 4}, {.margin = 0.1});
+  std::vector<std::uint8_t> reused{0, 0, 0, 1, 1};
+  const HoleFillCounts again = fill_holes(scene.input(), reused, known);
+  EXPECT_EQ(reused, selected);
+  EXPECT_EQ(again.seen_through, counts.seen_through);
+  std::vector<std::uint8_t> unflagged{0, 0, 0, 1, 1};
+  EXPECT_EQ(fill_holes(scene.input(), unflagged, std::vector<std::uint8_t>(5, 0)).added, 3u);
+  std::vector<std::uint8_t> short_flags{0, 0, 0, 1, 1};
+  EXPECT_THROW(fill_holes(scene.input(), short_flags, std::vector<std::uint8_t>(2, 0)), ProcessingError);
 
   for (Mesh& m : scene.meshes) m.sensor_positions.clear();
   std::vector<std::uint8_t> blind{0, 0, 0, 1, 1};

@@ -55,6 +55,9 @@ struct MosaicEnergy {
   /// Per variable: its centroid along the scene's longer horizontal extent (where the group
   /// moves cut their slabs).
   std::vector<float> coordinate;
+  /// Per variable: 1 when another pass saw through it (seen_through_quality); empty when the
+  /// check was not asked (seen_through_quality = 1).
+  std::vector<std::uint8_t> seen_through;
   MosaicStats stats;  ///< counts and length unit
 };
 MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& params);
@@ -80,7 +83,10 @@ struct HoleFillCounts {
 /// centroid (it lies in the empty space of another mesh's triangle, more than the threshold
 /// and at most 1 m in front of it; meshes without sensor positions see nothing). Where the
 /// mosaic's pieces leave a gap wider than the threshold (a piece's edge falls short of its
-/// neighbour's), this puts the input surface back.
-HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected);
+/// neighbour's), this puts the input surface back. `seen_through`, per global triangle, gives
+/// that check's answers when they are already known (the energy's, same margin and depth);
+/// empty: they are worked out for the triangles the fill would add.
+HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,
+                          std::span<const std::uint8_t> seen_through = {});
 
 }  // namespace citymesh
