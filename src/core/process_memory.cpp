@@ -2,7 +2,12 @@
 #include "citymesh/core/process_memory.h"
 
 #include <fstream>
+#include <limits>
 #include <string>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
 
 namespace citymesh {
 
@@ -25,5 +30,14 @@ std::uint64_t status_kib(const std::string& name) {
 
 std::uint64_t resident_bytes() { return status_kib("VmRSS"); }
 std::uint64_t peak_resident_bytes() { return status_kib("VmHWM"); }
+
+void keep_freed_memory_for_reuse() {
+#if defined(__GLIBC__)
+  constexpr int kNever = std::numeric_limits<int>::max();
+  // Both or neither: a heap that may not mmap but still trims gives pages back all the same.
+  mallopt(M_MMAP_THRESHOLD, kNever);
+  mallopt(M_TRIM_THRESHOLD, kNever);
+#endif
+}
 
 }  // namespace citymesh

@@ -13,6 +13,7 @@
 #include <fstream>
 #include <string>
 
+#include "citymesh/core/process_memory.h"
 #include "citymesh/change/detect.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
@@ -48,6 +49,7 @@ void print_run(const char* label, const ChangeStats& s, double wall) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory_for_reuse();  // as the citymesh binary does
   StreetParams street;
   street.length = 30.0f;
   street.epochs = 7;

@@ -47,6 +47,7 @@ double arg(int argc, char** argv, const char* name, double fallback) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory_for_reuse();  // as the citymesh binary does
   const auto length = static_cast<float>(arg(argc, argv, "--length", 30));
   const int epochs = static_cast<int>(arg(argc, argv, "--epochs", 7));
   const double tile = arg(argc, argv, "--tile", 10);

@@ -15,6 +15,7 @@
 #include "bench_scene.h"
 #include "citymesh/change/detect.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/max_flow.h"
 #include "citymesh/mosaic/mosaic.h"
@@ -86,6 +87,7 @@ int main(int argc, char** argv) {
   unsigned threads = 0;       // 0: every core
   bool mosaic_only = false;  // skips the baseline, the whole-energy QPBO and the max-flow race
   MosaicParams params;
+  bool keep_freed = true;  // as the citymesh binary does (--keep-freed 0: glibc's defaults)
   for (int i = 1; i + 1 < argc; i += 2) {
     if (std::strcmp(argv[i], "--sweeps") == 0) params.sweeps = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--length") == 0) length = std::stof(argv[i + 1]);
@@ -95,7 +97,9 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--mosaic-only") == 0) mosaic_only = std::strcmp(argv[i + 1], "0") != 0;
     if (std::strcmp(argv[i], "--seen-through-quality") == 0) params.seen_through_quality = std::stod(argv[i + 1]);
     if (std::strcmp(argv[i], "--crease-weight") == 0) params.crease_weight = std::stod(argv[i + 1]);
+    if (std::strcmp(argv[i], "--keep-freed") == 0) keep_freed = std::strcmp(argv[i + 1], "0") != 0;
   }
+  if (keep_freed) keep_freed_memory_for_reuse();
   const ThreadLimit limit(threads);
   const bench::BenchScene scene = bench::simulated_street(length, epochs);
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", length, scene.meshes.size(), scene.triangles);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "citymesh/core/process_memory.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/sim/simulate.h"
@@ -37,6 +38,7 @@ void print(const char* label, unsigned threads, const SimulationReport& r, doubl
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory_for_reuse();  // as the citymesh binary does
   const bool city = argc > 1 && std::strcmp(argv[1], "--city") == 0;
   const auto out = std::filesystem::temp_directory_path() / "citymesh_simulate_bench";
   SimulateParams p;

@@ -36,6 +36,7 @@ std::uint64_t read_only(const Config& config) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  keep_freed_memory_for_reuse();  // as the citymesh binary does
   if (argc < 2) {
     fmt::print(stderr, "usage: tile_bench CONFIG [tile_size] [work folder]\n");
     return 1;
