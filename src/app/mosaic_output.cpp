@@ -102,7 +102,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                        {"improving_moves", s.moves.improving_moves},
                        {"sweeps", s.moves.sweeps}};
   if (params.solved_per_tile) {
-    for (const char* per_tile : {"filled", "seen_through", "fill_seen_through", "overlap_terms", "seam_terms"}) {
+    for (const char* per_tile : {"overlap_terms", "seam_terms"}) {
       summary["counts"][per_tile] = nullptr;
     }
     summary["energy"] = nullptr;

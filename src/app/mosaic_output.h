@@ -23,9 +23,10 @@ struct MosaicOutputParams {
   bool pictures = true;
   nlohmann::json seconds;  ///< time per step, for the summary
   nlohmann::json stitch;   ///< stitching figures, for the summary
-  /// The selection was solved tile by tile (citymesh run): the energy, the solver's counts and
-  /// the fill's are per tile and not summed, so the summary writes null for them rather than
-  /// zeros (the run report has each tile's triangle counts and seconds).
+  /// The selection was solved tile by tile (citymesh run): the energy and the numbers of
+  /// terms belong to each tile's problem (owned and halo triangles) and do not add up, so the
+  /// summary writes null for them rather than zeros. The counts of triangles (seen through,
+  /// filled, left out by the fill) are the owned triangles' and are written.
   bool solved_per_tile = false;
 };
 

@@ -8,6 +8,7 @@
 #include <unordered_map>
 
 #include "citymesh/core/error.h"
+#include "citymesh/mosaic/mosaic.h"
 
 namespace citymesh::app {
 
@@ -41,6 +42,9 @@ void TileAssembly::add(TileResult result) {
     const std::uint32_t g = global(l.acquisition, l.index);
     ++owned_;
     candidates_ += l.kept;
+    seen_through_ += (l.notes & kNoteSeenThrough) != 0 ? 1 : 0;
+    filled_ += (l.notes & kNoteFilled) != 0 ? 1 : 0;
+    fill_left_out_ += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
     if (!change_) continue;
     ChangeResult& c = *change_;
     c.state[g] = l.state;

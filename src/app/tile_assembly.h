@@ -30,6 +30,11 @@ class TileAssembly {
 
   [[nodiscard]] std::uint64_t owned() const { return owned_; }
   [[nodiscard]] std::uint64_t candidates() const { return candidates_; }
+  /// Owned triangles with each mosaic note (MosaicNote): the whole run's counts, each
+  /// triangle counted once, by the tile that owns it.
+  [[nodiscard]] std::uint64_t seen_through() const { return seen_through_; }
+  [[nodiscard]] std::uint64_t filled() const { return filled_; }
+  [[nodiscard]] std::uint64_t fill_left_out() const { return fill_left_out_; }
 
  private:
   const TileStore& store_;
@@ -37,7 +42,7 @@ class TileAssembly {
   GlobalTriangles index_;
   std::vector<TilePiece> pieces_;
   std::optional<ChangeResult> change_;
-  std::uint64_t owned_ = 0, candidates_ = 0;
+  std::uint64_t owned_ = 0, candidates_ = 0, seen_through_ = 0, filled_ = 0, fill_left_out_ = 0;
 };
 
 }  // namespace citymesh::app

@@ -22,7 +22,9 @@ namespace {
 // Version 02: a version 01 result may have been cut short by a failing worker (fixed in
 // parallel_workers); such folders are processed again rather than trusted.
 // Version 03: the checksum is XXH3 (bulk_checksum) instead of FNV-1a.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '3'};
+// Version 04: each label carries the mosaic's notes (seen through, filled, left out by the
+// fill) in what was padding; older results would read as "nothing noted".
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '4'};
 
 struct ResultHeader {
   char magic[8];
@@ -126,6 +128,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
                           .sustainable = change.sustainable[g],
                           .refutes = change.refutes[g],
                           .selected = selection.selected[g],
+                          .notes = selection.notes.empty() ? std::uint8_t{0} : selection.notes[g],
                           .first_ms = change.first_seen[g].time_since_epoch().count(),
                           .last_ms = change.last_seen[g].time_since_epoch().count()});
     }

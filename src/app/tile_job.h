@@ -20,7 +20,8 @@ struct OwnedLabel {
   std::uint32_t index = 0;  ///< triangle index in the acquisition
   TriangleState state = TriangleState::single;
   std::uint8_t kept = 0, sustainable = 0, refutes = 0, selected = 0;
-  std::uint8_t pad[3]{};
+  std::uint8_t notes = 0;  ///< the mosaic's MosaicNote bits
+  std::uint8_t pad[2]{};
   std::int64_t first_ms = 0, last_ms = 0;  ///< first_seen, last_seen (Unix milliseconds)
 };
 static_assert(sizeof(OwnedLabel) == 32);

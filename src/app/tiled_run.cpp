@@ -105,6 +105,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   MosaicStats stats;
   stats.candidates = assembly.candidates();
   stats.selected = selected;
+  stats.seen_through = assembly.seen_through();
+  stats.filled = assembly.filled();
+  stats.fill_seen_through = assembly.fill_left_out();
   write_mosaic_outputs(config, describe_acquisitions(config), merged, stats,
                        {.dir = config.project.output / "mosaic",
                         .pixel_size = pictures.pixel_size,

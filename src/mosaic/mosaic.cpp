@@ -250,6 +250,10 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   out.selected.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
   account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
+  out.notes.assign(input.change->index.size(), 0);
+  for (std::size_t v = 0; v < e.seen_through.size(); ++v) {
+    if (e.seen_through[v] != 0) out.notes[e.triangle_of[v]] |= kNoteSeenThrough;
+  }
   if (params.fill_holes) {
     // The energy already asked every candidate whether another pass saw through it.
     std::vector<std::uint8_t> seen;
@@ -257,7 +261,7 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
       seen.assign(input.change->index.size(), 0);
       for (std::size_t v = 0; v < e.seen_through.size(); ++v) seen[e.triangle_of[v]] = e.seen_through[v];
     }
-    const HoleFillCounts fill = fill_holes(input, out.selected, seen);
+    const HoleFillCounts fill = fill_holes(input, out.selected, seen, &out.notes);
     out.stats.filled = fill.added;
     out.stats.fill_seen_through = fill.seen_through;
   }

@@ -41,9 +41,10 @@ std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const
 }
 
 /// Clears open[g] where another pass saw through triangle g (`known`, per global triangle,
-/// when given; else asked now); returns how many.
+/// when given; else asked now), noting it (kNoteFillLeftOut) when `notes`; returns how many.
 std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::SeenThroughParams& params,
-                                std::span<const std::uint8_t> known, std::vector<std::uint8_t>& open) {
+                                std::span<const std::uint8_t> known, std::vector<std::uint8_t>& open,
+                                std::vector<std::uint8_t>* notes) {
   std::vector<std::uint32_t> ids;
   for (std::size_t g = 0; g < open.size(); ++g) {
     if (open[g] != 0) ids.push_back(static_cast<std::uint32_t>(g));
@@ -58,6 +59,7 @@ std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::S
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (seen[i] != 0) {
       open[ids[i]] = 0;
+      if (notes != nullptr) (*notes)[ids[i]] |= kNoteFillLeftOut;
       ++dropped;
     }
   }
@@ -70,13 +72,14 @@ std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::S
 /// another pass saw through them. The triangles selected at the start are indexed once; the
 /// ones added on the way are indexed again per acquisition (few, for the hole fill).
 HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected,
-                             const mosaic_detail::SeenThroughParams* visibility, std::span<const std::uint8_t> seen = {}) {
+                             const mosaic_detail::SeenThroughParams* visibility, std::span<const std::uint8_t> seen = {},
+                             std::vector<std::uint8_t>* notes = nullptr) {
   const GlobalTriangles& index = input.change->index;
   const double reach = input.distance_threshold;
   std::vector<std::uint8_t> open = uncovered_by_selection(input, selected);
   HoleFillCounts counts;
   // Seen through or not does not depend on the selection: asked once, for every candidate.
-  if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, seen, open);
+  if (visibility != nullptr) counts.seen_through = drop_seen_through(input, *visibility, seen, open, notes);
   std::vector<std::uint8_t> added_so_far(selected.size(), 0);
   for (const std::size_t a : order) {
     const std::size_t base = index.offsets[a];
@@ -97,6 +100,7 @@ HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size
       selected[base + t] |= add[t];
       added_so_far[base + t] |= add[t];
       counts.added += add[t];
+      if (notes != nullptr && add[t] != 0) (*notes)[base + t] |= kNoteFilled;
     }
   }
   return counts;
@@ -126,7 +130,7 @@ MosaicSelection select_update_model(const MosaicInput& input) {
 }
 
 HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,
-                          std::span<const std::uint8_t> seen_through) {
+                          std::span<const std::uint8_t> seen_through, std::vector<std::uint8_t>* notes) {
   mosaic_detail::check_mosaic_input(input);
   std::vector<std::size_t> order = date_order(input);
   std::reverse(order.begin(), order.end());
@@ -137,7 +141,10 @@ HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& s
   if (!seen_through.empty() && seen_through.size() != input.change->index.size()) {
     throw ProcessingError("fill_holes: the seen-through flags do not cover every triangle");
   }
-  return add_uncovered(input, order, selected, &visibility, seen_through);
+  if (notes != nullptr && notes->size() != input.change->index.size()) {
+    throw ProcessingError("fill_holes: the notes do not cover every triangle");
+  }
+  return add_uncovered(input, order, selected, &visibility, seen_through, notes);
 }
 
 }  // namespace citymesh

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
@@ -189,6 +190,45 @@ TEST(FillHoles, LeavesOutWhatAnotherPassSawThrough) {
   for (Mesh& m : scene.meshes) m.sensor_positions.clear();
   std::vector<std::uint8_t> blind{0, 0, 0, 1, 1};
   EXPECT_EQ(fill_holes(scene.input(), blind).added, 3u);
+}
+
+TEST(FillHoles, NotesWhatItAddsAndWhatItLeavesOut) {
+  // The same scene: the fill notes the triangle it adds and the two it leaves out, nothing
+  // else; notes already raised stay; notes of the wrong length are refused.
+  const RaisedOverFloor scene;
+  std::vector<std::uint8_t> selected{0, 0, 0, 1, 1};
+  std::vector<std::uint8_t> notes{0, 0, 0, 0, kNoteSeenThrough};
+  const HoleFillCounts counts = fill_holes(scene.input(), selected, {}, &notes);
+  EXPECT_EQ(notes, (std::vector<std::uint8_t>{kNoteFillLeftOut, kNoteFillLeftOut, kNoteFilled, 0, kNoteSeenThrough}));
+  EXPECT_EQ(counts.added, 1u);
+  EXPECT_EQ(counts.seen_through, 2u);
+  std::vector<std::uint8_t> again{0, 0, 0, 1, 1}, short_notes(3, 0);
+  EXPECT_THROW(fill_holes(scene.input(), again, {}, &short_notes), ProcessingError);
+}
+
+TEST(MosaicSelection, NotesCountWhatTheStatsCount) {
+  // Per-triangle notes are what tiled runs add up: their counts must be the stats'.
+  const RaisedOverFloor scene;
+  MosaicParams params;
+  params.seen_through_quality = 0.5;
+  const MosaicSelection s = select_mosaic(scene.input(), params);
+  ASSERT_EQ(s.notes.size(), 5u);
+  const auto noted = [&](std::uint8_t bit) {
+    return static_cast<std::uint64_t>(std::count_if(s.notes.begin(), s.notes.end(), [&](std::uint8_t n) { return (n & bit) != 0; }));
+  };
+  EXPECT_EQ(noted(kNoteSeenThrough), s.stats.seen_through);
+  EXPECT_EQ(s.stats.seen_through, 2u);
+  EXPECT_EQ(noted(kNoteFilled), s.stats.filled);
+  EXPECT_EQ(noted(kNoteFillLeftOut), s.stats.fill_seen_through);
+  for (std::size_t g = 0; g < 5; ++g) {
+    if ((s.notes[g] & kNoteFilled) != 0) {
+      EXPECT_EQ(s.selected[g], 1) << "a filled triangle is selected";
+    }
+    if ((s.notes[g] & kNoteFillLeftOut) != 0) {
+      EXPECT_EQ(s.selected[g], 0) << "a left-out triangle is not";
+    }
+  }
+  EXPECT_TRUE(select_update_model(scene.input()).notes.empty());
 }
 
 TEST(MosaicEnergy, ScalesTheQualityOfWhatAnotherPassSawThrough) {

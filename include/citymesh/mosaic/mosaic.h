@@ -41,8 +41,19 @@ struct MosaicStats {
   double seconds_build = 0, seconds_solve = 0, seconds_fill = 0;
 };
 
+/// Bits of MosaicSelection::notes: what the mosaic found out about a triangle on the way, so
+/// that a tiled run can count its owned triangles and the counts add up over tiles.
+enum MosaicNote : std::uint8_t {
+  kNoteSeenThrough = 1,  ///< a candidate another pass saw through (MosaicStats::seen_through)
+  kNoteFilled = 2,       ///< added by the hole fill (MosaicStats::filled)
+  kNoteFillLeftOut = 4,  ///< left out by the hole fill: seen through (MosaicStats::fill_seen_through)
+};
+
 struct MosaicSelection {
   std::vector<std::uint8_t> selected;  ///< per global triangle
+  /// Per global triangle: MosaicNote bits; their counts are the stats' (energy mosaic; empty
+  /// for the update model, which notes nothing).
+  std::vector<std::uint8_t> notes;
   MosaicStats stats;
 };
 
@@ -85,8 +96,9 @@ struct HoleFillCounts {
 /// mosaic's pieces leave a gap wider than the threshold (a piece's edge falls short of its
 /// neighbour's), this puts the input surface back. `seen_through`, per global triangle, gives
 /// that check's answers when they are already known (the energy's, same margin and depth);
-/// empty: they are worked out for the triangles the fill would add.
+/// empty: they are worked out for the triangles the fill would add. `notes`, when given (per
+/// global triangle), gets kNoteFilled and kNoteFillLeftOut raised where they apply.
 HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,
-                          std::span<const std::uint8_t> seen_through = {});
+                          std::span<const std::uint8_t> seen_through = {}, std::vector<std::uint8_t>* notes = nullptr);
 
 }  // namespace citymesh
