@@ -250,17 +250,17 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   out.selected.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
   account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
+  // The energy's answers per global triangle: noted, and given to the fill, which need not
+  // ask again (empty when the energy did not ask: the fill then works them out).
   out.notes.assign(input.change->index.size(), 0);
+  std::vector<std::uint8_t> seen;
+  if (!e.seen_through.empty()) seen.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < e.seen_through.size(); ++v) {
-    if (e.seen_through[v] != 0) out.notes[e.triangle_of[v]] |= kNoteSeenThrough;
+    if (e.seen_through[v] == 0) continue;
+    seen[e.triangle_of[v]] = 1;
+    out.notes[e.triangle_of[v]] |= kNoteSeenThrough;
   }
   if (params.fill_holes) {
-    // The energy already asked every candidate whether another pass saw through it.
-    std::vector<std::uint8_t> seen;
-    if (!e.seen_through.empty()) {
-      seen.assign(input.change->index.size(), 0);
-      for (std::size_t v = 0; v < e.seen_through.size(); ++v) seen[e.triangle_of[v]] = e.seen_through[v];
-    }
     const HoleFillCounts fill = fill_holes(input, out.selected, seen, &out.notes);
     out.stats.filled = fill.added;
     out.stats.fill_seen_through = fill.seen_through;
