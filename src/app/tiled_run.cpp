@@ -104,9 +104,11 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   seconds["stitch"] = clock.restart();
   MosaicStats stats;
   stats.candidates = assembly.candidates();
-  stats.selected = selected;
   stats.seen_through = assembly.seen_through();
   stats.filled = assembly.filled();
+  // As in `citymesh mosaic`: the solver's selection, before the fill added to it (every
+  // filled triangle is one of the selected owned ones).
+  stats.selected = selected - std::min(selected, stats.filled);
   stats.fill_seen_through = assembly.fill_left_out();
   write_mosaic_outputs(config, describe_acquisitions(config), merged, stats,
                        {.dir = config.project.output / "mosaic",

@@ -51,7 +51,7 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   }
 
   // The mosaic's counts of triangles are summed over the tiles' owned triangles: one tile
-  // counts what the untiled mosaic counts (up to the float rounding of the tile's frame), and
+  // counts what the untiled mosaic counts (`selected` before the fill in both) (up to the float rounding of the tile's frame), and
   // the visibility check, which does not depend on the selection, gives the same count in
   // many tiles.
   ASSERT_EQ(test::run_citymesh(fmt::format("detect {}/config.toml --no-pictures", sim)).exit_code, 0);
@@ -59,7 +59,7 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   const nlohmann::json whole = read_json(dir / "sim/out/mosaic/summary.json")["counts"];
   const nlohmann::json tile1 = read_json(dir / "sim/one/mosaic/summary.json")["counts"];
   const nlohmann::json tiles = read_json(dir / "sim/many/mosaic/summary.json")["counts"];
-  for (const char* key : {"seen_through", "filled", "fill_seen_through"}) {
+  for (const char* key : {"selected", "seen_through", "filled", "fill_seen_through"}) {
     const auto expected = whole[key].get<double>();
     EXPECT_GT(expected, 0.0) << key;
     EXPECT_NEAR(tile1[key].get<double>(), expected, 0.005 * expected) << key;
