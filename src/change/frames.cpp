@@ -86,7 +86,8 @@ Box3f padded_box(std::span<const Vec3d> points) {
   for (const Vec3d& p : points) b.extend(p);
   const double pad = 1e-5 + 1e-6 * std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x),
                                              std::abs(b.max.y), std::abs(b.max.z)});
-  return {Vec3f(b.min - Vec3d{pad, pad, pad}), Vec3f(b.max + Vec3d{pad, pad, pad})};
+  b = b.grown(pad);
+  return {Vec3f(b.min), Vec3f(b.max)};
 }
 }  // namespace
 

@@ -32,14 +32,10 @@ bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
 MeshProximity::MeshProximity(const Mesh& mesh, double max_reach) : mesh_(mesh) {
   std::vector<Box3f> boxes(mesh.triangle_count());
   for (std::size_t t = 0; t < boxes.size(); ++t) {
-    const TriangleCorners c = mesh.corners(t);
-    Vec3d lo = c[0], hi = c[0];
-    for (const Vec3d& p : c) {
-      lo = {std::min(lo.x, p.x), std::min(lo.y, p.y), std::min(lo.z, p.z)};
-      hi = {std::max(hi.x, p.x), std::max(hi.y, p.y), std::max(hi.z, p.z)};
-    }
-    const double pad = max_reach + 1e-5;
-    boxes[t] = {Vec3f(lo - Vec3d{pad, pad, pad}), Vec3f(hi + Vec3d{pad, pad, pad})};
+    Box3d b;
+    for (const Vec3d& p : mesh.corners(t)) b.extend(p);
+    b = b.grown(max_reach + 1e-5);
+    boxes[t] = {Vec3f(b.min), Vec3f(b.max)};
   }
   tree_ = std::make_unique<BoxTree>(std::move(boxes));
 }

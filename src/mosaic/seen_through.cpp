@@ -58,7 +58,7 @@ class EmptySpace {
       b.extend(c + (v_ - c) * far);
     }
     constexpr double kPad = 1e-3;
-    return {b.min - Vec3d{kPad, kPad, kPad}, b.max + Vec3d{kPad, kPad, kPad}};
+    return b.grown(kPad);
   }
 
  private:
@@ -70,11 +70,6 @@ class EmptySpace {
 
 /// Triangles of the other pass whose empty spaces share one tree query.
 constexpr std::size_t kRun = 16;
-
-/// p in the closed box b.
-bool inside(const Vec3d& p, const Box3d& b) {
-  return b.min.x <= p.x && p.x <= b.max.x && b.min.y <= p.y && p.y <= b.max.y && b.min.z <= p.z && p.z <= b.max.z;
-}
 
 }  // namespace
 
@@ -117,7 +112,7 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         for (const std::uint32_t i : hits) {
           if (mesh_of[i] == b) continue;
           for (std::size_t k = 0; k < spaces.size(); ++k) {
-            if (!inside(centroid[i], boxes[k])) continue;
+            if (!boxes[k].contains(centroid[i])) continue;
             // Flags are only raised: any order of raising gives the same result.
             std::atomic_ref<std::uint8_t> flag(seen[i]);
             if (flag.load(std::memory_order_relaxed) != 0) break;

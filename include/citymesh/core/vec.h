@@ -57,6 +57,15 @@ struct Box3d {
   void extend(const Box3d& b) {
     if (!b.empty()) { extend(b.min); extend(b.max); }
   }
+  /// p in the closed box.
+  [[nodiscard]] bool contains(const Vec3d& p) const {
+    return min.x <= p.x && p.x <= max.x && min.y <= p.y && p.y <= max.y && min.z <= p.z && p.z <= max.z;
+  }
+  /// The box grown by pad on every side; an empty box stays empty.
+  [[nodiscard]] Box3d grown(double pad) const {
+    if (empty()) return *this;
+    return {min - Vec3d{pad, pad, pad}, max + Vec3d{pad, pad, pad}};
+  }
 };
 
 }  // namespace citymesh
