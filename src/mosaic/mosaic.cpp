@@ -152,7 +152,8 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   // Facets another pass saw through are worth less (seen_through_quality): the same check as
   // the hole fill's, asked of every candidate.
   if (params.seen_through_quality != 1.0) {
-    out.seen_through = mosaic_detail::seen_through(input.meshes, index, out.triangle_of, {.margin = input.distance_threshold});
+    out.seen_through = mosaic_detail::seen_through(input.meshes, index, out.triangle_of,
+                                                   mosaic_detail::mosaic_visibility(input.distance_threshold));
   }
   out.stats.seen_through = static_cast<std::uint64_t>(std::count(out.seen_through.begin(), out.seen_through.end(), 1));
 

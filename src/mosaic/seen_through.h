@@ -23,6 +23,10 @@ struct SeenThroughParams {
   double depth = 1.0;
 };
 
+/// The check as the mosaic asks it, in the energy (seen_through_quality) and in the hole fill:
+/// one definition, because the fill takes the energy's answers instead of asking again.
+inline SeenThroughParams mosaic_visibility(double distance_threshold) { return {.margin = distance_threshold}; }
+
 /// For each listed triangle (global ids of `index`), 1 when its centroid lies in the empty
 /// space of a triangle of another mesh: inside the tetrahedron between that triangle and its
 /// viewpoint (the barycentre of its corners' sensor positions), more than params.margin and at

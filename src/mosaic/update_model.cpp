@@ -137,7 +137,7 @@ HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& s
   // What another pass saw through is not put back: mostly facets one pass strung across a
   // window recess that another pass saw into (they lie on no surface), which the fill would
   // otherwise add as a second sheet standing in front of the selection.
-  const mosaic_detail::SeenThroughParams visibility{.margin = input.distance_threshold};
+  const mosaic_detail::SeenThroughParams visibility = mosaic_detail::mosaic_visibility(input.distance_threshold);
   if (!seen_through.empty() && seen_through.size() != input.change->index.size()) {
     throw ProcessingError("fill_holes: the seen-through flags do not cover every triangle");
   }
