@@ -80,6 +80,7 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
   nlohmann::json summary;
   summary["config"] = config.file.string();
   summary["policy"] = unconfirmed_policy_name(config.change.unconfirmed);
+  summary["empty_space"] = empty_space_reach_name(config.change.empty_space);
   summary["sustainability"] = format_duration(config.change.sustainability);
   for (std::size_t k = 0; k < input.meshes.size(); ++k) {
     const std::size_t begin = r.index.offsets[k];

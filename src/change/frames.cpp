@@ -22,6 +22,10 @@ std::string_view unconfirmed_policy_name(UnconfirmedPolicy p) {
   }
 }
 
+std::string_view empty_space_reach_name(EmptySpaceReach r) {
+  return r == EmptySpaceReach::nearest_sample ? "nearest-sample" : "tetrahedron";
+}
+
 std::string_view triangle_state_name(TriangleState s) {
   switch (s) {
     case TriangleState::consistent:
@@ -96,6 +100,18 @@ Box3f TriangleFrames::bounds(std::size_t g) const {
   return padded_box(c);
 }
 
+double empty_space_scale(const TriangleCorners& c, const Vec3d& viewpoint, double height, const ChangeParams& params) {
+  const double margin = params.conflict_margin;
+  if (!(height > margin)) return 0.0;
+  double scale = (height - margin) / height;
+  if (params.empty_space == EmptySpaceReach::nearest_sample) {
+    const double r0 = norm(c[0] - viewpoint), r1 = norm(c[1] - viewpoint), r2 = norm(c[2] - viewpoint);
+    // Every point of the tetrahedron scaled by s lies within s * (farthest corner's range).
+    scale = std::min(scale, std::max(0.0, (std::min({r0, r1, r2}) - margin) / std::max({r0, r1, r2})));
+  }
+  return scale;
+}
+
 int slab_count(const TetrahedronCorners& q, double length) {
   const double reach = std::max({norm(q[1] - q[0]), norm(q[2] - q[0]), norm(q[3] - q[0])});
   return static_cast<int>(std::clamp(std::ceil(reach / length), 1.0, 100000.0));
@@ -145,7 +161,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
         f.centroid[g] = Vec3f(c);
         f.normal[g] = Vec3f(normal);
         f.viewpoint[g] = Vec3f(v);
-        f.empty_scale[g] = h > params.conflict_margin ? static_cast<float>((h - params.conflict_margin) / h) : 0.0f;
+        f.empty_scale[g] = static_cast<float>(empty_space_scale({p0, p1, p2}, v, h, params));
       }
     });
   }

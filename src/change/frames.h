@@ -34,6 +34,14 @@ struct TriangleFrames {
   [[nodiscard]] TimePoint date_of(std::size_t g) const { return dates[index.acquisition_of(g)]; }
 };
 
+/// The factor about the viewpoint that turns triangle c's tetrahedron into its empty space
+/// (TriangleFrames::empty_scale): (h - margin) / h keeps exactly the points at least
+/// conflict_margin from c's plane (h: the viewpoint's height above it); with
+/// EmptySpaceReach::nearest_sample it is also at most (nearest corner's range - margin) /
+/// farthest corner's range, so that no point lies farther from the viewpoint than the nearest
+/// corner less the margin. 0 (no empty space) when h is within the margin.
+double empty_space_scale(const TriangleCorners& c, const Vec3d& viewpoint, double height, const ChangeParams& params);
+
 /// Cuts of about `length` metres along an empty space q (viewpoint first), at least 1.
 int slab_count(const TetrahedronCorners& q, double length);
 /// Box of slab k of n of the empty space q: the hull of its cross-sections at k/n and (k+1)/n

@@ -179,6 +179,13 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(real_key(change, "conflict_margin",
       "a triangle must lie this far inside a newer empty space to conflict (metres)",
       [](auto& c) -> auto& { return c.change.conflict_margin; }, 0, 10));
+  keys.push_back(enum_key(change, "empty_space",
+      "how far a triangle's empty space reaches: the whole tetrahedron to its viewpoint (the paper), or no farther "
+      "than its nearest corner's range (nearest-sample: facets bridging an occluding edge do not carve what lies "
+      "behind the edge)",
+      [](auto& c) -> auto& { return c.change.empty_space; },
+      std::vector<std::pair<std::string, EmptySpaceReach>>{{"tetrahedron", EmptySpaceReach::tetrahedron},
+                                                           {"nearest-sample", EmptySpaceReach::nearest_sample}}));
   keys.push_back(real_key(change, "normal_angle",
       "largest angle between the normals of consistent triangles (degrees)",
       [](auto& c) -> auto& { return c.change.normal_angle; }, 0, 90));

@@ -176,6 +176,47 @@ TEST(Conflicts, NoiseWithinTheMarginIsNotAConflict) {
   EXPECT_EQ(std::count(r.state.begin(), r.state.end(), TriangleState::conflicting), 0);
 }
 
+/// A newer facet from a sample on a cornice's underside (20 m from the sensor) to the next
+/// sample of the scan line on the wall above (22 m), as a scan-line mesher strings it across
+/// the lip; and two small older surfaces inside its tetrahedron, at `near` and `far` of the way
+/// from the sensor to the facet's centroid.
+std::vector<Mesh> facet_across_a_lip(float near, float far) {
+  std::vector<Mesh> m(2);
+  const Vec3f sensor{0, 0, 0};
+  const Vec3f a{-0.5f, 20, 0}, b{0.5f, 20, 0}, c{0, 22, 2};
+  const Vec3f centroid = (a + b + c) / 3.0f;
+  for (const float s : {near, far}) {
+    const Vec3f p = centroid * s;
+    const auto base = static_cast<std::uint32_t>(m[0].positions.size());
+    for (const Vec3f& d : {Vec3f{-0.02f, 0, 0}, Vec3f{0.02f, 0, 0}, Vec3f{0, 0, 0.03f}}) {
+      m[0].positions.push_back(p + d);
+      m[0].sensor_positions.push_back(sensor);
+    }
+    m[0].triangles.push_back({base, base + 1, base + 2});
+  }
+  m[1].positions = {a, b, c};
+  m[1].sensor_positions = {sensor, sensor, sensor};
+  m[1].triangles.push_back({0, 1, 2});
+  finish(m[0], 0);
+  finish(m[1], 1);
+  return m;
+}
+
+TEST(Conflicts, NearestSampleReachClaimsNoEmptySpaceBeyondTheNearestCorner) {
+  // The far surface is 42 cm in front of the facet's plane but beyond its nearest corner's
+  // range less the margin (20.06 m > 19.91 m); the near one is 12 m from the sensor.
+  const std::vector<Mesh> m = facet_across_a_lip(0.6f, 0.97f);
+  const ChangeResult whole = detect(m, {day(0), day(40)});
+  EXPECT_EQ(whole.state[0], TriangleState::conflicting);
+  EXPECT_EQ(whole.state[1], TriangleState::conflicting);
+  ChangeParams p;
+  p.empty_space = EmptySpaceReach::nearest_sample;
+  const ChangeResult nearest = detect(m, {day(0), day(40)}, p);
+  EXPECT_EQ(nearest.state[0], TriangleState::conflicting);
+  EXPECT_EQ(nearest.state[1], TriangleState::single);
+  EXPECT_EQ(nearest.refutes[2], 1);
+}
+
 // ---- time series and policies ----------------------------------------------------------
 
 TEST(TimeSeries, FirstAndLastSeenSpanPartnersAndDecideSustainability) {

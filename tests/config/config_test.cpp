@@ -64,6 +64,7 @@ intensity = "amplitude"
 [change]
 distance_threshold = 0.05
 conflict_margin = 0.2
+empty_space = "nearest-sample"
 normal_angle = 30
 sustainability = "12h"
 [mosaic]
@@ -89,6 +90,7 @@ draco_tolerance = 0.002
   EXPECT_EQ(c.ply_read_params().intensity_name, "amplitude");
   EXPECT_EQ(c.change.distance_threshold, 0.05);
   EXPECT_EQ(c.change.sustainability, std::chrono::hours(12));
+  EXPECT_EQ(c.change.empty_space, EmptySpaceReach::nearest_sample);
   EXPECT_EQ(c.mosaic.quality, QualityMeasure::area);
   EXPECT_EQ(c.mosaic.overlap_weight, 1000);
   EXPECT_EQ(c.tiling.origin[1], 6860000);

@@ -23,9 +23,23 @@ enum class UnconfirmedPolicy {
   keep,
 };
 
+/// How far a triangle's empty space reaches towards and beyond its surface ([change]
+/// empty_space).
+enum class EmptySpaceReach {
+  /// The paper: the whole tetrahedron between the triangle and its viewpoint, less the points
+  /// within conflict_margin of the triangle's plane.
+  tetrahedron,
+  /// Also no farther from the viewpoint than the triangle's nearest corner, less the margin.
+  /// Between two rays the scene may come nearer than the facet joining their samples (the lip
+  /// of a cornice between a sample on its underside and the next one on the wall above):
+  /// only the depth that every corner's ray reached is claimed empty.
+  nearest_sample,
+};
+
 struct ChangeParams {
   double distance_threshold = 0.10;                 ///< metres: closer surfaces are the same surface
   double conflict_margin = 0.10;                    ///< metres: depth into a newer empty space needed to conflict
+  EmptySpaceReach empty_space = EmptySpaceReach::tetrahedron;
   double normal_angle = 45.0;                       ///< degrees between normals of consistent triangles
   Duration sustainability = std::chrono::days(30);  ///< Ts
   UnconfirmedPolicy unconfirmed = UnconfirmedPolicy::keep_unobserved;
@@ -34,5 +48,6 @@ struct ChangeParams {
 };
 
 [[nodiscard]] std::string_view unconfirmed_policy_name(UnconfirmedPolicy p);
+[[nodiscard]] std::string_view empty_space_reach_name(EmptySpaceReach r);
 
 }  // namespace citymesh
