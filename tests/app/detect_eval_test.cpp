@@ -50,7 +50,7 @@ TEST(DetectEval, DefaultStreetMeetsTheRemovalAndCompletenessTargets) {
   EXPECT_GT(s["prefilter"]["skipped"].get<std::uint64_t>(), 0u);
 }
 
-TEST(DetectEval, StrictPolicyKeepsLessAndSameInputGivesSameBytes) {
+TEST(DetectEval, StrictPolicyKeepsLessNearestSampleConflictsLessAndSameInputGivesSameBytes) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
@@ -60,8 +60,21 @@ TEST(DetectEval, StrictPolicyKeepsLessAndSameInputGivesSameBytes) {
   EXPECT_EQ(test::read_text(dir / "sim/out/detect/2_epoch 2.ply"), one);
   const auto kept = [&] { return read_json(dir / "sim/out/detect/summary.json")["totals"]["kept"].get<std::uint64_t>(); };
   const std::uint64_t default_kept = kept();
+  const auto conflicting = [&] {
+    return read_json(dir / "sim/out/detect/summary.json")["totals"]["conflicting"].get<std::uint64_t>();
+  };
+  const std::uint64_t default_conflicting = conflicting();
   ASSERT_EQ(test::run_citymesh(fmt::format("detect {}/config.toml --no-pictures --set change.unconfirmed=drop", sim)).exit_code, 0);
   EXPECT_LT(kept(), default_kept);
+  // Empty spaces cut at the nearest corner's range claim less: fewer conflicts, and the
+  // summary says which reach was used.
+  ASSERT_EQ(test::run_citymesh(
+                fmt::format("detect {}/config.toml --no-pictures --set change.empty_space=nearest-sample", sim))
+                .exit_code,
+            0);
+  EXPECT_LT(conflicting(), default_conflicting);
+  EXPECT_GT(conflicting(), 0u);
+  EXPECT_EQ(read_json(dir / "sim/out/detect/summary.json")["empty_space"], "nearest-sample");
 }
 
 TEST(DetectEval, BadInputsGiveClearErrors) {

@@ -37,11 +37,11 @@ enum class EmptySpaceReach {
 };
 
 struct ChangeParams {
-  double distance_threshold = 0.10;                 ///< metres: closer surfaces are the same surface
-  double conflict_margin = 0.10;                    ///< metres: depth into a newer empty space needed to conflict
-  EmptySpaceReach empty_space = EmptySpaceReach::tetrahedron;
-  double normal_angle = 45.0;                       ///< degrees between normals of consistent triangles
-  Duration sustainability = std::chrono::days(30);  ///< Ts
+  double distance_threshold = 0.10;  ///< metres: closer surfaces are the same surface
+  double conflict_margin = 0.10;     ///< metres: depth into a newer empty space needed to conflict
+  EmptySpaceReach empty_space = EmptySpaceReach::tetrahedron;  ///< how far an empty space reaches
+  double normal_angle = 45.0;                                  ///< degrees between normals of consistent triangles
+  Duration sustainability = std::chrono::days(30);             ///< Ts
   UnconfirmedPolicy unconfirmed = UnconfirmedPolicy::keep_unobserved;
   double voxel_size = 0.5;  ///< metres: the empty-space grids of the pre-filter and the policy
   bool prefilter = true;    ///< skip exact tests where the grids show no newer empty space
