@@ -6,6 +6,8 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <initializer_list>
+
 #include "citymesh/core/error.h"
 
 namespace citymesh::config_detail {
@@ -116,10 +118,14 @@ KeyDef duration_key(std::string_view section, std::string_view name, std::string
           [=](const Config& c) { return toml_string(format_duration(get(c))); }};
 }
 
-/// A string key naming one of `values` (name, enum value); the help lists the names.
+/// A string key naming one of `choices`, spelt by the enum's own name function (the one the
+/// summaries write, so a config and a summary always use the same words); the help lists the
+/// names.
 template <class Get, class E>
 KeyDef enum_key(std::string_view section, std::string_view name, std::string_view help, Get get,
-                std::vector<std::pair<std::string, E>> values) {
+                std::initializer_list<E> choices, std::string_view (*spell)(E)) {
+  std::vector<std::pair<std::string, E>> values;
+  for (const E e : choices) values.emplace_back(spell(e), e);
   std::vector<std::string> quoted;
   for (const auto& v : values) quoted.push_back(toml_string(v.first));
   return {section, name, fmt::format("{}: {}", help, fmt::join(quoted, ", ")), "",
@@ -184,8 +190,7 @@ std::vector<KeyDef> make_keys() {
       "than its nearest corner's range (nearest-sample: facets bridging an occluding edge do not carve what lies "
       "behind the edge)",
       [](auto& c) -> auto& { return c.change.empty_space; },
-      std::vector<std::pair<std::string, EmptySpaceReach>>{{"tetrahedron", EmptySpaceReach::tetrahedron},
-                                                           {"nearest-sample", EmptySpaceReach::nearest_sample}}));
+      {EmptySpaceReach::tetrahedron, EmptySpaceReach::nearest_sample}, empty_space_reach_name));
   keys.push_back(real_key(change, "normal_angle",
       "largest angle between the normals of consistent triangles (degrees)",
       [](auto& c) -> auto& { return c.change.normal_angle; }, 0, 90));
@@ -196,9 +201,8 @@ std::vector<KeyDef> make_keys() {
       "triangles neither conflicting nor sustainable: drop them (the paper), keep them unless a newer scan "
       "saw their place (keep-unobserved), or keep them",
       [](auto& c) -> auto& { return c.change.unconfirmed; },
-      std::vector<std::pair<std::string, UnconfirmedPolicy>>{{"drop", UnconfirmedPolicy::drop},
-                                                             {"keep-unobserved", UnconfirmedPolicy::keep_unobserved},
-                                                             {"keep", UnconfirmedPolicy::keep}}));
+      {UnconfirmedPolicy::drop, UnconfirmedPolicy::keep_unobserved, UnconfirmedPolicy::keep},
+      unconfirmed_policy_name));
   keys.push_back(real_key(change, "voxel_size",
       "voxel edge of the empty-space grids used by the pre-filter and keep-unobserved (metres)",
       [](auto& c) -> auto& { return c.change.voxel_size; }, 0.05, 10));
@@ -210,13 +214,10 @@ std::vector<KeyDef> make_keys() {
       "how kept triangles are merged: the paper's energy solved by QPBO, or its baseline (keep unless something "
       "older lies within the distance threshold)",
       [](auto& c) -> auto& { return c.mosaic.method; },
-      std::vector<std::pair<std::string, MosaicMethod>>{{"energy", MosaicMethod::energy},
-                                                        {"update-model", MosaicMethod::update_model}}));
+      {MosaicMethod::energy, MosaicMethod::update_model}, mosaic_method_name));
   keys.push_back(enum_key(mosaic, "quality", "per-triangle quality Q (constant favours the finer mesh)",
       [](auto& c) -> auto& { return c.mosaic.quality; },
-      std::vector<std::pair<std::string, QualityMeasure>>{{"constant", QualityMeasure::constant},
-                                                          {"area", QualityMeasure::area},
-                                                          {"resolution", QualityMeasure::resolution}}));
+      {QualityMeasure::constant, QualityMeasure::area, QualityMeasure::resolution}, quality_measure_name));
   keys.push_back(real_key(mosaic, "quality_weight", "lambda 1: reward for keeping quality",
       [](auto& c) -> auto& { return c.mosaic.quality_weight; }, 0, 1e6));
   keys.push_back(real_key(mosaic, "boundary_weight", "lambda 2: cost per mean edge length of mesh boundary kept",
