@@ -183,9 +183,8 @@ class AcquisitionTiler {
       if (b.piece.triangle_count() == 0) continue;
       const std::filesystem::path file = dir_ / chunk_name(key);
       std::filesystem::create_directories(file.parent_path());
-      append_tile_block(file, b.piece);
+      out_.stats.bytes_written += append_tile_block(file, b.piece);
       ++out_.stats.blocks;
-      out_.stats.bytes_written += b.piece.byte_size();
     }
     buffers_.clear();
     live_.clear();

@@ -64,6 +64,18 @@ struct Fixture {
   }
 };
 
+/// The counts in a chunk's first block header (version 3: magic, version, flags, vertices,
+/// triangles, payload bytes, checksum) and the block's whole size.
+struct BlockCounts {
+  std::uint64_t vertices = 0, triangles = 0, bytes = 0;
+};
+BlockCounts first_block_counts(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  std::array<std::uint64_t, 6> header{};  // 8 + 4 + 4 bytes of magic, version, flags first
+  in.read(reinterpret_cast<char*>(header.data()), sizeof header);
+  return {header[2], header[3], 48 + header[4]};
+}
+
 std::array<Vec3d, 3> world_corners(const Mesh& m, std::size_t t) {
   const Triangle& tri = m.triangles[t];
   return {m.world_position(tri[0]), m.world_position(tri[1]), m.world_position(tri[2])};
@@ -119,16 +131,17 @@ TEST(Tiler, EveryTriangleIsOwnedOnceAndCopiedWhereBruteForceSays) {
       }
       EXPECT_EQ(per_role, tile.triangles[a]);
       owned += per_role[0];
-      // One block per chunk (large buffers) holding each vertex once: its size counts only
-      // the distinct vertices its triangles use (40-byte header, 32 bytes per vertex with an
-      // intensity, 29 per triangle), so a vertex written twice would show.
+      // One block per chunk (large buffers) holding each vertex once: its header counts only
+      // the distinct vertices its triangles use, so a vertex written twice would show.
       if (p.triangle_count() == 0) continue;
       std::set<std::uint32_t> used;
       for (const Triangle& tri : p.mesh.triangles) {
         for (const std::uint32_t v : tri) used.insert(p.vertex_ids[v]);
       }
-      EXPECT_EQ(std::filesystem::file_size(tile_chunk_path(store.dir, tile.key, a)),
-                40 + 32 * used.size() + 29 * p.triangle_count());
+      const BlockCounts counts = first_block_counts(tile_chunk_path(store.dir, tile.key, a));
+      EXPECT_EQ(counts.vertices, used.size());
+      EXPECT_EQ(counts.triangles, p.triangle_count());
+      EXPECT_EQ(counts.bytes, std::filesystem::file_size(tile_chunk_path(store.dir, tile.key, a)));
     }
   }
   EXPECT_EQ(owned, 6000u);

@@ -30,14 +30,13 @@ struct TilePiece {
   std::vector<TileRole> roles;
 
   [[nodiscard]] std::size_t triangle_count() const { return mesh.triangle_count(); }
-  /// Bytes one block of this piece takes on disk (and roughly in memory).
-  [[nodiscard]] std::uint64_t byte_size() const;
   void clear();
 };
 
-/// `piece` as one checksummed block: header (magic, version, attribute flags, counts, XXH3
-/// of the payload) and payload (vertex ids, positions, sensor positions, attributes, triangles,
-/// faces, fans, triangle indices, roles).
+/// `piece` as one checksummed block: header (magic, version 3, attribute flags, counts,
+/// payload size, XXH3 of the payload) and payload (positions and attributes as they are, then
+/// varint deltas of vertex ids, sensor positions, corners, faces, triangle indices, fans and
+/// roles: mostly a byte each).
 std::string encode_tile_block(const TilePiece& piece);
 
 /// The blocks in `bytes` merged into one piece (see read_tile_piece); `source` names them in
@@ -46,8 +45,8 @@ TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::u
                              std::string_view source);
 
 /// Appends `piece` as one checksummed block to `file`, creating it (not synced: see
-/// sync_tile_files). Throws OutputError naming the file.
-void append_tile_block(const std::filesystem::path& file, const TilePiece& piece);
+/// sync_tile_files); returns the bytes written. Throws OutputError naming the file.
+std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePiece& piece);
 
 /// fsyncs every file under `dir` (and the folders): the tile store is durable once this returns.
 void sync_tile_files(const std::filesystem::path& dir);

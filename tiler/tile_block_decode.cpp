@@ -1,0 +1,230 @@
+// SPDX-License-Identifier: MIT
+// Reading the tile store's blocks: version 3 (varints) and version 2 (fixed-size arrays), each
+// checked against its own bytes before anything is allocated.
+#include <fmt/format.h>
+
+#include <array>
+#include <bit>
+#include <cstring>
+#include <unordered_map>
+
+#include "citymesh/core/checksum.h"
+#include "citymesh/core/error.h"
+#include "citymesh/tiler/tile_store.h"
+#include "tile_block_format.h"
+#include "varint.h"
+
+namespace citymesh {
+
+using namespace tiler_detail;
+
+namespace {
+
+/// Reads consecutive arrays out of one block's payload.
+class PayloadReader {
+ public:
+  explicit PayloadReader(const char* data) : data_(data) {}
+  template <class T>
+  void take(std::vector<T>& values, std::size_t count) {
+    values.resize(count);
+    std::memcpy(static_cast<void*>(values.data()), data_, count * sizeof(T));
+    data_ += count * sizeof(T);
+  }
+  [[nodiscard]] const char* at() const { return data_; }
+
+ private:
+  const char* data_;
+};
+
+/// One block's arrays as stored: its corners index the block's own vertices.
+struct BlockArrays {
+  std::uint32_t flags = 0;
+  std::vector<std::uint32_t> ids;
+  std::vector<Vec3f> positions, sensors;
+  std::vector<float> intensities;
+  std::vector<Rgb8> colors;
+  std::vector<Triangle> triangles;
+  std::vector<std::uint64_t> faces;
+  std::vector<std::uint32_t> fans, indices;
+  std::vector<TileRole> roles;
+};
+
+/// Where a block lies, for its errors.
+struct BlockPlace {
+  std::string_view source;
+  std::size_t block = 0, at = 0;
+  [[nodiscard]] InputError fail(std::string_view what) const {
+    return InputError(fmt::format("{}: block {} at byte {}: {}", source, block, at, what));
+  }
+};
+
+/// Reads the version-2 block at the start of `bytes` into `b`; returns its size in bytes.
+std::size_t read_fixed_block(std::string_view bytes, const BlockPlace& place, BlockArrays& b) {
+  FixedBlockHeader h{};
+  if (bytes.size() < sizeof h) throw place.fail("truncated header");
+  std::memcpy(&h, bytes.data(), sizeof h);
+  const std::uint64_t room = bytes.size() - sizeof h, vertex_bytes = fixed_vertex_bytes(h.start.flags);
+  // Counts are checked against the bytes present before anything is allocated.
+  if (h.vertices > room / vertex_bytes || h.triangles > room / kFixedTriangleBytes ||
+      h.vertices * vertex_bytes + h.triangles * kFixedTriangleBytes > room) {
+    throw place.fail("counts larger than the file (truncated?)");
+  }
+  const char* payload = bytes.data() + sizeof h;
+  const std::uint64_t size = h.vertices * vertex_bytes + h.triangles * kFixedTriangleBytes;
+  if (bulk_checksum(payload, size) != h.checksum) throw place.fail("checksum mismatch");
+  b.flags = h.start.flags;
+  const std::size_t nv = h.vertices, nt = h.triangles;
+  PayloadReader r(payload);
+  r.take(b.ids, nv);
+  r.take(b.positions, nv);
+  r.take(b.sensors, nv);
+  if ((b.flags & kHasIntensity) != 0) r.take(b.intensities, nv);
+  if ((b.flags & kHasColor) != 0) r.take(b.colors, nv);
+  r.take(b.triangles, nt);
+  r.take(b.faces, nt);
+  r.take(b.fans, nt);
+  r.take(b.indices, nt);
+  r.take(b.roles, nt);
+  return sizeof h + size;
+}
+
+/// The next delta-coded value, which must fit in 32 bits.
+std::uint32_t next_u32(VarintReader& in, std::uint64_t previous, const BlockPlace& place) {
+  std::uint64_t value = 0;
+  if (!in.get_delta(value, previous)) throw place.fail("truncated varints");
+  if (value > UINT32_MAX) throw place.fail(fmt::format("value {} out of range", value));
+  return static_cast<std::uint32_t>(value);
+}
+
+/// The varint part of a version-3 payload (see encode_varints).
+void read_varints(VarintReader& in, std::size_t nv, std::size_t nt, const BlockPlace& place, BlockArrays& b) {
+  b.ids.resize(nv);
+  b.sensors.resize(nv);
+  std::uint32_t id = 0;
+  std::array<std::uint32_t, 3> sensor{};
+  for (std::size_t v = 0; v < nv; ++v) {
+    b.ids[v] = id = next_u32(in, id, place);
+    for (std::uint32_t& bits : sensor) bits = next_u32(in, bits, place);
+    b.sensors[v] = {std::bit_cast<float>(sensor[0]), std::bit_cast<float>(sensor[1]), std::bit_cast<float>(sensor[2])};
+  }
+  b.triangles.resize(nt);
+  b.faces.resize(nt);
+  b.fans.resize(nt);
+  b.indices.resize(nt);
+  b.roles.resize(nt);
+  std::uint32_t corner = 0, index = 0;
+  std::uint64_t face = 0, fan_role = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    for (std::uint32_t& c : b.triangles[t]) c = corner = next_u32(in, corner, place);
+    if (!in.get_delta(face, face)) throw place.fail("truncated varints");
+    b.faces[t] = face;
+    b.indices[t] = index = next_u32(in, index, place);
+    if (!in.get(fan_role)) throw place.fail("truncated varints");
+    if (fan_role >> 2 > UINT32_MAX) throw place.fail(fmt::format("triangle {}: fan out of range", t));
+    b.fans[t] = static_cast<std::uint32_t>(fan_role >> 2);
+    b.roles[t] = static_cast<TileRole>(fan_role & 3);
+  }
+}
+
+/// Reads the version-3 block at the start of `bytes` into `b`; returns its size in bytes.
+std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, BlockArrays& b) {
+  BlockHeader h{};
+  if (bytes.size() < sizeof h) throw place.fail("truncated header");
+  std::memcpy(&h, bytes.data(), sizeof h);
+  if (h.payload_bytes > bytes.size() - sizeof h) throw place.fail("payload larger than the file (truncated?)");
+  // Counts are checked against the payload before anything is allocated.
+  const std::uint64_t size = h.payload_bytes, per_vertex = raw_vertex_bytes(h.start.flags) + kMinVarintsPerVertex;
+  if (h.vertices > size / per_vertex || h.triangles > size / kMinVarintsPerTriangle ||
+      h.vertices * per_vertex + h.triangles * kMinVarintsPerTriangle > size) {
+    throw place.fail("counts larger than the block");
+  }
+  const char* payload = bytes.data() + sizeof h;
+  if (bulk_checksum(payload, size) != h.checksum) throw place.fail("checksum mismatch");
+  b.flags = h.start.flags;
+  const std::size_t nv = h.vertices, nt = h.triangles;
+  PayloadReader r(payload);
+  r.take(b.positions, nv);
+  if ((b.flags & kHasIntensity) != 0) r.take(b.intensities, nv);
+  if ((b.flags & kHasColor) != 0) r.take(b.colors, nv);
+  VarintReader in(r.at(), payload + size);
+  read_varints(in, nv, nt, place, b);
+  if (!in.at_end()) throw place.fail("bytes left after the triangles");
+  return sizeof h + size;
+}
+
+/// Appends block `b` to `piece`; a vertex whose id an earlier block had is that block's copy.
+void merge_block(const BlockArrays& b, const BlockPlace& place, std::uint32_t acquisition,
+                 std::unordered_map<std::uint32_t, std::uint32_t>& local, TilePiece& piece) {
+  const std::size_t nv = b.ids.size(), nt = b.triangles.size();
+  // The first block gets exact room (a piece is mostly one block): growth by doubling would
+  // leave up to twice the memory in every piece the assembly holds for the whole city. Later
+  // blocks grow the arrays geometrically, as usual.
+  Mesh& m = piece.mesh;
+  if (piece.vertex_ids.empty() && m.triangles.empty()) {
+    piece.vertex_ids.reserve(nv);
+    m.positions.reserve(nv);
+    m.sensor_positions.reserve(nv);
+    if ((b.flags & kHasIntensity) != 0) m.intensities.reserve(nv);
+    if ((b.flags & kHasColor) != 0) m.colors.reserve(nv);
+    m.triangles.reserve(nt);
+    m.triangle_ids.reserve(nt);
+    piece.triangle_index.reserve(nt);
+    piece.roles.reserve(nt);
+  }
+  std::vector<std::uint32_t> remap(nv);
+  for (std::size_t v = 0; v < nv; ++v) {
+    const auto [it, added] = local.try_emplace(b.ids[v], static_cast<std::uint32_t>(piece.vertex_ids.size()));
+    remap[v] = it->second;
+    if (!added) continue;
+    piece.vertex_ids.push_back(b.ids[v]);
+    m.positions.push_back(b.positions[v]);
+    m.sensor_positions.push_back(b.sensors[v]);
+    if ((b.flags & kHasIntensity) != 0) m.intensities.push_back(b.intensities[v]);
+    if ((b.flags & kHasColor) != 0) m.colors.push_back(b.colors[v]);
+  }
+  for (std::size_t t = 0; t < nt; ++t) {
+    Triangle tri = b.triangles[t];
+    for (std::uint32_t& c : tri) {
+      if (c >= nv) throw place.fail(fmt::format("triangle {} uses vertex {} of {}", t, c, nv));
+      c = remap[c];
+    }
+    if (static_cast<std::uint8_t>(b.roles[t]) > 2) throw place.fail(fmt::format("triangle {}: bad role", t));
+    m.triangles.push_back(tri);
+    m.triangle_ids.push_back({acquisition, b.fans[t], b.faces[t]});
+    piece.triangle_index.push_back(b.indices[t]);
+    piece.roles.push_back(b.roles[t]);
+  }
+}
+
+}  // namespace
+
+TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,
+                             std::string_view source) {
+  TilePiece piece;
+  piece.mesh.origin = origin;
+  std::unordered_map<std::uint32_t, std::uint32_t> local;  // vertex id -> index in the piece
+  BlockPlace place{source, 0, 0};
+  BlockArrays block;  // reused: each block's arrays take the place of the last one's
+  for (; place.at < bytes.size(); ++place.block) {
+    const std::string_view rest = bytes.substr(place.at);
+    BlockStart start{};
+    if (rest.size() < sizeof start) throw place.fail("truncated header");
+    std::memcpy(&start, rest.data(), sizeof start);
+    if (std::memcmp(start.magic, kMagic, sizeof kMagic) != 0) throw place.fail("not a citymesh tile block");
+    if (start.version == kVersion) {
+      place.at += read_varint_block(rest, place, block);
+    } else if (start.version == kFixedVersion) {
+      place.at += read_fixed_block(rest, place, block);
+    } else {
+      throw place.fail(fmt::format("version {} (this build reads {} and {})", start.version, kFixedVersion, kVersion));
+    }
+    merge_block(block, place, acquisition, local, piece);
+  }
+  // Blocks of one acquisition come from one file and carry the same attributes; keep an
+  // attribute only when every vertex has it.
+  if (piece.mesh.intensities.size() != piece.mesh.vertex_count()) piece.mesh.intensities.clear();
+  if (piece.mesh.colors.size() != piece.mesh.vertex_count()) piece.mesh.colors.clear();
+  return piece;
+}
+
+}  // namespace citymesh

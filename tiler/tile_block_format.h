@@ -1,0 +1,67 @@
+// SPDX-License-Identifier: MIT
+// The tile store's block format, private to the tiler: shared by the writer (tile_store.cpp)
+// and the reader (tile_block_decode.cpp).
+#pragma once
+
+#include <bit>
+#include <cstdint>
+
+#include "citymesh/core/mesh.h"
+
+namespace citymesh::tiler_detail {
+
+inline constexpr char kMagic[8] = {'C', 'M', 'T', 'I', 'L', 'E', '0', '1'};
+// Version 3: vertex ids, sensor positions, corners, faces, fans, roles and triangle indices
+// as varint deltas, which mostly take a byte each: a block is under half the size of version
+// 2's fixed-size arrays, and the tiler's time went mostly into writing them. Version 2 is
+// still read, so that work folders and tile results made before stay usable. (Version 1
+// had an FNV-1a checksum, a tenth of the tiler's time on a city; no longer read.)
+inline constexpr std::uint32_t kVersion = 3;
+inline constexpr std::uint32_t kFixedVersion = 2;
+inline constexpr std::uint32_t kHasIntensity = 1, kHasColor = 2;
+
+/// What both versions begin with.
+struct BlockStart {
+  char magic[8];
+  std::uint32_t version;
+  std::uint32_t flags;
+};
+
+/// Version 3's header.
+struct BlockHeader {
+  BlockStart start;
+  std::uint64_t vertices;
+  std::uint64_t triangles;
+  std::uint64_t payload_bytes;
+  std::uint64_t checksum;  ///< bulk_checksum (XXH3) of the payload
+};
+static_assert(sizeof(BlockHeader) == 48);
+
+/// Version 2's header: the payload's size follows from the counts.
+struct FixedBlockHeader {
+  BlockStart start;
+  std::uint64_t vertices;
+  std::uint64_t triangles;
+  std::uint64_t checksum;
+};
+static_assert(sizeof(FixedBlockHeader) == 40);
+
+/// Bytes per vertex of the attributes stored as they are (version 3: positions, intensities,
+/// colours).
+inline std::uint64_t raw_vertex_bytes(std::uint32_t flags) {
+  return 12 + ((flags & kHasIntensity) != 0 ? 4 : 0) + ((flags & kHasColor) != 0 ? 3 : 0);
+}
+/// Version 3's varints take at least a byte each: 4 per vertex (id, sensor x, y, z) and 6 per
+/// triangle (3 corners, face, index, fan and role).
+inline constexpr std::uint64_t kMinVarintsPerVertex = 4, kMinVarintsPerTriangle = 6;
+/// Version 2's fixed sizes.
+inline std::uint64_t fixed_vertex_bytes(std::uint32_t flags) { return 4 + 12 + raw_vertex_bytes(flags); }
+inline constexpr std::uint64_t kFixedTriangleBytes = 12 + 8 + 4 + 4 + 1;
+
+inline std::uint32_t flags_of(const Mesh& m) {
+  return (m.intensities.empty() ? 0 : kHasIntensity) | (m.colors.empty() ? 0 : kHasColor);
+}
+
+inline std::uint32_t float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
+
+}  // namespace citymesh::tiler_detail

@@ -1,0 +1,81 @@
+// SPDX-License-Identifier: MIT
+// Variable-length integers for the tile store's blocks (private to the tiler): LEB128 bytes
+// of zigzag deltas, so that the ids and indices of a block, which mostly grow by one, take a
+// byte each instead of four or eight.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+namespace citymesh::tiler_detail {
+
+/// The most bytes put() or put_delta() takes for values of `bits` bits (put_delta's zigzag
+/// needs one bit more).
+constexpr std::size_t max_varint_bytes(unsigned bits) { return (bits + 1 + 6) / 7; }
+
+/// Writes varints into a buffer sized beforehand: `room` must be at least the bytes every
+/// value to come can take (see max_varint_bytes), so that no write checks the capacity. The
+/// buffer is not zeroed: only the bytes written are ever touched.
+class VarintWriter {
+ public:
+  explicit VarintWriter(std::size_t room) : buffer_(new char[room]), at_(buffer_.get()) {}
+
+  void put(std::uint64_t v) {
+    while (v >= 0x80) {
+      *at_++ = static_cast<char>(v | 0x80);
+      v >>= 7;
+    }
+    *at_++ = static_cast<char>(v);
+  }
+
+  /// `value - previous` as a zigzag varint (small either way); wraps modulo 2^64, so any pair
+  /// of values round-trips.
+  void put_delta(std::uint64_t value, std::uint64_t previous) {
+    const auto d = static_cast<std::int64_t>(value - previous);
+    put((static_cast<std::uint64_t>(d) << 1) ^ static_cast<std::uint64_t>(d >> 63));
+  }
+
+  [[nodiscard]] std::string_view bytes() const {
+    return {buffer_.get(), static_cast<std::size_t>(at_ - buffer_.get())};
+  }
+
+ private:
+  std::unique_ptr<char[]> buffer_;
+  char* at_;
+};
+
+/// Reads varints from a byte range; every read says whether it stayed inside the range, so a
+/// damaged block is an error, never a read past its end.
+class VarintReader {
+ public:
+  VarintReader(const char* begin, const char* end) : at_(begin), end_(end) {}
+
+  [[nodiscard]] bool get(std::uint64_t& v) {
+    v = 0;
+    for (unsigned shift = 0; shift < 64; shift += 7) {
+      if (at_ == end_) return false;
+      const auto byte = static_cast<std::uint8_t>(*at_++);
+      v |= std::uint64_t{byte & 0x7fu} << shift;
+      if ((byte & 0x80u) == 0) return true;
+    }
+    return false;  // more than ten bytes: not a varint this writer made
+  }
+
+  /// The inverse of VarintWriter::put_delta.
+  [[nodiscard]] bool get_delta(std::uint64_t& value, std::uint64_t previous) {
+    std::uint64_t z = 0;
+    if (!get(z)) return false;
+    value = previous + ((z >> 1) ^ (~(z & 1) + 1));
+    return true;
+  }
+
+  [[nodiscard]] bool at_end() const { return at_ == end_; }
+
+ private:
+  const char* at_;
+  const char* end_;
+};
+
+}  // namespace citymesh::tiler_detail
