@@ -10,9 +10,9 @@
 
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/varint.h"
 #include "citymesh/tiler/tile_store.h"
 #include "tile_block_format.h"
-#include "varint.h"
 
 namespace citymesh {
 

@@ -14,8 +14,8 @@
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
+#include "citymesh/core/varint.h"
 #include "tile_block_format.h"
-#include "varint.h"
 
 namespace citymesh {
 

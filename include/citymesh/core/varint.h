@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
-// Variable-length integers for the tile store's blocks (private to the tiler): LEB128 bytes
-// of zigzag deltas, so that the ids and indices of a block, which mostly grow by one, take a
-// byte each instead of four or eight.
+// Variable-length integers for citymesh's bulk files (tile store blocks, tile results): LEB128
+// bytes of zigzag deltas, so that ids and indices that mostly grow by one take a byte each
+// instead of four or eight.
 #pragma once
 
 #include <cstddef>
@@ -9,7 +9,7 @@
 #include <memory>
 #include <string_view>
 
-namespace citymesh::tiler_detail {
+namespace citymesh {
 
 /// The most bytes put() or put_delta() takes for values of `bits` bits (put_delta's zigzag
 /// needs one bit more).
@@ -78,4 +78,4 @@ class VarintReader {
   const char* end_;
 };
 
-}  // namespace citymesh::tiler_detail
+}  // namespace citymesh

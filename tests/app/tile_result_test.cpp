@@ -1,0 +1,119 @@
+// SPDX-License-Identifier: MIT
+// Tile result files: labels and pairs of any values round-trip; damage under a valid checksum
+// makes the tile "processed again", never a crash or a wrong result.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <fstream>
+#include <random>
+
+#include "citymesh/core/checksum.h"
+#include "citymesh/core/read_file.h"
+#include "test_support.h"
+#include "tile_job.h"
+
+namespace citymesh::app {
+namespace {
+
+constexpr std::uint64_t kFingerprint = 0x1234;
+
+/// A store of two acquisitions on 50 m tiles (what read_tile_result checks against).
+TileStore two_acquisitions() {
+  TileStore store;
+  store.grid = {.tile_size = 50, .halo = 2, .origin = {651000, 6860000}};
+  store.triangles = {1000, 1000};
+  return store;
+}
+
+/// A result with labels and pairs sorted as process_tile writes them. `scan_order`: labels of
+/// consecutive triangles over few dates; otherwise any value over its whole range.
+TileResult random_result(std::uint32_t seed, bool scan_order) {
+  std::mt19937_64 rng(seed);
+  TileResult r;
+  r.key = {13020, -7};
+  r.triangles_in_tile = 4321;
+  r.seconds_detect = 0.25;
+  for (std::uint32_t k = 0; k < 700; ++k) {
+    OwnedLabel l{.acquisition = scan_order ? k / 400 : static_cast<std::uint32_t>(rng()),
+                 .index = scan_order ? 10 + k : static_cast<std::uint32_t>(rng()),
+                 .state = static_cast<TriangleState>(rng() % 3),
+                 .kept = static_cast<std::uint8_t>(rng() % 2),
+                 .sustainable = static_cast<std::uint8_t>(rng() % 2),
+                 .refutes = static_cast<std::uint8_t>(rng() % 2),
+                 .selected = static_cast<std::uint8_t>(rng() % 2),
+                 .notes = static_cast<std::uint8_t>(rng())};
+    l.first_ms = scan_order ? 1767607200000 + std::int64_t(k / 100) * 86400000 : static_cast<std::int64_t>(rng());
+    l.last_ms = scan_order ? l.first_ms + 2592000000 : static_cast<std::int64_t>(rng());
+    r.labels.push_back(l);
+  }
+  std::sort(r.labels.begin(), r.labels.end(), by_triangle);
+  for (std::uint32_t k = 0; k < 900; ++k) {
+    r.pairs.push_back({static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng()),
+                       static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng())});
+  }
+  r.selected.resize(2);
+  for (TilePiece& p : r.selected) p.mesh.origin = {651000 + 50 * 13020.0, 6860000 - 50 * 7.0, 0};
+  return r;
+}
+
+void expect_same_labels(const std::vector<OwnedLabel>& a, const std::vector<OwnedLabel>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    EXPECT_EQ(std::memcmp(&a[k], &b[k], sizeof(OwnedLabel)), 0) << "label " << k;
+  }
+}
+
+TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
+  test::TempDir tmp;
+  const TileStore store = two_acquisitions();
+  for (const bool scan_order : {false, true}) {
+    const TileResult r = random_result(scan_order ? 1 : 2, scan_order);
+    write_tile_result(tmp / "t.bin", r, kFingerprint);
+    const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint, store);
+    ASSERT_TRUE(back.has_value());
+    EXPECT_EQ(back->key, r.key);
+    EXPECT_EQ(back->triangles_in_tile, r.triangles_in_tile);
+    EXPECT_EQ(back->seconds_detect, r.seconds_detect);
+    expect_same_labels(back->labels, r.labels);
+    ASSERT_EQ(back->pairs.size(), r.pairs.size());
+    for (std::size_t k = 0; k < r.pairs.size(); ++k) {
+      EXPECT_EQ(std::memcmp(&back->pairs[k], &r.pairs[k], sizeof(LabelPair)), 0) << "pair " << k;
+    }
+    // Another config's result is not this run's.
+    EXPECT_FALSE(read_tile_result(tmp / "t.bin", kFingerprint + 1, store).has_value());
+  }
+}
+
+TEST(TileResult, ScanOrderedLabelsTakeUnderAQuarterOfTheFixedLayout) {
+  test::TempDir tmp;
+  TileResult r = random_result(3, true);
+  r.pairs.clear();
+  write_tile_result(tmp / "t.bin", r, kFingerprint);
+  // Version 04 took 32 bytes per label after an 80-byte header.
+  EXPECT_LT(std::filesystem::file_size(tmp / "t.bin"), (80 + 32 * r.labels.size()) / 4);
+}
+
+TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
+  test::TempDir tmp;
+  const TileStore store = two_acquisitions();
+  const TileResult r = random_result(4, true);
+  write_tile_result(tmp / "good.bin", r, kFingerprint);
+  const std::string good = *read_file_bytes(tmp / "good.bin");
+  std::mt19937 rng(5);
+  int refused = 0;
+  for (int trial = 0; trial < 500; ++trial) {
+    std::string bytes = good;
+    // A count or section size in the header (bytes 24-56 and 80-96), or the varint sections.
+    const std::size_t at = trial % 4 == 0 ? 24 + rng() % 32 : trial % 4 == 1 ? 80 + rng() % 16 : 96 + rng() % 3000;
+    bytes[at] = static_cast<char>(rng());
+    const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
+    std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
+    std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
+    const std::optional<TileResult> back = read_tile_result(tmp / "bad.bin", kFingerprint, store);
+    if (!back) ++refused;
+  }
+  EXPECT_GT(refused, 250);
+}
+
+}  // namespace
+}  // namespace citymesh::app
