@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Tile result files: the labels, consistent pairs and selected triangles of one finished tile.
 #include <algorithm>
+#include <atomic>
 #include <cstring>
 
 #include "citymesh/core/atomic_file.h"
@@ -125,6 +126,19 @@ bool decode_pairs(std::string_view bytes, std::size_t count, std::vector<LabelPa
   return in.at_end();
 }
 
+/// After an upgrade every result of the older format is processed again: said once, not once
+/// per tile (a city has tens of thousands).
+std::optional<TileResult> older_version(const std::filesystem::path& file) {
+  static std::atomic<bool> said{false};
+  if (!said.exchange(true)) {
+    log::warn("{}: not a tile result of this version (made by an older citymesh?); such tiles are processed again",
+              file.string());
+  } else {
+    log::debug("{}: not a tile result of this version; the tile is processed again", file.string());
+  }
+  return std::nullopt;
+}
+
 template <class T>
 void append_raw(std::string& bytes, const T& value) {
   bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
@@ -176,7 +190,7 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
   if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale("checksum mismatch");
   std::memcpy(&h, bytes.data(), sizeof h);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return stale("not a tile result of this version");
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return older_version(file);
   if (h.fingerprint != fingerprint) return std::nullopt;  // made with another config: --force was given
   const std::size_t body = bytes.size() - sizeof sum - sizeof h;
   // Counts are checked against the section sizes (a varint takes a byte at least) before
