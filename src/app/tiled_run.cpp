@@ -183,9 +183,13 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   if (cluster.root()) check_run_config(config.project.work, keys, options.force);
   const std::uint64_t result_fingerprint = fingerprint(keys, false);
   const TileStore store = prepare_tile_store(config, fingerprint(keys, true), cluster, options.subset);
+  // Each stage's arrays differ from the last one's: the memory one freed goes back to the
+  // system instead of staying resident under the next one's peak.
+  release_freed_memory();
   nlohmann::json seconds{{"tiling", clock.restart()}};
   if (options.subset) return run_subset(config, store, result_fingerprint, *options.subset, cluster);
   const TileStageReport tiles = process_tiles(config, store, result_fingerprint, cluster, all_tiles(store));
+  release_freed_memory();
   seconds["tiles"] = clock.restart();
   // The seam pass and the outputs need every tile: the root writes them alone.
   if (cluster.root()) write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, cluster.size());

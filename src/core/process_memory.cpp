@@ -40,4 +40,10 @@ void keep_freed_memory_for_reuse() {
 #endif
 }
 
+void release_freed_memory() {
+#if defined(__GLIBC__)
+  malloc_trim(0);
+#endif
+}
+
 }  // namespace citymesh

@@ -38,6 +38,18 @@ TEST(ProcessMemory, FreedMemoryStaysForReuse) {
   EXPECT_LE(resident_bytes(), touched + 16 * kMiB);
   std::free(again);
 }
+
+TEST(ProcessMemory, ReleasedMemoryLeavesTheResidentSet) {
+  keep_freed_memory_for_reuse();
+  constexpr std::size_t kBlock = 256 * kMiB;
+  auto* block = static_cast<char*>(std::malloc(kBlock));
+  ASSERT_NE(block, nullptr);
+  std::memset(block, 1, kBlock);
+  const std::uint64_t touched = resident_bytes();
+  std::free(block);
+  release_freed_memory();  // what a run does between its stages
+  EXPECT_LE(resident_bytes(), touched - kBlock / 2) << "the freed block stayed resident";
+}
 #endif
 
 }  // namespace

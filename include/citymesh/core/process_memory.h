@@ -21,4 +21,10 @@ std::uint64_t peak_resident_bytes();
 /// no-op elsewhere than glibc.
 void keep_freed_memory_for_reuse();
 
+/// Gives the free memory the allocator kept back to the system (glibc: malloc_trim over every
+/// arena). For the boundaries between a run's stages: what one stage freed is not what the
+/// next allocates, and would otherwise stay resident under the next stage's peak. A no-op
+/// elsewhere than glibc.
+void release_freed_memory();
+
 }  // namespace citymesh
