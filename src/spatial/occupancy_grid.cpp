@@ -28,8 +28,10 @@ openvdb::Int32 floor_to_int(double v) {
 }
 
 /// The voxel holding p, for voxels of 1 / `inverse_size` metres. Marking and queries both use
-/// it, so that a box overlapping a marked box always meets one of its voxels.
-openvdb::Coord voxel_of(const Vec3f& p, double inverse_size) {
+/// it, so that a box overlapping a marked box always meets one of its voxels. Always inlined:
+/// returned from a call, the three ints are stored as two halves and reloaded as one (a
+/// store-forwarding stall that took 8 % of the change step).
+[[gnu::always_inline]] inline openvdb::Coord voxel_of(const Vec3f& p, double inverse_size) {
   return {floor_to_int(p.x * inverse_size), floor_to_int(p.y * inverse_size), floor_to_int(p.z * inverse_size)};
 }
 
