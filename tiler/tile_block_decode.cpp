@@ -88,12 +88,11 @@ std::size_t read_fixed_block(std::string_view bytes, const BlockPlace& place, Bl
   return sizeof h + size;
 }
 
-/// The next delta-coded value, which must fit in 32 bits.
-std::uint32_t next_u32(VarintReader& in, std::uint64_t previous, const BlockPlace& place) {
-  std::uint64_t value = 0;
-  if (!in.get_delta(value, previous)) throw place.fail("truncated varints");
-  if (value > UINT32_MAX) throw place.fail(fmt::format("value {} out of range", value));
-  return static_cast<std::uint32_t>(value);
+/// The next value of the sequence `running` (see VarintReader::get_next), or an input error.
+template <class Unsigned>
+Unsigned next(VarintReader& in, Unsigned& running, const BlockPlace& place) {
+  if (!in.get_next(running)) throw place.fail("a varint is truncated or out of range");
+  return running;
 }
 
 /// The varint part of a version-3 payload (see encode_varints).
@@ -103,8 +102,8 @@ void read_varints(VarintReader& in, std::size_t nv, std::size_t nt, const BlockP
   std::uint32_t id = 0;
   std::array<std::uint32_t, 3> sensor{};
   for (std::size_t v = 0; v < nv; ++v) {
-    b.ids[v] = id = next_u32(in, id, place);
-    for (std::uint32_t& bits : sensor) bits = next_u32(in, bits, place);
+    b.ids[v] = next(in, id, place);
+    for (std::uint32_t& bits : sensor) next(in, bits, place);
     b.sensors[v] = {std::bit_cast<float>(sensor[0]), std::bit_cast<float>(sensor[1]), std::bit_cast<float>(sensor[2])};
   }
   b.triangles.resize(nt);
@@ -115,11 +114,10 @@ void read_varints(VarintReader& in, std::size_t nv, std::size_t nt, const BlockP
   std::uint32_t corner = 0, index = 0;
   std::uint64_t face = 0, fan_role = 0;
   for (std::size_t t = 0; t < nt; ++t) {
-    for (std::uint32_t& c : b.triangles[t]) c = corner = next_u32(in, corner, place);
-    if (!in.get_delta(face, face)) throw place.fail("truncated varints");
-    b.faces[t] = face;
-    b.indices[t] = index = next_u32(in, index, place);
-    if (!in.get(fan_role)) throw place.fail("truncated varints");
+    for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
+    b.faces[t] = next(in, face, place);
+    b.indices[t] = next(in, index, place);
+    if (!in.get(fan_role)) throw place.fail("a varint is truncated or out of range");
     if (fan_role >> 2 > UINT32_MAX) throw place.fail(fmt::format("triangle {}: fan out of range", t));
     b.fans[t] = static_cast<std::uint32_t>(fan_role >> 2);
     b.roles[t] = static_cast<TileRole>(fan_role & 3);

@@ -38,26 +38,21 @@ VarintWriter encode_varints(const TilePiece& piece) {
   const std::size_t per_vertex = 4 * max_varint_bytes(32);
   const std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(34);
   VarintWriter w(piece.vertex_ids.size() * per_vertex + m.triangle_count() * per_triangle);
-  std::uint64_t id = 0;
-  std::array<std::uint64_t, 3> sensor{};
+  std::uint32_t id = 0;
+  std::array<std::uint32_t, 3> sensor{};
   for (std::size_t v = 0; v < piece.vertex_ids.size(); ++v) {
-    w.put_delta(piece.vertex_ids[v], id);
-    id = piece.vertex_ids[v];
+    w.put_next(piece.vertex_ids[v], id);
     const Vec3f& p = m.sensor_positions[v];
-    const std::array<std::uint64_t, 3> bits{float_bits(p.x), float_bits(p.y), float_bits(p.z)};
-    for (std::size_t k = 0; k < 3; ++k) w.put_delta(bits[k], sensor[k]);
-    sensor = bits;
+    w.put_next(float_bits(p.x), sensor[0]);
+    w.put_next(float_bits(p.y), sensor[1]);
+    w.put_next(float_bits(p.z), sensor[2]);
   }
-  std::uint64_t corner = 0, face = 0, index = 0;
+  std::uint32_t corner = 0, index = 0;
+  std::uint64_t face = 0;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    for (const std::uint32_t c : m.triangles[t]) {
-      w.put_delta(c, corner);
-      corner = c;
-    }
-    w.put_delta(m.triangle_ids[t].face, face);
-    face = m.triangle_ids[t].face;
-    w.put_delta(piece.triangle_index[t], index);
-    index = piece.triangle_index[t];
+    for (const std::uint32_t c : m.triangles[t]) w.put_next(c, corner);
+    w.put_next(m.triangle_ids[t].face, face);
+    w.put_next(piece.triangle_index[t], index);
     w.put(std::uint64_t{m.triangle_ids[t].fan} << 2 | static_cast<std::uint8_t>(piece.roles[t]));
   }
   return w;

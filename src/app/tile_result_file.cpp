@@ -36,8 +36,9 @@ static_assert(sizeof(ResultHeader) == 96);
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
 std::uint64_t label_bits(const OwnedLabel& l) {
-  return static_cast<std::uint64_t>(l.state) | std::uint64_t{l.kept != 0} << 2 | std::uint64_t{l.sustainable != 0} << 3 |
-         std::uint64_t{l.refutes != 0} << 4 | std::uint64_t{l.selected != 0} << 5 | std::uint64_t{l.notes} << 6;
+  return static_cast<std::uint64_t>(l.state) | std::uint64_t{l.kept != 0} << 2 |
+         std::uint64_t{l.sustainable != 0} << 3 | std::uint64_t{l.refutes != 0} << 4 |
+         std::uint64_t{l.selected != 0} << 5 | std::uint64_t{l.notes} << 6;
 }
 
 /// Varints per label: acquisition, index, bits, first and last seen.
@@ -49,14 +50,14 @@ constexpr std::size_t kVarintsPerPair = 4;
 /// mostly the next triangle of the same acquisition, seen over the same dates.
 VarintWriter encode_labels(std::span<const OwnedLabel> labels) {
   VarintWriter w(labels.size() * (kVarintsPerLabel - 1) * max_varint_bytes(64) + labels.size() * max_varint_bytes(14));
-  OwnedLabel previous{};
+  std::uint32_t acquisition = 0, index = 0;
+  std::uint64_t first = 0, last = 0;  // Unix milliseconds, as two's complement
   for (const OwnedLabel& l : labels) {
-    w.put_delta(l.acquisition, previous.acquisition);
-    w.put_delta(l.index, previous.index);
+    w.put_next(l.acquisition, acquisition);
+    w.put_next(l.index, index);
     w.put(label_bits(l));
-    w.put_delta(static_cast<std::uint64_t>(l.first_ms), static_cast<std::uint64_t>(previous.first_ms));
-    w.put_delta(static_cast<std::uint64_t>(l.last_ms), static_cast<std::uint64_t>(previous.last_ms));
-    previous = l;
+    w.put_next(static_cast<std::uint64_t>(l.first_ms), first);
+    w.put_next(static_cast<std::uint64_t>(l.last_ms), last);
   }
   return w;
 }
@@ -64,48 +65,38 @@ VarintWriter encode_labels(std::span<const OwnedLabel> labels) {
 /// Pairs (sorted) as deltas against the previous pair.
 VarintWriter encode_pairs(std::span<const LabelPair> pairs) {
   VarintWriter w(pairs.size() * kVarintsPerPair * max_varint_bytes(32));
-  LabelPair previous{};
+  LabelPair running{};
   for (const LabelPair& p : pairs) {
-    w.put_delta(p.a_acquisition, previous.a_acquisition);
-    w.put_delta(p.a_index, previous.a_index);
-    w.put_delta(p.b_acquisition, previous.b_acquisition);
-    w.put_delta(p.b_index, previous.b_index);
-    previous = p;
+    w.put_next(p.a_acquisition, running.a_acquisition);
+    w.put_next(p.a_index, running.a_index);
+    w.put_next(p.b_acquisition, running.b_acquisition);
+    w.put_next(p.b_index, running.b_index);
   }
   return w;
-}
-
-/// The next delta-coded value if it fits in 32 bits.
-bool next_u32(VarintReader& in, std::uint32_t& value) {
-  std::uint64_t v = 0;
-  if (!in.get_delta(v, value) || v > UINT32_MAX) return false;
-  value = static_cast<std::uint32_t>(v);
-  return true;
 }
 
 /// The inverse of encode_labels; false when the bytes do not hold `labels` valid labels.
 bool decode_labels(std::string_view bytes, std::size_t count, std::vector<OwnedLabel>& labels) {
   VarintReader in(bytes.data(), bytes.data() + bytes.size());
   labels.resize(count);
-  OwnedLabel previous{};
+  std::uint32_t acquisition = 0, index = 0;
+  std::uint64_t bits = 0, first = 0, last = 0;
   for (OwnedLabel& l : labels) {
-    std::uint64_t bits = 0, first = static_cast<std::uint64_t>(previous.first_ms),
-                  last = static_cast<std::uint64_t>(previous.last_ms);
-    l = previous;
-    if (!next_u32(in, l.acquisition) || !next_u32(in, l.index) || !in.get(bits) || !in.get_delta(first, first) ||
-        !in.get_delta(last, last)) {
+    if (!in.get_next(acquisition) || !in.get_next(index) || !in.get(bits) || !in.get_next(first) ||
+        !in.get_next(last)) {
       return false;
     }
     if ((bits & 3) > 2 || bits >> 14 != 0) return false;
-    l.state = static_cast<TriangleState>(bits & 3);
-    l.kept = (bits >> 2) & 1;
-    l.sustainable = (bits >> 3) & 1;
-    l.refutes = (bits >> 4) & 1;
-    l.selected = (bits >> 5) & 1;
-    l.notes = static_cast<std::uint8_t>(bits >> 6);
-    l.first_ms = static_cast<std::int64_t>(first);
-    l.last_ms = static_cast<std::int64_t>(last);
-    previous = l;
+    l = {.acquisition = acquisition,
+         .index = index,
+         .state = static_cast<TriangleState>(bits & 3),
+         .kept = static_cast<std::uint8_t>((bits >> 2) & 1),
+         .sustainable = static_cast<std::uint8_t>((bits >> 3) & 1),
+         .refutes = static_cast<std::uint8_t>((bits >> 4) & 1),
+         .selected = static_cast<std::uint8_t>((bits >> 5) & 1),
+         .notes = static_cast<std::uint8_t>(bits >> 6),
+         .first_ms = static_cast<std::int64_t>(first),
+         .last_ms = static_cast<std::int64_t>(last)};
   }
   return in.at_end();
 }
@@ -114,14 +105,13 @@ bool decode_labels(std::string_view bytes, std::size_t count, std::vector<OwnedL
 bool decode_pairs(std::string_view bytes, std::size_t count, std::vector<LabelPair>& pairs) {
   VarintReader in(bytes.data(), bytes.data() + bytes.size());
   pairs.resize(count);
-  LabelPair previous{};
+  LabelPair running{};
   for (LabelPair& p : pairs) {
-    p = previous;
-    if (!next_u32(in, p.a_acquisition) || !next_u32(in, p.a_index) || !next_u32(in, p.b_acquisition) ||
-        !next_u32(in, p.b_index)) {
+    if (!in.get_next(running.a_acquisition) || !in.get_next(running.a_index) || !in.get_next(running.b_acquisition) ||
+        !in.get_next(running.b_index)) {
       return false;
     }
-    previous = p;
+    p = running;
   }
   return in.at_end();
 }

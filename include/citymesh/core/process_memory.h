@@ -16,9 +16,9 @@ std::uint64_t peak_resident_bytes();
 /// the system (glibc: no mmap for large blocks, no trimming of the heap's top). Each tile and
 /// each mosaic allocates and frees the same large arrays (the energy's pair index alone is
 /// ~150 MB on a street); returned, every page is faulted in and zeroed again by the kernel on
-/// the next use, a tenth of the mosaic's time. The resident set then stays at its peak: the
-/// peak, which the memory budget bounds, does not change. Call once, first thing in main(); a
-/// no-op elsewhere than glibc.
+/// the next use, a tenth of the mosaic's time. The resident set then stays at its peak until
+/// release_freed_memory(): the peak, which the memory budget bounds, does not change. Call
+/// once, first thing in main(); a no-op elsewhere than glibc.
 void keep_freed_memory_for_reuse();
 
 /// Gives the free memory the allocator kept back to the system (glibc: malloc_trim over every

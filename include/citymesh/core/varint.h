@@ -8,10 +8,11 @@
 #include <cstdint>
 #include <memory>
 #include <string_view>
+#include <type_traits>
 
 namespace citymesh {
 
-/// The most bytes put() or put_delta() takes for values of `bits` bits (put_delta's zigzag
+/// The most bytes put() or put_next() takes for values of `bits` bits (put_next's zigzag
 /// needs one bit more).
 constexpr std::size_t max_varint_bytes(unsigned bits) { return (bits + 1 + 6) / 7; }
 
@@ -30,11 +31,15 @@ class VarintWriter {
     *at_++ = static_cast<char>(v);
   }
 
-  /// `value - previous` as a zigzag varint (small either way); wraps modulo 2^64, so any pair
-  /// of values round-trips.
-  void put_delta(std::uint64_t value, std::uint64_t previous) {
-    const auto d = static_cast<std::int64_t>(value - previous);
+  /// `value - running` as a zigzag varint (small either way), then `running = value`: a
+  /// sequence written against its own previous value. Wraps modulo 2^64, so any pair of values
+  /// round-trips.
+  template <class Unsigned>
+  void put_next(Unsigned value, Unsigned& running) {
+    static_assert(std::is_unsigned_v<Unsigned>);
+    const auto d = static_cast<std::int64_t>(std::uint64_t{value} - std::uint64_t{running});
     put((static_cast<std::uint64_t>(d) << 1) ^ static_cast<std::uint64_t>(d >> 63));
+    running = value;
   }
 
   [[nodiscard]] std::string_view bytes() const {
@@ -63,11 +68,19 @@ class VarintReader {
     return false;  // more than ten bytes: not a varint this writer made
   }
 
-  /// The inverse of VarintWriter::put_delta.
-  [[nodiscard]] bool get_delta(std::uint64_t& value, std::uint64_t previous) {
+  /// The inverse of VarintWriter::put_next: the next value of the sequence, into `running`.
+  [[nodiscard]] bool get_next(std::uint64_t& running) {
     std::uint64_t z = 0;
     if (!get(z)) return false;
-    value = previous + ((z >> 1) ^ (~(z & 1) + 1));
+    running += (z >> 1) ^ (~(z & 1) + 1);
+    return true;
+  }
+
+  /// The same for a sequence of 32-bit values: false also when the next value does not fit.
+  [[nodiscard]] bool get_next(std::uint32_t& running) {
+    std::uint64_t value = running;
+    if (!get_next(value) || value > UINT32_MAX) return false;
+    running = static_cast<std::uint32_t>(value);
     return true;
   }
 
