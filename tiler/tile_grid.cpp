@@ -65,19 +65,34 @@ Vec3d TileGrid::corner(TileKey key) const {
   return {params_.origin[0] + key.i * params_.tile_size, params_.origin[1] + key.j * params_.tile_size, 0.0};
 }
 
-template <class Keep>
-std::vector<TileKey> TileGrid::tiles_near(const Box3d& box, Keep keep) const {
+TileGrid::CellRange TileGrid::cells_near(const Box3d& box) const {
   const double h = params_.halo, s = params_.tile_size;
   // A tile (i, j) grown by h meets the box when [i*s - h, (i+1)*s + h] overlaps [min, max].
-  const std::int32_t i0 = cell(box.min.x - h, params_.origin[0], s), i1 = cell(box.max.x + h, params_.origin[0], s);
-  const std::int32_t j0 = cell(box.min.y - h, params_.origin[1], s), j1 = cell(box.max.y + h, params_.origin[1], s);
+  return {cell(box.min.x - h, params_.origin[0], s), cell(box.max.x + h, params_.origin[0], s),
+          cell(box.min.y - h, params_.origin[1], s), cell(box.max.y + h, params_.origin[1], s)};
+}
+
+template <class Keep>
+std::vector<TileKey> TileGrid::tiles_near(const Box3d& box, Keep keep) const {
+  const CellRange r = cells_near(box);
   std::vector<TileKey> tiles;
-  for (std::int32_t i = i0; i <= i1; ++i) {
-    for (std::int32_t j = j0; j <= j1; ++j) {
+  for (std::int32_t i = r.i0; i <= r.i1; ++i) {
+    for (std::int32_t j = r.j0; j <= r.j1; ++j) {
       if (keep(TileKey{i, j})) tiles.push_back({i, j});
     }
   }
   return tiles;
+}
+
+bool TileGrid::hull_meets_band(std::span<const Vec3d> points, TileKey key) const {
+  const double h = params_.halo, s = params_.tile_size;
+  const Vec3d c = corner(key);
+  const double x0 = c.x - h, y0 = c.y - h, x1 = c.x + s + h, y1 = c.y + s + h;
+  // A point inside settles it (most tiles a tetrahedron meets hold one of its corners).
+  const bool holds_a_point = std::any_of(points.begin(), points.end(), [&](const Vec3d& p) {
+    return p.x >= x0 && p.x <= x1 && p.y >= y0 && p.y <= y1;
+  });
+  return holds_a_point || hull_meets_rectangle(points, x0, y0, x1, y1);
 }
 
 std::vector<TileKey> TileGrid::halo_tiles(const Box3d& box, TileKey owner_key) const {
@@ -89,21 +104,49 @@ bool TileGrid::within_one_tile(const Box3d& box) const {
   return owner(box.min - grow) == owner(box.max + grow);
 }
 
+bool TileGrid::clearly_within(const Box3d& box, TileKey key) const {
+  const Vec3d c = corner(key);
+  const double h = params_.halo, s = params_.tile_size;
+  // Far enough inside the tile's sides that no rounding of owner()'s division can put a
+  // point of the grown box in another tile.
+  const double margin = 1e-12 * (std::abs(c.x) + std::abs(c.y) + s) + 1e-9;
+  return box.min.x - h >= c.x + margin && box.max.x + h <= c.x + s - margin && box.min.y - h >= c.y + margin &&
+         box.max.y + h <= c.y + s - margin;
+}
+
 std::vector<TileKey> TileGrid::tiles_crossed(std::span<const Vec3d> points) const {
   Box3d box;
   for (const Vec3d& p : points) box.extend(p);
-  const double h = params_.halo, s = params_.tile_size;
   // The shape grown by the halo inside one tile (the common case): no exact test needed.
   if (within_one_tile(box)) return {owner(box.min)};
-  return tiles_near(box, [&](TileKey k) {
-    const Vec3d c = corner(k);
-    const double x0 = c.x - h, y0 = c.y - h, x1 = c.x + s + h, y1 = c.y + s + h;
-    // A point inside settles it (most tiles a tetrahedron meets hold one of its corners).
-    const bool holds_a_point = std::any_of(points.begin(), points.end(), [&](const Vec3d& p) {
-      return p.x >= x0 && p.x <= x1 && p.y >= y0 && p.y <= y1;
-    });
-    return holds_a_point || hull_meets_rectangle(points, x0, y0, x1, y1);
-  });
+  return tiles_near(box, [&](TileKey k) { return hull_meets_band(points, k); });
+}
+
+void TileGrid::copy_targets(std::span<const Vec3d, 3> corners, const Vec3d& viewpoint, TileKey owner_key,
+                            std::vector<TileKey>& halo, std::vector<TileKey>& crossed) const {
+  halo.clear();
+  crossed.clear();
+  Box3d box;
+  for (const Vec3d& p : corners) box.extend(p);
+  Box3d reach = box;
+  reach.extend(viewpoint);
+  if (clearly_within(reach, owner_key)) return;
+  // The cells tiles_crossed would visit hold those halo_tiles would: one loop names both.
+  const CellRange near_reach = cells_near(reach);
+  if (near_reach.i0 == near_reach.i1 && near_reach.j0 == near_reach.j1) return;  // within one tile
+  const CellRange near_box = cells_near(box);
+  const std::array<Vec3d, 4> tetrahedron{corners[0], corners[1], corners[2], viewpoint};
+  for (std::int32_t i = near_reach.i0; i <= near_reach.i1; ++i) {
+    for (std::int32_t j = near_reach.j0; j <= near_reach.j1; ++j) {
+      const TileKey k{i, j};
+      if (k == owner_key) continue;
+      if (near_box.holds(k)) {
+        halo.push_back(k);
+      } else if (hull_meets_band(tetrahedron, k)) {
+        crossed.push_back(k);
+      }
+    }
+  }
 }
 
 }  // namespace citymesh

@@ -120,8 +120,13 @@ std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePie
   // No fsync here: sync_tile_files() makes the store durable once, before the manifest names it.
   const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   bool ok = fd >= 0;
+  const off_t at = ok ? ::lseek(fd, 0, SEEK_END) : 0;
   ok = ok && ::writev(fd, io.data(), static_cast<int>(io.size())) == static_cast<ssize_t>(total);
   const int err = errno;
+  // Start writing the block back now, without waiting: the tiler goes on while the disk
+  // works, and the fsync before the store is published then finds little left to wait for
+  // (it was a fifth of the tiler's time). Only a hint: a failure here changes nothing.
+  if (ok) (void)::sync_file_range(fd, at, static_cast<off_t>(total), SYNC_FILE_RANGE_WRITE);
   if (fd >= 0) ::close(fd);
   if (!ok) throw OutputError(fmt::format("{}: cannot append a tile block: {}", file.string(), std::strerror(err)));
   return total;

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <map>
-#include <unordered_map>
+#include <span>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
@@ -34,28 +34,54 @@ struct AcquisitionVertices {
   }
 };
 
-/// The triangles of the current acquisition bound for one tile, not yet on disk.
-struct TileBuffer {
-  TilePiece piece;
-  std::array<std::uint64_t, 3> counts{};  ///< triangles per role since the last flush
-  std::uint32_t serial = 0;               ///< unique within the acquisition's run, never 0
-  /// vertex id -> index in the piece, for the vertices whose cache slot (see
-  /// AcquisitionTiler::slots_) went to another buffer: the slot and this map together know
-  /// every vertex of the piece.
-  std::unordered_map<std::uint32_t, std::uint32_t> local;
+/// A triangle of the current batch: what its copies need once the batch is written.
+struct BatchTriangle {
+  Triangle corners;     ///< vertex ids in the acquisition
+  std::uint32_t fan = 0;
+  std::uint64_t face = 0;
+  std::uint32_t index = 0;  ///< in the acquisition (PlyReader's order)
+};
+
+/// One copy of a batch triangle bound for a tile: the tile's slot in the batch and the role.
+struct TileCopy {
+  std::uint32_t triangle;   ///< in the batch
+  std::uint32_t slot_role;  ///< slot << 2 | role
+};
+
+/// A tile the current batch sends triangles to.
+struct BatchTile {
+  TileKey key;
+  std::array<std::uint64_t, 3> counts{};  ///< copies per role
+  std::uint32_t copies = 0;               ///< in all
 };
 
 std::string chunk_name(TileKey key);
 
-/// Hash-map overhead per buffered vertex, on top of the block bytes: an upper bound since
-/// most vertices sit in the cache slots instead (see local_vertex).
-constexpr std::uint64_t kMapBytesPerVertex = 32;
+/// Upper bound of the memory one copy takes in the piece and block of its tile while that
+/// tile is written (triangle 33 bytes, up to a vertex of ~35 bytes, block bytes): only the
+/// largest tile of a batch is ever built at once.
+constexpr std::uint64_t kPieceBytesPerCopy = 96;
+/// A batch is written once it holds this much, even when the budget allows more: larger
+/// batches gain nothing (their blocks go to the same files) and touch fresh memory, whose
+/// page faults took a fifth of the tiler's time with batches of a quarter of a 2 GiB budget.
+constexpr std::uint64_t kMaxBatchBytes = 32ull << 20;
+/// Batch triangles are numbered in 30 bits (TileCopy, the sorted copies).
+constexpr std::size_t kMaxBatchTriangles = (std::size_t{1} << 30) - 1;
 
+/// Tiles one acquisition in batches: each triangle's destinations (owner, halo tiles, tiles
+/// its empty space crosses) are recorded as it is read; when the batch is full, its copies are
+/// sorted by tile and each tile's block is built in one reused piece and appended to the
+/// tile's chunk file. A tile's triangles keep their input order and its vertices their order
+/// of first use, so the blocks do not depend on how the work is done.
 class AcquisitionTiler {
  public:
   AcquisitionTiler(const TileGrid& grid, std::filesystem::path dir, AcquisitionTiling& out, std::uint32_t acquisition,
                    std::uint64_t buffer_bytes)
-      : grid_(grid), dir_(std::move(dir)), out_(out), acquisition_(acquisition), buffer_bytes_(buffer_bytes) {}
+      : grid_(grid),
+        dir_(std::move(dir)),
+        out_(out),
+        acquisition_(acquisition),
+        buffer_bytes_(std::min(buffer_bytes, kMaxBatchBytes)) {}
 
   void run(const std::filesystem::path& file, const PlyReadParams& ply) {
     PlyReader reader(file, ply);
@@ -86,8 +112,8 @@ class AcquisitionTiler {
         }
         check_face_extent(file, faces.faces[t], vertices_.positions[tri[0]], vertices_.positions[tri[1]],
                           vertices_.positions[tri[2]]);
-        add_triangle(tri, {acquisition_, faces.fans[t], faces.faces[t]});
-        if (buffered_ > buffer_bytes_) flush();
+        add_triangle({tri, faces.fans[t], faces.faces[t], next_index_++});
+        if (batch_bytes() > buffer_bytes_ || batch_.size() >= kMaxBatchTriangles) flush();
       }
     }
     flush();
@@ -106,91 +132,97 @@ class AcquisitionTiler {
     slots_.reserve(n);
   }
 
-  void add_triangle(const Triangle& tri, const TriangleId& id) {
-    const std::uint32_t index = next_index_++;
+  /// What the batch holds, and the largest tile's piece and block while it is written.
+  [[nodiscard]] std::uint64_t batch_bytes() const {
+    return batch_.size() * sizeof(BatchTriangle) + copies_.size() * (sizeof(TileCopy) + sizeof(std::uint32_t)) +
+           std::uint64_t{largest_tile_} * kPieceBytesPerCopy;
+  }
+
+  void add_triangle(const BatchTriangle& triangle) {
+    const auto t = static_cast<std::uint32_t>(batch_.size());
+    batch_.push_back(triangle);
+    const Triangle& tri = triangle.corners;
     const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
                                  vertices_.positions[tri[2]]};
     const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
-    Box3d box;
-    for (const Vec3d& p : c) box.extend(p);
-    add_to(owner, tri, id, index, TileRole::owned);
+    add_copy(owner, t, TileRole::owned);
     const Vec3d viewpoint =
         (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
-    Box3d reach = box;
-    reach.extend(viewpoint);
-    // Most triangles and their viewpoints lie well inside one tile (then it is the owner): no
-    // halo copy and no other tile crossed, as halo_tiles and tiles_crossed would find.
-    if (grid_.within_one_tile(reach)) return;
-    const std::vector<TileKey> halo = grid_.halo_tiles(box, owner);
-    for (const TileKey k : halo) add_to(k, tri, id, index, TileRole::halo);
-    out_.stats.halo_copies += halo.size();
-    const std::array<Vec3d, 4> tetrahedron{c[0], c[1], c[2], viewpoint};
-    for (const TileKey k : grid_.tiles_crossed(tetrahedron)) {
-      if (k == owner || std::binary_search(halo.begin(), halo.end(), k)) continue;
-      add_to(k, tri, id, index, TileRole::empty_space);
-      ++out_.stats.empty_space_copies;
-    }
+    grid_.copy_targets(c, viewpoint, owner, halo_, crossed_);
+    for (const TileKey k : halo_) add_copy(k, t, TileRole::halo);
+    for (const TileKey k : crossed_) add_copy(k, t, TileRole::empty_space);
+    out_.stats.halo_copies += halo_.size();
+    out_.stats.empty_space_copies += crossed_.size();
   }
 
-  void add_to(TileKey key, const Triangle& tri, const TriangleId& id, std::uint32_t index, TileRole role) {
+  void add_copy(TileKey key, std::uint32_t triangle, TileRole role) {
     // Consecutive triangles mostly go to the same tile: skip the map lookup then.
-    if (last_ == nullptr || key != last_key_) {
-      last_ = &buffers_[key];
-      last_key_ = key;
-      if (last_->serial == 0) {
-        last_->serial = next_serial_++;
-        live_.push_back(last_);
-      }
+    if (tiles_.empty() || key != tiles_[last_slot_].key) {
+      const auto [it, added] = slot_of_.try_emplace(key, static_cast<std::uint32_t>(tiles_.size()));
+      if (added) tiles_.push_back({key, {}, 0});
+      last_slot_ = it->second;
     }
-    TileBuffer& b = *last_;
-    if (b.piece.mesh.positions.empty() && b.piece.mesh.triangles.empty()) b.piece.mesh.origin = grid_.corner(key);
-    Triangle local{};
-    for (std::size_t k = 0; k < 3; ++k) local[k] = local_vertex(b, tri[k]);
-    b.piece.mesh.triangles.push_back(local);
-    b.piece.mesh.triangle_ids.push_back(id);
-    b.piece.triangle_index.push_back(index);
-    b.piece.roles.push_back(role);
-    buffered_ += 29;
-    ++b.counts[static_cast<std::size_t>(role)];
+    copies_.push_back({triangle, last_slot_ << 2 | static_cast<std::uint32_t>(role)});
+    BatchTile& tile = tiles_[last_slot_];
+    ++tile.counts[static_cast<std::size_t>(role)];
+    largest_tile_ = std::max(largest_tile_, ++tile.copies);
   }
 
-  /// v's index in b's piece, added to the piece the first time. Each vertex has one cache
-  /// slot (buffer serial, index) that answers nearly every lookup, since a vertex's triangles
-  /// mostly go to one tile; when another buffer takes the slot, the entry moves to its
-  /// buffer's map. A map per buffer alone took three hash lookups per triangle.
-  std::uint32_t local_vertex(TileBuffer& b, std::uint32_t v) {
-    std::uint64_t& slot = slots_[v];
-    if (slot >> 32 == b.serial) return static_cast<std::uint32_t>(slot);
-    if (const auto it = b.local.find(v); it != b.local.end()) return it->second;
-    if (slot >> 32 >= first_live_serial_) {
-      live_[(slot >> 32) - first_live_serial_]->local.emplace(v, static_cast<std::uint32_t>(slot));
+  /// Writes one block per tile of the batch (in key order) and empties the batch.
+  void flush() {
+    // Copies grouped by tile, each tile's in input order (a stable counting sort).
+    std::vector<std::uint32_t> start(tiles_.size() + 1, 0);
+    for (std::size_t s = 0; s < tiles_.size(); ++s) start[s + 1] = start[s] + tiles_[s].copies;
+    sorted_.resize(copies_.size());
+    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+    for (const TileCopy& c : copies_) sorted_[at[c.slot_role >> 2]++] = c.triangle << 2 | (c.slot_role & 3u);
+    for (const auto& [key, s] : slot_of_) {
+      auto& counts = out_.counts[key];
+      for (std::size_t r = 0; r < 3; ++r) counts[r] += tiles_[s].counts[r];
+      build_piece(key, std::span(sorted_).subspan(start[s], start[s + 1] - start[s]));
+      const std::filesystem::path chunk = dir_ / chunk_name(key);
+      std::filesystem::create_directories(chunk.parent_path());
+      out_.stats.bytes_written += append_tile_block(chunk, piece_);
+      ++out_.stats.blocks;
     }
-    const auto index = static_cast<std::uint32_t>(b.piece.vertex_ids.size());
-    slot = std::uint64_t{b.serial} << 32 | index;
-    Mesh& m = b.piece.mesh;
-    b.piece.vertex_ids.push_back(v);
+    batch_.clear();
+    copies_.clear();
+    tiles_.clear();
+    slot_of_.clear();
+    largest_tile_ = 0;
+  }
+
+  /// One tile's block of the batch in piece_: its triangles (`copies`: batch triangle << 2 |
+  /// role) in input order, their vertices in order of first use, in the tile's frame.
+  void build_piece(TileKey key, std::span<const std::uint32_t> copies) {
+    piece_.clear();
+    Mesh& m = piece_.mesh;
+    m.origin = grid_.corner(key);
+    ++stamp_;  // every slot of an earlier block is stale
+    for (const std::uint32_t copy : copies) {
+      const BatchTriangle& t = batch_[copy >> 2];
+      Triangle local{};
+      for (std::size_t k = 0; k < 3; ++k) local[k] = local_vertex(t.corners[k]);
+      m.triangles.push_back(local);
+      m.triangle_ids.push_back({acquisition_, t.fan, t.face});
+      piece_.triangle_index.push_back(t.index);
+      piece_.roles.push_back(static_cast<TileRole>(copy & 3u));
+    }
+  }
+
+  /// v's index in piece_, added to it the first time this block uses v.
+  std::uint32_t local_vertex(std::uint32_t v) {
+    std::uint64_t& slot = slots_[v];
+    if (slot >> 32 == stamp_) return static_cast<std::uint32_t>(slot);
+    const auto index = static_cast<std::uint32_t>(piece_.vertex_ids.size());
+    slot = std::uint64_t{stamp_} << 32 | index;
+    Mesh& m = piece_.mesh;
+    piece_.vertex_ids.push_back(v);
     m.positions.push_back(to_local(vertices_.positions[v], m.origin));
     m.sensor_positions.push_back(to_local(vertices_.sensors[v], m.origin));
     if (!vertices_.intensities.empty()) m.intensities.push_back(vertices_.intensities[v]);
     if (!vertices_.colors.empty()) m.colors.push_back(vertices_.colors[v]);
-    buffered_ += 28 + kMapBytesPerVertex;
     return index;
-  }
-
-  void flush() {
-    for (auto& [key, b] : buffers_) {
-      for (std::size_t r = 0; r < 3; ++r) out_.counts[key][r] += b.counts[r];
-      if (b.piece.triangle_count() == 0) continue;
-      const std::filesystem::path file = dir_ / chunk_name(key);
-      std::filesystem::create_directories(file.parent_path());
-      out_.stats.bytes_written += append_tile_block(file, b.piece);
-      ++out_.stats.blocks;
-    }
-    buffers_.clear();
-    live_.clear();
-    first_live_serial_ = next_serial_;  // every slot now names a flushed buffer
-    last_ = nullptr;
-    buffered_ = 0;
   }
 
   const TileGrid& grid_;
@@ -199,14 +231,20 @@ class AcquisitionTiler {
   std::uint32_t acquisition_;
   std::uint64_t buffer_bytes_;
   AcquisitionVertices vertices_;
-  std::map<TileKey, TileBuffer> buffers_;
-  std::vector<std::uint64_t> slots_;  ///< per vertex: buffer serial << 32 | index in its piece
-  std::vector<TileBuffer*> live_;     ///< the buffers since the last flush, by serial
-  std::uint32_t first_live_serial_ = 1, next_serial_ = 1;
-  TileBuffer* last_ = nullptr;  ///< the buffer of last_key_ (map nodes do not move)
-  TileKey last_key_;
-  std::uint64_t buffered_ = 0;
   std::uint32_t next_index_ = 0;
+  // The batch: triangles read since the last flush and their copies.
+  std::vector<BatchTriangle> batch_;
+  std::vector<TileCopy> copies_;
+  std::vector<BatchTile> tiles_;             ///< by slot
+  std::map<TileKey, std::uint32_t> slot_of_;
+  std::uint32_t last_slot_ = 0;
+  std::vector<TileKey> halo_, crossed_;  ///< the current triangle's other tiles
+  std::uint32_t largest_tile_ = 0;  ///< copies of the batch's largest tile
+  // Reused by every flush.
+  std::vector<std::uint32_t> sorted_;
+  TilePiece piece_;
+  std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in piece_
+  std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };
 
 std::string chunk_name(TileKey key) { return key.name() + ".bin"; }

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <random>
 
 #include "citymesh/core/error.h"
@@ -57,6 +58,61 @@ TEST(TileGrid, HaloTilesEqualBruteForce) {
   }
   EXPECT_GT(within, 200u);  // both answers occur
   EXPECT_LT(within, 1800u);
+}
+
+/// copy_targets as the tiler had it: halo_tiles, then tiles_crossed less the owner and the
+/// halo tiles, nothing when the whole shape lies within one tile.
+void reference_targets(const TileGrid& grid, const std::array<Vec3d, 3>& c, const Vec3d& viewpoint, TileKey owner,
+                       std::vector<TileKey>& halo, std::vector<TileKey>& crossed) {
+  halo.clear();
+  crossed.clear();
+  Box3d box, reach;
+  for (const Vec3d& p : c) box.extend(p);
+  reach = box;
+  reach.extend(viewpoint);
+  if (grid.within_one_tile(reach)) return;
+  halo = grid.halo_tiles(box, owner);
+  const std::array<Vec3d, 4> tetrahedron{c[0], c[1], c[2], viewpoint};
+  for (const TileKey k : grid.tiles_crossed(tetrahedron)) {
+    if (k != owner && !std::binary_search(halo.begin(), halo.end(), k)) crossed.push_back(k);
+  }
+}
+
+TEST(TileGrid, CopyTargetsEqualHaloAndCrossedTilesOnTileSidesAtCityCoordinates) {
+  // Lambert-93 sized coordinates, and triangles whose grown box falls exactly on a tile side
+  // or an ulp either way: where the quick comparisons must hand over to the cells.
+  const TileGrid grid({.tile_size = 50, .halo = 2, .origin = {650000.5, 6860000.25}});
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> tile(-3, 3), offset(-2, 2);
+  std::uniform_real_distribution<double> u(0, 50), e(0, 5), far(-30, 30);
+  std::vector<TileKey> halo, crossed, expected_halo, expected_crossed;
+  std::size_t none = 0, with_crossed = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const Vec3d corner = grid.corner({tile(rng), tile(rng)});
+    const auto near_side = [&](double side) {
+      double x = side;
+      for (int k = offset(rng); k != 0; k += k > 0 ? -1 : 1) x = std::nextafter(x, k > 0 ? 1e300 : -1e300);
+      return x;
+    };
+    Vec3d a{corner.x + u(rng), corner.y + u(rng), 0};
+    if (n % 2 == 0) a.x = near_side(corner.x + 2);  // grown lower side on the tile's side
+    if (n % 3 == 0) a.y = near_side(corner.y + 2);
+    Vec3d b = a + Vec3d{e(rng), 0, 1}, c = a + Vec3d{0, e(rng), 2};
+    if (n % 5 == 0) b.x = near_side(corner.x + 48);  // grown upper side on the next tile's
+    const std::array<Vec3d, 3> t{a, b, c};
+    // The viewpoint near the triangle, or far enough to cross tiles.
+    const Vec3d viewpoint = n % 4 == 0 ? a + Vec3d{far(rng), far(rng), 2} : a + Vec3d{0.5, 0.5, 2};
+    const TileKey owner = grid.owner((a + b + c) / 3.0);
+    grid.copy_targets(t, viewpoint, owner, halo, crossed);
+    reference_targets(grid, t, viewpoint, owner, expected_halo, expected_crossed);
+    ASSERT_EQ(halo, expected_halo) << n;
+    ASSERT_EQ(crossed, expected_crossed) << n;
+    none += halo.empty() && crossed.empty() ? 1 : 0;
+    with_crossed += crossed.empty() ? 0 : 1;
+  }
+  EXPECT_GT(none, 1000u);  // every kind of answer occurs
+  EXPECT_GT(with_crossed, 1000u);
+  EXPECT_LT(none, 19000u);
 }
 
 /// Brute force: two convex sets in the plane meet when a point of one lies in the other or

@@ -4,10 +4,12 @@
 // ratio, the tile count and the bytes the store took.
 // Usage: tile_bench CONFIG [tile_size (default: the config's)] [work folder (default: temp)]
 #include <fmt/format.h>
+#include <sys/resource.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "citymesh/config/config.h"
 #include "citymesh/core/parallel.h"
@@ -33,6 +35,15 @@ std::uint64_t read_only(const Config& config) {
   return triangles;
 }
 
+/// CPU seconds (user and system) of this process so far: next to the wall time, it tells
+/// the tiler's own work from its waits on the disk.
+double cpu_seconds() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  const auto seconds = [](const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) / 1e6; };
+  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -50,23 +61,29 @@ int main(int argc, char** argv) {
   params.buffer_bytes = config.run.memory / 4;
 
   Stopwatch clock;
+  double cpu = cpu_seconds();
+  const auto cpu_since = [&cpu] {
+    const double before = std::exchange(cpu, cpu_seconds());
+    return cpu - before;
+  };
   const std::uint64_t triangles = read_only(config);
-  const double read = clock.restart();
+  const double read = clock.restart(), read_cpu = cpu_since();
   const TileStore store = tile_acquisitions(config.acquisition_list(), params);
-  const double tile = clock.restart();
+  const double tile = clock.restart(), tile_cpu = cpu_since();
   // As `citymesh run` tiles when the budget allows: one acquisition per thread.
   const unsigned at_once = available_threads();
   (void)tile_acquisitions(config.acquisition_list(), params, at_once);
-  const double tile_parallel = clock.restart();
+  const double tile_parallel = clock.restart(), tile_parallel_cpu = cpu_since();
   fmt::print("input: {} acquisitions, {:.2f} M triangles, {:.0f} MB\n", store.triangles.size(), double(triangles) / 1e6,
              double(store.stats.input_bytes) / 1e6);
-  fmt::print("read only : {:7.2f} s  {:6.2f} M triangles/s (one file after another)\n", read,
-             double(triangles) / read / 1e6);
-  fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; one acquisition at a time)\n",
-             tile, double(triangles) / tile / 1e6, tile / read);
+  fmt::print("read only : {:7.2f} s  {:6.2f} M triangles/s (one file after another; CPU {:.2f} s)\n", read,
+             double(triangles) / read / 1e6, read_cpu);
+  fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; one acquisition at a time; "
+             "CPU {:.2f} s)\n",
+             tile, double(triangles) / tile / 1e6, tile / read, tile_cpu);
   fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; {} at a time, as `run`; "
-             "target <= 2)\n",
-             tile_parallel, double(triangles) / tile_parallel / 1e6, tile_parallel / read, at_once);
+             "CPU {:.2f} s; target <= 2)\n",
+             tile_parallel, double(triangles) / tile_parallel / 1e6, tile_parallel / read, at_once, tile_parallel_cpu);
   fmt::print("tiles     : {} of {:.0f} m, halo copies {:.2f} M, empty-space copies {:.2f} M, {} blocks, {:.0f} MB "
              "written\n",
              store.tiles.size(), params.grid.tile_size, double(store.stats.halo_copies) / 1e6,

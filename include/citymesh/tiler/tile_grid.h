@@ -50,11 +50,30 @@ class TileGrid {
   /// tetrahedron (a triangle and its viewpoint) goes to these tiles, so that a conflict is
   /// found even when the sensor stood in another tile.
   [[nodiscard]] std::vector<TileKey> tiles_crossed(std::span<const Vec3d> points) const;
+  /// Where a triangle is copied besides its owner `owner` (the tile of its centroid):
+  /// `halo` = halo_tiles(box of the corners, owner), `crossed` = tiles_crossed(corners and
+  /// viewpoint) less the owner and the halo tiles, both in (i, j) order; both empty when the
+  /// triangle and its viewpoint lie within the owner grown by the halo, which the tiler's
+  /// triangles mostly do and which four comparisons mostly settle. Both vectors are cleared
+  /// first; their room is reused from call to call.
+  void copy_targets(std::span<const Vec3d, 3> corners, const Vec3d& viewpoint, TileKey owner,
+                    std::vector<TileKey>& halo, std::vector<TileKey>& crossed) const;
 
  private:
   /// Tiles whose halo band meets the x-y extent of `box` and that `keep` accepts.
   template <class Keep>
   std::vector<TileKey> tiles_near(const Box3d& box, Keep keep) const;
+  /// Whether the x-y hull of `points` meets tile `key` grown by the halo.
+  [[nodiscard]] bool hull_meets_band(std::span<const Vec3d> points, TileKey key) const;
+  /// The first and last column and row whose halo bands meet the x-y extent of `box`.
+  struct CellRange {
+    std::int32_t i0, i1, j0, j1;
+    [[nodiscard]] bool holds(TileKey k) const { return k.i >= i0 && k.i <= i1 && k.j >= j0 && k.j <= j1; }
+  };
+  [[nodiscard]] CellRange cells_near(const Box3d& box) const;
+  /// True when the x-y extent of `box` grown by the halo lies inside tile `key` by more than
+  /// any rounding of owner() can cross (false says nothing).
+  [[nodiscard]] bool clearly_within(const Box3d& box, TileKey key) const;
 
   TileGridParams params_;
 };
