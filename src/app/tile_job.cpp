@@ -50,10 +50,27 @@ bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
   return std::pair{x.acquisition, x.index} < std::pair{y.acquisition, y.index};
 }
 
+void SettledSelection::add(std::span<const OwnedLabel> labels) {
+  const auto middle = static_cast<std::ptrdiff_t>(keys_.size());
+  keys_.reserve(keys_.size() + labels.size());
+  for (const OwnedLabel& l : labels) {
+    keys_.push_back(std::uint64_t{l.acquisition} << 33 | std::uint64_t{l.index} << 1 | (l.selected != 0 ? 1u : 0u));
+  }
+  if (!std::is_sorted(keys_.begin() + middle, keys_.end())) std::sort(keys_.begin() + middle, keys_.end());
+  std::inplace_merge(keys_.begin(), keys_.begin() + middle, keys_.end());
+}
+
+std::optional<bool> SettledSelection::selected(std::uint32_t acquisition, std::uint32_t index) const {
+  const std::uint64_t probe = std::uint64_t{acquisition} << 33 | std::uint64_t{index} << 1;
+  const auto it = std::lower_bound(keys_.begin(), keys_.end(), probe);
+  if (it == keys_.end() || (*it | 1u) != (probe | 1u)) return std::nullopt;
+  return (*it & 1u) != 0;
+}
+
 int tile_phase(TileKey key) { return (key.i & 1) * 2 + (key.j & 1); }
 
 TileResult process_tile(const TileStore& store, TileKey key, const Config& config,
-                        std::span<const OwnedLabel> settled) {
+                        const SettledSelection& settled) {
   Stopwatch clock;
   TileResult r;
   r.key = key;
@@ -75,11 +92,10 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
       // Empty-space triangles lie outside the tile and its halo: never mosaic candidates.
       if (pieces[a].roles[t] == TileRole::empty_space) change.kept[g] = 0;
       if (pieces[a].roles[t] != TileRole::halo) continue;
-      const OwnedLabel probe{.acquisition = a, .index = pieces[a].triangle_index[t]};
-      const auto it = std::lower_bound(settled.begin(), settled.end(), probe, by_triangle);
-      if (it == settled.end() || it->acquisition != a || it->index != probe.index) continue;
-      change.kept[g] = it->selected;
-      forced[g] = it->selected;
+      const std::optional<bool> selected = settled.selected(a, pieces[a].triangle_index[t]);
+      if (!selected) continue;
+      change.kept[g] = *selected ? 1 : 0;
+      forced[g] = *selected ? 1 : 0;
     }
   }
   const MosaicSelection selection = select(config, meshes, dates, change, forced);

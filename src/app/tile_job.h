@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "citymesh/change/detect.h"
@@ -34,6 +35,24 @@ struct LabelPair {
   std::uint32_t a_acquisition = 0, a_index = 0, b_acquisition = 0, b_index = 0;
 };
 
+/// The mosaic's decisions on triangles that earlier-phase neighbours own: the tile keeps
+/// them for its halo copies of those triangles (see process_tile).
+class SettledSelection {
+ public:
+  /// Adds a neighbour's labels, sorted by triangle as a tile result holds them; neighbours own
+  /// disjoint triangles.
+  void add(std::span<const OwnedLabel> labels);
+  /// Whether a neighbour selected triangle `index` of `acquisition`; nothing when no
+  /// neighbour added has decided it.
+  [[nodiscard]] std::optional<bool> selected(std::uint32_t acquisition, std::uint32_t index) const;
+  [[nodiscard]] std::size_t size() const { return keys_.size(); }
+
+ private:
+  /// acquisition << 33 | index << 1 | selected, sorted: an eighth of the labels' bytes, and
+  /// each neighbour's run merged in linear time instead of sorting them all.
+  std::vector<std::uint64_t> keys_;
+};
+
 struct TileResult {
   TileKey key;
   std::vector<OwnedLabel> labels;   ///< every owned triangle, by (acquisition, index)
@@ -56,7 +75,7 @@ inline constexpr int kTilePhases = 4;
 /// ones are forced into the energy mosaic, the others are no candidates), so both sides of a
 /// tile border agree.
 TileResult process_tile(const TileStore& store, TileKey key, const Config& config,
-                        std::span<const OwnedLabel> settled);
+                        const SettledSelection& settled);
 
 /// Writes the result atomically with the run's fingerprint.
 void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t fingerprint);
@@ -64,5 +83,9 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& resu
 /// otherwise (then the tile is processed again).
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
                                            const TileStore& store);
+/// Only the labels of that result (same checks; the other sections are not decoded): what
+/// a later-phase neighbour needs.
+std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t fingerprint,
+                                                        const TileStore& store);
 
 }  // namespace citymesh::app

@@ -118,7 +118,7 @@ bool decode_pairs(std::string_view bytes, std::size_t count, std::vector<LabelPa
 
 /// After an upgrade every result of the older format is processed again: said once, not once
 /// per tile (a city has tens of thousands).
-std::optional<TileResult> older_version(const std::filesystem::path& file) {
+std::nullopt_t older_version(const std::filesystem::path& file) {
   static std::atomic<bool> said{false};
   if (!said.exchange(true)) {
     log::warn("{}: not a tile result of this version (made by an older citymesh?); such tiles are processed again",
@@ -165,20 +165,31 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
   write_file_atomically(file, bytes);
 }
 
-std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
-                                           const TileStore& store) {
-  const std::optional<std::string> read = read_file_bytes(file);
+namespace {
+
+/// A result file whose checksum, magic, fingerprint and section sizes passed: the header and
+/// the bytes, for the sections to be decoded.
+struct CheckedResult {
+  ResultHeader header{};
+  std::string bytes;
+};
+
+/// Says why a result is not used; nothing, for the reader to return.
+std::nullopt_t stale(const std::filesystem::path& file, std::string_view why) {
+  log::warn("{}: {}; the tile is processed again", file.string(), why);
+  return std::nullopt;
+}
+
+std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::uint64_t fingerprint,
+                                            const TileStore& store) {
+  std::optional<std::string> read = read_file_bytes(file);
   if (!read) return std::nullopt;
   const std::string_view bytes = *read;
   ResultHeader h{};
   std::uint64_t sum = 0;
-  const auto stale = [&](std::string_view why) -> std::optional<TileResult> {
-    log::warn("{}: {}; the tile is processed again", file.string(), why);
-    return std::nullopt;
-  };
-  if (bytes.size() < sizeof h + sizeof sum) return stale("truncated");
+  if (bytes.size() < sizeof h + sizeof sum) return stale(file, "truncated");
   std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
-  if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale("checksum mismatch");
+  if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale(file, "checksum mismatch");
   std::memcpy(&h, bytes.data(), sizeof h);
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return older_version(file);
   if (h.fingerprint != fingerprint) return std::nullopt;  // made with another config: --force was given
@@ -187,8 +198,20 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   // anything is allocated.
   if (h.acquisitions != store.triangles.size() || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
       h.labels > h.label_bytes / kVarintsPerLabel || h.pairs > h.pair_bytes / kVarintsPerPair) {
-    return stale("counts do not fit");
+    return stale(file, "counts do not fit");
   }
+  return CheckedResult{h, std::move(*read)};
+}
+
+}  // namespace
+
+std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
+                                           const TileStore& store) {
+  const std::optional<CheckedResult> checked = checked_result(file, fingerprint, store);
+  if (!checked) return std::nullopt;
+  const ResultHeader& h = checked->header;
+  const std::string_view bytes = checked->bytes;
+  const std::size_t end = bytes.size() - sizeof(std::uint64_t);  // the checksum follows
   TileResult r;
   r.key = {h.i, h.j};
   r.triangles_in_tile = h.triangles_in_tile;
@@ -196,17 +219,17 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   r.seconds_detect = h.seconds_detect;
   r.seconds_mosaic = h.seconds_mosaic;
   std::size_t at = sizeof h;
-  if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale("damaged labels");
+  if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;
-  if (!decode_pairs(bytes.substr(at, h.pair_bytes), h.pairs, r.pairs)) return stale("damaged pairs");
+  if (!decode_pairs(bytes.substr(at, h.pair_bytes), h.pairs, r.pairs)) return stale(file, "damaged pairs");
   at += h.pair_bytes;
   const Vec3d origin = TileGrid(store.grid).corner(r.key);
   for (std::uint32_t a = 0; a < h.acquisitions; ++a) {
     std::uint64_t size = 0;
-    if (bytes.size() - sizeof sum - at < sizeof size) return stale("truncated");
+    if (end - at < sizeof size) return stale(file, "truncated");
     std::memcpy(&size, bytes.data() + at, sizeof size);
     at += sizeof size;
-    if (size > bytes.size() - sizeof sum - at) return stale("truncated");
+    if (size > end - at) return stale(file, "truncated");
     TilePiece piece;
     piece.mesh.origin = origin;
     if (size > 0) piece = decode_tile_blocks(bytes.substr(at, size), origin, a, file.string());
@@ -214,6 +237,18 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
     at += size;
   }
   return r;
+}
+
+std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t fingerprint,
+                                                        const TileStore& store) {
+  const std::optional<CheckedResult> checked = checked_result(file, fingerprint, store);
+  if (!checked) return std::nullopt;
+  const ResultHeader& h = checked->header;
+  std::vector<OwnedLabel> labels;
+  if (!decode_labels(std::string_view(checked->bytes).substr(sizeof h, h.label_bytes), h.labels, labels)) {
+    return stale(file, "damaged labels");
+  }
+  return labels;
 }
 
 }  // namespace citymesh::app

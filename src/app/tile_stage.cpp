@@ -72,28 +72,28 @@ class Progress {
   Stopwatch clock_, since_line_;
 };
 
-/// A dependency's result. On a shared filesystem a file another machine just renamed into
+/// A dependency's labels. On a shared filesystem a file another machine just renamed into
 /// place may take a moment to appear: look again for a few seconds before giving up.
-TileResult dependency_result(const Config& config, const TileStore& store, TileKey key, TileKey needed_by,
-                             std::uint64_t fingerprint) {
+std::vector<OwnedLabel> dependency_labels(const Config& config, const TileStore& store, TileKey key, TileKey needed_by,
+                                          std::uint64_t fingerprint) {
   const std::filesystem::path file = result_path(config, key);
   for (int attempt = 0;; ++attempt) {
-    if (std::optional<TileResult> r = read_tile_result(file, fingerprint, store)) return std::move(*r);
+    if (std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(file, fingerprint, store)) {
+      return std::move(*labels);
+    }
     if (attempt == 20) throw ProcessingError(fmt::format("{}: missing, needed by tile {}", file.string(), needed_by.name()));
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
   }
 }
 
-/// The labels of the tiles `k` waits for, sorted.
-std::vector<OwnedLabel> settled_labels(const Config& config, const TileStore& store, std::size_t k,
-                                       std::uint64_t fingerprint) {
-  std::vector<OwnedLabel> labels;
+/// The decisions of the tiles `k` waits for.
+SettledSelection settled_selection(const Config& config, const TileStore& store, std::size_t k,
+                                   std::uint64_t fingerprint) {
+  SettledSelection settled;
   for (const std::size_t d : tile_dependencies(store, k)) {
-    const TileResult r = dependency_result(config, store, store.tiles[d].key, store.tiles[k].key, fingerprint);
-    labels.insert(labels.end(), r.labels.begin(), r.labels.end());
+    settled.add(dependency_labels(config, store, store.tiles[d].key, store.tiles[k].key, fingerprint));
   }
-  std::sort(labels.begin(), labels.end(), by_triangle);
-  return labels;
+  return settled;
 }
 
 /// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
@@ -150,7 +150,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     const std::uint64_t estimate = tile.total() * kBytesPerTileTriangle;
     gate.acquire(estimate);
     try {
-      const TileResult r = process_tile(store, tile.key, config, settled_labels(config, store, k, fingerprint));
+      const TileResult r = process_tile(store, tile.key, config, settled_selection(config, store, k, fingerprint));
       write_tile_result(result_path(config, tile.key), r, fingerprint);
     } catch (...) {
       gate.release(estimate);

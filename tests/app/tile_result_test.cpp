@@ -3,8 +3,10 @@
 // makes the tile "processed again", never a crash or a wrong result.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <random>
 
 #include "citymesh/core/checksum.h"
@@ -79,8 +81,13 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {
       EXPECT_EQ(std::memcmp(&back->pairs[k], &r.pairs[k], sizeof(LabelPair)), 0) << "pair " << k;
     }
+    // The labels alone, as a later-phase neighbour reads them.
+    const std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(tmp / "t.bin", kFingerprint, store);
+    ASSERT_TRUE(labels.has_value());
+    expect_same_labels(*labels, r.labels);
     // Another config's result is not this run's.
     EXPECT_FALSE(read_tile_result(tmp / "t.bin", kFingerprint + 1, store).has_value());
+    EXPECT_FALSE(read_tile_labels(tmp / "t.bin", kFingerprint + 1, store).has_value());
   }
 }
 
@@ -111,8 +118,47 @@ TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
     std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
     const std::optional<TileResult> back = read_tile_result(tmp / "bad.bin", kFingerprint, store);
     if (!back) ++refused;
+    // The labels alone are refused whenever damage reaches the header or the labels.
+    const std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(tmp / "bad.bin", kFingerprint, store);
+    if (labels && back) expect_same_labels(*labels, back->labels);
   }
   EXPECT_GT(refused, 250);
+}
+
+TEST(SettledSelection, AnswersAsAMapOfEveryNeighboursLabels) {
+  // Up to eight neighbours own disjoint triangles of three acquisitions; each gives its labels
+  // sorted, as its result holds them.
+  std::mt19937 rng(6);
+  for (int trial = 0; trial < 20; ++trial) {
+    std::vector<std::uint32_t> indices(3000);
+    for (std::uint32_t k = 0; k < indices.size(); ++k) indices[k] = k * 7 + static_cast<std::uint32_t>(rng() % 7);
+    std::shuffle(indices.begin(), indices.end(), rng);
+    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> expected;
+    SettledSelection settled;
+    const std::size_t neighbours = 1 + rng() % 8;
+    for (std::size_t n = 0; n < neighbours; ++n) {
+      std::vector<OwnedLabel> labels;
+      for (std::size_t k = n; k < indices.size(); k += neighbours) {
+        const OwnedLabel l{.acquisition = static_cast<std::uint32_t>(rng() % 3),
+                           .index = indices[k],
+                           .selected = static_cast<std::uint8_t>(rng() % 2)};
+        if (expected.try_emplace({l.acquisition, l.index}, l.selected != 0).second) labels.push_back(l);
+      }
+      std::sort(labels.begin(), labels.end(), by_triangle);
+      settled.add(labels);
+    }
+    ASSERT_EQ(settled.size(), expected.size());
+    for (std::uint32_t a = 0; a < 3; ++a) {
+      for (std::uint32_t index = 0; index < 3000 * 7; ++index) {
+        const auto it = expected.find({a, index});
+        const std::optional<bool> got = settled.selected(a, index);
+        ASSERT_EQ(got.has_value(), it != expected.end()) << a << " " << index;
+        if (got) {
+          ASSERT_EQ(*got, it->second) << a << " " << index;
+        }
+      }
+    }
+  }
 }
 
 }  // namespace
