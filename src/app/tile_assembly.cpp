@@ -4,10 +4,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <tuple>
-#include <unordered_map>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/radix_sort.h"
 #include "citymesh/mosaic/mosaic.h"
 
 namespace citymesh::app {
@@ -65,45 +64,75 @@ void TileAssembly::add(TileResult result) {
 }
 
 MergedMesh TileAssembly::merged() const {
-  // (acquisition, triangle index, piece, triangle in piece): the output order is the input's.
-  std::vector<std::tuple<std::uint32_t, std::uint32_t, std::uint32_t, std::uint32_t>> order;
+  // Every selected triangle by its flat number (piece_start[p] + t), gathered per
+  // acquisition as (triangle index, flat number): sorted, the output order is the input's.
+  std::vector<std::uint32_t> piece_start{0};
+  std::vector<std::vector<std::pair<std::uint32_t, std::uint32_t>>> by_acquisition(store_.triangles.size());
+  std::vector<std::uint32_t> vertex_ids_end(store_.triangles.size(), 0);  ///< 1 + largest vertex id used
   bool intensities = true, colors = true;
-  for (std::uint32_t p = 0; p < pieces_.size(); ++p) {
-    const TilePiece& piece = pieces_[p];
+  for (const TilePiece& piece : pieces_) {
     intensities = intensities && !piece.mesh.intensities.empty();
     colors = colors && !piece.mesh.colors.empty();
     for (std::uint32_t t = 0; t < piece.triangle_count(); ++t) {
-      order.emplace_back(piece.mesh.triangle_ids[t].acquisition, piece.triangle_index[t], p, t);
+      const std::uint32_t a = piece.mesh.triangle_ids[t].acquisition;
+      by_acquisition[a].emplace_back(piece.triangle_index[t], piece_start.back() + t);
+      for (const std::uint32_t v : piece.mesh.triangles[t]) {
+        vertex_ids_end[a] = std::max(vertex_ids_end[a], piece.vertex_ids[v] + 1);
+      }
     }
+    piece_start.push_back(piece_start.back() + static_cast<std::uint32_t>(piece.triangle_count()));
   }
-  std::sort(order.begin(), order.end());
   MergedMesh out;
   Mesh& m = out.mesh;
-  if (!order.empty()) {
-    const TilePiece& first = pieces_[std::get<2>(order.front())];
-    m.origin = whole_metre_origin(first.mesh.world_position(first.mesh.triangles[std::get<3>(order.front())][0]));
-  }
-  std::unordered_map<std::uint64_t, std::uint32_t> vertex;  // (acquisition, vertex id) -> merged vertex
-  vertex.reserve(order.size());  // about one vertex for every two triangles; no rehash on the way
-  for (const auto& [a, index, p, t] : order) {
-    const TilePiece& piece = pieces_[p];
-    Triangle tri{};
-    for (std::size_t c = 0; c < 3; ++c) {
-      const std::uint32_t v = piece.mesh.triangles[t][c];
-      const std::uint64_t key = (std::uint64_t{a} << 32) | piece.vertex_ids[v];
-      const auto [it, added] = vertex.try_emplace(key, static_cast<std::uint32_t>(m.positions.size()));
-      if (added) {
-        m.positions.push_back(to_local(piece.mesh.world_position(v), m.origin));
-        m.sensor_positions.push_back(to_local(piece.mesh.world_sensor_position(v), m.origin));
-        if (intensities) m.intensities.push_back(piece.mesh.intensities[v]);
-        if (colors) m.colors.push_back(piece.mesh.colors[v]);
+  // Room at once (the triangles exactly, the vertices at most the pieces' own): growing by
+  // doubling copied the arrays of a city's output several times over.
+  std::size_t vertex_room = 0;
+  for (const TilePiece& piece : pieces_) vertex_room += piece.vertex_ids.size();
+  const std::size_t triangles = piece_start.back();
+  m.positions.reserve(vertex_room);
+  m.sensor_positions.reserve(vertex_room);
+  if (intensities) m.intensities.reserve(vertex_room);
+  if (colors) m.colors.reserve(vertex_room);
+  m.triangles.reserve(triangles);
+  m.triangle_ids.reserve(triangles);
+  out.source_acq.reserve(triangles);
+  out.source_triangle.reserve(triangles);
+  bool origin_set = false;
+  // Vertex id in the acquisition -> merged vertex: a dense table, one acquisition at a time
+  // (a hash map of every vertex took most of the assembly).
+  std::vector<std::uint32_t> merged_vertex;
+  for (std::uint32_t a = 0; a < by_acquisition.size(); ++a) {
+    auto& order = by_acquisition[a];
+    radix_sort_pairs(order);
+    merged_vertex.assign(vertex_ids_end[a], UINT32_MAX);
+    for (const auto& [index, flat] : order) {
+      const auto p = static_cast<std::size_t>(std::upper_bound(piece_start.begin(), piece_start.end(), flat) -
+                                              piece_start.begin() - 1);
+      const TilePiece& piece = pieces_[p];
+      const std::uint32_t t = flat - piece_start[p];
+      if (!origin_set) {
+        m.origin = whole_metre_origin(piece.mesh.world_position(piece.mesh.triangles[t][0]));
+        origin_set = true;
       }
-      tri[c] = it->second;
+      Triangle tri{};
+      for (std::size_t c = 0; c < 3; ++c) {
+        const std::uint32_t v = piece.mesh.triangles[t][c];
+        std::uint32_t& slot = merged_vertex[piece.vertex_ids[v]];
+        if (slot == UINT32_MAX) {
+          slot = static_cast<std::uint32_t>(m.positions.size());
+          m.positions.push_back(to_local(piece.mesh.world_position(v), m.origin));
+          m.sensor_positions.push_back(to_local(piece.mesh.world_sensor_position(v), m.origin));
+          if (intensities) m.intensities.push_back(piece.mesh.intensities[v]);
+          if (colors) m.colors.push_back(piece.mesh.colors[v]);
+        }
+        tri[c] = slot;
+      }
+      m.triangles.push_back(tri);
+      m.triangle_ids.push_back(piece.mesh.triangle_ids[t]);
+      out.source_acq.push_back(static_cast<std::int32_t>(a));
+      out.source_triangle.push_back(static_cast<std::int32_t>(index));
     }
-    m.triangles.push_back(tri);
-    m.triangle_ids.push_back(piece.mesh.triangle_ids[t]);
-    out.source_acq.push_back(static_cast<std::int32_t>(a));
-    out.source_triangle.push_back(static_cast<std::int32_t>(index));
+    std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(order);
   }
   return out;
 }

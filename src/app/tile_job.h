@@ -79,10 +79,18 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
 
 /// Writes the result atomically with the run's fingerprint.
 void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t fingerprint);
+/// Which sections of a tile result to decode (the checksum covers the whole file whatever
+/// is decoded).
+struct TileResultSections {
+  /// The consistent pairs: only the labelled PLYs need them, and on a city they are tens of
+  /// millions of pairs to decode and hold.
+  bool pairs = true;
+};
+
 /// The result in `file` when it is complete and was made with `fingerprint`; nothing
-/// otherwise (then the tile is processed again).
+/// otherwise (then the tile is processed again). Sections not asked for are left empty.
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
-                                           const TileStore& store);
+                                           const TileStore& store, TileResultSections sections = {});
 /// Only the labels of that result (same checks; the other sections are not decoded): what
 /// a later-phase neighbour needs.
 std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t fingerprint,

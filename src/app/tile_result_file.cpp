@@ -206,7 +206,7 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
 }  // namespace
 
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
-                                           const TileStore& store) {
+                                           const TileStore& store, TileResultSections sections) {
   const std::optional<CheckedResult> checked = checked_result(file, fingerprint, store);
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
@@ -221,7 +221,9 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   std::size_t at = sizeof h;
   if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;
-  if (!decode_pairs(bytes.substr(at, h.pair_bytes), h.pairs, r.pairs)) return stale(file, "damaged pairs");
+  if (sections.pairs && !decode_pairs(bytes.substr(at, h.pair_bytes), h.pairs, r.pairs)) {
+    return stale(file, "damaged pairs");
+  }
   at += h.pair_bytes;
   const Vec3d origin = TileGrid(store.grid).corner(r.key);
   for (std::uint32_t a = 0; a < h.acquisitions; ++a) {

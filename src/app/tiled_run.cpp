@@ -85,7 +85,8 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     const std::size_t count = std::min(kBatch, store.tiles.size() - first);
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store);
+        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store,
+                                    {.pairs = config.output.labels});
       }
     });
     for (std::size_t i = 0; i < count; ++i) add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0,

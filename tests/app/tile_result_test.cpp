@@ -81,6 +81,12 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {
       EXPECT_EQ(std::memcmp(&back->pairs[k], &r.pairs[k], sizeof(LabelPair)), 0) << "pair " << k;
     }
+    // Without the pairs, as the assembly reads it when no labelled PLY is written.
+    const std::optional<TileResult> no_pairs = read_tile_result(tmp / "t.bin", kFingerprint, store, {.pairs = false});
+    ASSERT_TRUE(no_pairs.has_value());
+    expect_same_labels(no_pairs->labels, r.labels);
+    EXPECT_TRUE(no_pairs->pairs.empty());
+    EXPECT_EQ(no_pairs->selected.size(), r.selected.size());
     // The labels alone, as a later-phase neighbour reads them.
     const std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(tmp / "t.bin", kFingerprint, store);
     ASSERT_TRUE(labels.has_value());
