@@ -149,6 +149,13 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     throw_if_interrupted("tile processing");
     const std::uint64_t estimate = tile.total() * kBytesPerTileTriangle;
     gate.acquire(estimate);
+    // The memory earlier tiles freed stays resident for reuse (keep_freed_memory_for_reuse),
+    // in each thread's arena: when that would take this tile past the budget, hand it back.
+    if (const std::uint64_t resident = resident_bytes(); resident + estimate > config.run.memory) {
+      log::debug("tile {}: {} MiB resident and {} MiB estimated: handing freed memory back", tile.key.name(),
+                 resident >> 20, estimate >> 20);
+      release_freed_memory();
+    }
     try {
       const TileResult r = process_tile(store, tile.key, config, settled_selection(config, store, k, fingerprint));
       write_tile_result(result_path(config, tile.key), r, fingerprint);
