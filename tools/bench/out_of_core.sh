@@ -11,7 +11,7 @@ dir="${1:-/tmp/citymesh-city}"
 streets="${2:-6}"
 bin=build/release/citymesh
 [ -f "$dir/config.toml" ] || "$bin" simulate --out "$dir" --streets "$streets" --length 500 >/dev/null
-build/release/bench/tile_bench "$dir/config.toml" 50 "$dir/tile-bench"
+build/release/bench/tile_bench "$dir/config.toml" 50 "$dir/tile-bench" 3
 for threads in 1 2; do
   rm -rf "$dir/work-$threads" "$dir/out-$threads"
   /usr/bin/time -v "$bin" run "$dir/config.toml" --no-pictures --threads "$threads" --memory 2GiB \

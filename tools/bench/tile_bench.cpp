@@ -1,15 +1,20 @@
 // SPDX-License-Identifier: MIT
 // Benchmark: the tiler against just reading the same input files with the streaming PLY
 // reader (the target: tiling within 2x of reading). Prints triangles/s of both, the
-// ratio, the tile count and the bytes the store took.
+// ratio, the tile count and the bytes the store took. Reading, tiling one acquisition at a
+// time and tiling as `run` does alternate over several rounds and the medians are compared:
+// on a shared VM the same read has taken from 0.46 to 1.77 s within minutes, so a ratio of
+// two single measurements says more about the host than about the tiler.
 // Usage: tile_bench CONFIG [tile_size (default: the config's)] [work folder (default: temp)]
+//                          [rounds (default 3)]
 #include <fmt/format.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
-#include <utility>
+#include <vector>
 
 #include "citymesh/config/config.h"
 #include "citymesh/core/parallel.h"
@@ -44,12 +49,42 @@ double cpu_seconds() {
   return seconds(usage.ru_utime) + seconds(usage.ru_stime);
 }
 
+/// Wall and CPU seconds of one measurement.
+struct Timing {
+  double wall = 0, cpu = 0;
+};
+
+template <class Work>
+Timing timed(Work&& work) {
+  Stopwatch clock;
+  const double cpu = cpu_seconds();
+  work();
+  return {clock.seconds(), cpu_seconds() - cpu};
+}
+
+/// The median of each field over the rounds (the lower middle one for an even count).
+Timing median(std::vector<Timing> rounds) {
+  const auto middle = [&](auto field) {
+    std::vector<double> v;
+    for (const Timing& t : rounds) v.push_back(t.*field);
+    std::nth_element(v.begin(), v.begin() + (v.size() - 1) / 2, v.end());
+    return v[(v.size() - 1) / 2];
+  };
+  return {middle(&Timing::wall), middle(&Timing::cpu)};
+}
+
+std::string wall_list(const std::vector<Timing>& rounds) {
+  std::string s;
+  for (const Timing& t : rounds) s += fmt::format("{}{:.2f}", s.empty() ? "" : " ", t.wall);
+  return s;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   keep_freed_memory_for_reuse();  // as the citymesh binary does
   if (argc < 2) {
-    fmt::print(stderr, "usage: tile_bench CONFIG [tile_size] [work folder]\n");
+    fmt::print(stderr, "usage: tile_bench CONFIG [tile_size] [work folder] [rounds]\n");
     return 1;
   }
   const Config config = load_config(argv[1]);
@@ -59,31 +94,36 @@ int main(int argc, char** argv) {
   params.ply = config.ply_read_params();
   params.dir = argc > 3 ? std::filesystem::path(argv[3]) : std::filesystem::temp_directory_path() / "citymesh_tile_bench";
   params.buffer_bytes = config.run.memory / 4;
-
-  Stopwatch clock;
-  double cpu = cpu_seconds();
-  const auto cpu_since = [&cpu] {
-    const double before = std::exchange(cpu, cpu_seconds());
-    return cpu - before;
-  };
-  const std::uint64_t triangles = read_only(config);
-  const double read = clock.restart(), read_cpu = cpu_since();
-  const TileStore store = tile_acquisitions(config.acquisition_list(), params);
-  const double tile = clock.restart(), tile_cpu = cpu_since();
+  const int rounds = argc > 4 ? std::max(1, std::stoi(argv[4])) : 3;
   // As `citymesh run` tiles when the budget allows: one acquisition per thread.
   const unsigned at_once = available_threads();
-  (void)tile_acquisitions(config.acquisition_list(), params, at_once);
-  const double tile_parallel = clock.restart(), tile_parallel_cpu = cpu_since();
-  fmt::print("input: {} acquisitions, {:.2f} M triangles, {:.0f} MB\n", store.triangles.size(), double(triangles) / 1e6,
-             double(store.stats.input_bytes) / 1e6);
-  fmt::print("read only : {:7.2f} s  {:6.2f} M triangles/s (one file after another; CPU {:.2f} s)\n", read,
-             double(triangles) / read / 1e6, read_cpu);
+
+  std::uint64_t triangles = 0;
+  TileStore store;
+  std::vector<Timing> read, tile, tile_parallel;
+  std::vector<double> ratios;  // tiling as `run` against the read of the same round
+  for (int r = 0; r < rounds; ++r) {
+    read.push_back(timed([&] { triangles = read_only(config); }));
+    tile.push_back(timed([&] { store = tile_acquisitions(config.acquisition_list(), params); }));
+    tile_parallel.push_back(timed([&] { (void)tile_acquisitions(config.acquisition_list(), params, at_once); }));
+    ratios.push_back(tile_parallel.back().wall / read.back().wall);
+  }
+  const Timing read_m = median(read), tile_m = median(tile), parallel_m = median(tile_parallel);
+  std::sort(ratios.begin(), ratios.end());
+  const auto per_second = [&](const Timing& t) { return double(triangles) / t.wall / 1e6; };
+  fmt::print("input: {} acquisitions, {:.2f} M triangles, {:.0f} MB; medians of {} rounds\n", store.triangles.size(),
+             double(triangles) / 1e6, double(store.stats.input_bytes) / 1e6, rounds);
+  fmt::print("read only : {:7.2f} s  {:6.2f} M triangles/s (one file after another; CPU {:.2f} s; rounds: {} s)\n",
+             read_m.wall, per_second(read_m), read_m.cpu, wall_list(read));
   fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; one acquisition at a time; "
-             "CPU {:.2f} s)\n",
-             tile, double(triangles) / tile / 1e6, tile / read, tile_cpu);
+             "CPU {:.2f} s; rounds: {} s)\n",
+             tile_m.wall, per_second(tile_m), tile_m.wall / read_m.wall, tile_m.cpu, wall_list(tile));
   fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; {} at a time, as `run`; "
-             "CPU {:.2f} s; target <= 2)\n",
-             tile_parallel, double(triangles) / tile_parallel / 1e6, tile_parallel / read, at_once, tile_parallel_cpu);
+             "CPU {:.2f} s; rounds: {} s; target <= 2)\n",
+             parallel_m.wall, per_second(parallel_m), parallel_m.wall / read_m.wall, at_once, parallel_m.cpu,
+             wall_list(tile_parallel));
+  fmt::print("ratio     : {:.2f} .. {:.2f} x the read of the same round (tiling as `run`)\n", ratios.front(),
+             ratios.back());
   fmt::print("tiles     : {} of {:.0f} m, halo copies {:.2f} M, empty-space copies {:.2f} M, {} blocks, {:.0f} MB "
              "written\n",
              store.tiles.size(), params.grid.tile_size, double(store.stats.halo_copies) / 1e6,
