@@ -27,6 +27,20 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
   return after;
 }
 
+std::uint64_t tile_memory_estimate(const TileContents& tile) { return tile.total() * kBytesPerTileTriangle; }
+
+std::vector<std::size_t> tiles_over_budget(const TileStore& store, const std::vector<std::size_t>& tiles,
+                                           std::uint64_t budget) {
+  std::vector<std::size_t> over;
+  for (const std::size_t k : tiles) {
+    if (tile_memory_estimate(store.tiles[k]) > budget) over.push_back(k);
+  }
+  std::stable_sort(over.begin(), over.end(), [&](std::size_t a, std::size_t b) {
+    return store.tiles[a].total() > store.tiles[b].total();
+  });
+  return over;
+}
+
 Subset Subset::parse(const std::string& text) {
   Subset s;
   const auto slash = text.find('/');

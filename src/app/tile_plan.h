@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,18 @@ namespace citymesh::app {
 /// The tiles (indices into store.tiles) that tile `k` waits for: its neighbours (sides and
 /// corners) of earlier phases, in index order.
 std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k);
+
+/// Estimated peak bytes of a tile in flight per triangle it holds (all roles): meshes, change
+/// step (~180 B) and mosaic, measured on the default street (docs/tiling.md).
+inline constexpr std::uint64_t kBytesPerTileTriangle = 900;
+
+/// The estimated peak bytes of `tile` while it is processed: what the memory budget counts.
+std::uint64_t tile_memory_estimate(const TileContents& tile);
+
+/// The tiles among `tiles` (indices into store.tiles) whose estimate alone exceeds `budget`,
+/// largest first: each runs alone and may take the process past the budget.
+std::vector<std::size_t> tiles_over_budget(const TileStore& store, const std::vector<std::size_t>& tiles,
+                                           std::uint64_t budget);
 
 /// One part of a run split for a scheduler: "i/N", 1 <= i <= N.
 struct Subset {

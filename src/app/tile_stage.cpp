@@ -15,16 +15,13 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/core/time.h"
 #include "run_stages.h"
 #include "tile_job.h"
 
 namespace citymesh::app {
 
 namespace {
-
-/// Estimated peak bytes of a tile in flight per triangle it holds (all roles): meshes, change
-/// step (~180 B) and mosaic, measured on the default street (docs/tiling.md).
-constexpr std::uint64_t kBytesPerTileTriangle = 900;
 
 /// Bounds the estimated bytes of the tiles in flight. A tile larger than the whole budget
 /// still runs, alone.
@@ -119,6 +116,18 @@ WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::ui
   return WorkSchedule(std::move(costs), after, done);
 }
 
+/// Says once which tiles the budget cannot hold, and what to change.
+void warn_tiles_over_budget(const Config& config, const TileStore& store, const std::vector<std::size_t>& tiles) {
+  const std::vector<std::size_t> over = tiles_over_budget(store, tiles, config.run.memory);
+  if (over.empty()) return;
+  const TileContents& largest = store.tiles[over.front()];
+  log::warn("{} of {} tiles are estimated above the memory budget of {} (largest: tile {}, {} triangles with its "
+            "halo, ~{} MiB); each runs alone and may pass the budget: use a smaller [tiling] tile_size or a larger "
+            "--memory",
+            over.size(), tiles.size(), format_byte_size(config.run.memory), largest.key.name(), largest.total(),
+            tile_memory_estimate(largest) >> 20);
+}
+
 }  // namespace
 
 std::filesystem::path result_path(const Config& config, TileKey key) {
@@ -135,6 +144,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   for (const std::size_t k : tiles) input += store.tiles[k].owned();
   Progress progress(tiles.size(), input);
   if (cluster.root()) schedule.emplace(tile_schedule(config, store, fingerprint, tiles));
+  if (cluster.root()) warn_tiles_over_budget(config, store, tiles);
   MemoryGate gate(config.run.memory);
   const auto on_finish = [&](std::size_t item) {
     report.processed[tiles[item]] = 1;
@@ -147,7 +157,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
     throw_if_interrupted("tile processing");
-    const std::uint64_t estimate = tile.total() * kBytesPerTileTriangle;
+    const std::uint64_t estimate = tile_memory_estimate(tile);
     gate.acquire(estimate);
     // The memory earlier tiles freed stays resident for reuse (keep_freed_memory_for_reuse),
     // in each thread's arena: when that would take this tile past the budget, hand it back.

@@ -107,5 +107,30 @@ TEST(TilePlan, SubsetParsing) {
   }
 }
 
+TEST(TilePlan, TilesOverBudgetAreTheOnesTheBudgetCannotHoldLargestFirst) {
+  std::mt19937 rng(5);
+  const TileStore store = random_store(rng, 9, 8);
+  std::vector<std::size_t> all(store.tiles.size());
+  for (std::size_t k = 0; k < all.size(); ++k) all[k] = k;
+  // Budgets that hold every tile, none, and about half of them.
+  for (const std::uint64_t triangles : {std::uint64_t{1200}, std::uint64_t{0}, std::uint64_t{600}}) {
+    const std::uint64_t budget = triangles * kBytesPerTileTriangle;
+    const std::vector<std::size_t> over = tiles_over_budget(store, all, budget);
+    std::set<std::size_t> expected;
+    for (std::size_t k = 0; k < all.size(); ++k) {
+      if (store.tiles[k].total() * kBytesPerTileTriangle > budget) expected.insert(k);
+    }
+    EXPECT_EQ(std::set<std::size_t>(over.begin(), over.end()), expected) << "budget for " << triangles;
+    EXPECT_EQ(over.size(), expected.size());
+    for (std::size_t n = 1; n < over.size(); ++n) {
+      EXPECT_GE(store.tiles[over[n - 1]].total(), store.tiles[over[n]].total());
+    }
+  }
+  // Only the tiles asked about.
+  const std::vector<std::size_t> first_three{0, 1, 2};
+  for (const std::size_t k : tiles_over_budget(store, first_three, 0)) EXPECT_LT(k, 3u);
+  EXPECT_EQ(tiles_over_budget(store, first_three, 0).size(), 3u);
+}
+
 }  // namespace
 }  // namespace citymesh::app
