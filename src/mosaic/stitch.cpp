@@ -7,6 +7,7 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include "citymesh/core/log.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
@@ -248,13 +249,16 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   // again only when clipping changed the triangles.
   std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged);
   const double before = length_of(merged.mesh, unclipped->boundary_edges());
+  log::debug("stitch: topology and boundary at {:.2f} s", clock.seconds());
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
     unclipped.reset();
     clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle});
   }
+  log::debug("stitch: clipped at {:.2f} s", clock.seconds());
   mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
+  log::debug("stitch: snapped at {:.2f} s", clock.seconds());
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
   c.stats.triangles_uncovered = clipped.triangles_removed;
@@ -263,6 +267,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   c.stats.edges_split = snapped.edges_split;
   c.stats.rejected = snapped.rejected;
   match_vertices(c);
+  log::debug("stitch: boundary matched at {:.2f} s", clock.seconds());
   // Open chains (broken at pinched vertices) are walked from their head, so that each is
   // one walk; closed loops from their smallest vertex.
   std::unordered_set<std::uint32_t> visited;
@@ -272,13 +277,16 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   for (const std::uint32_t v : c.boundary.vertices) {
     if (!visited.contains(v)) stitch_loop(c, v, visited);
   }
+  log::debug("stitch: zippered at {:.2f} s", clock.seconds());
   if (params.gap > 0) {
     const mosaic_detail::GapFillStats gaps =
         mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = kGapPerimeterInWidths * params.gap});
     c.stats.gaps_filled = gaps.gaps_filled + gaps.gaps_split;
     c.stats.triangles_added += gaps.triangles_added;
   }
+  log::debug("stitch: gaps at {:.2f} s", clock.seconds());
   weld(c);
+  log::debug("stitch: welded at {:.2f} s", clock.seconds());
   // From fresh incidence lists (the weld merged vertices and dropped collapsed triangles, so
   // topo's lists are stale): sorting every edge of a city's output instead took a third of
   // the pass. open_boundary_length() stays the sort-based reference the tests compare with.
