@@ -5,6 +5,7 @@
 #include <optional>
 #include <span>
 
+#include "citymesh/core/parallel.h"
 #include "citymesh/spatial/box_tree.h"
 #include "citymesh/spatial/kd_tree.h"
 
@@ -74,25 +75,44 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   return true;
 }
 
+/// For each of `vertices`, the others within the tolerance that belong to another source,
+/// in index order. The searches run on the pool: nothing moves before the merges.
+std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
+                                                       const std::vector<std::uint32_t>& vertices,
+                                                       const std::vector<Vec3f>& points, double tolerance) {
+  const PointKdTree tree(points);
+  std::vector<std::vector<std::uint32_t>> partners(vertices.size());
+  parallel_for_blocks(vertices.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::uint32_t> near;
+    for (std::size_t i = begin; i < end; ++i) {
+      tree.radius_search(points[i], static_cast<float>(tolerance), near);
+      const std::int32_t source = topo.source_of_vertex(vertices[i]);
+      for (const std::uint32_t j : near) {
+        if (topo.source_of_vertex(vertices[j]) != source) partners[i].push_back(j);
+      }
+    }
+  });
+  return partners;
+}
+
 /// Stage 1: boundary vertices of different sources within the tolerance become one.
 void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<std::uint32_t> vertices = vertices_of(topo.boundary_half_edges());
   std::vector<Vec3f> points;
   for (const std::uint32_t v : vertices) points.push_back(topo.merged().mesh.positions[v]);
-  const PointKdTree tree(points);
+  const std::vector<std::vector<std::uint32_t>> partners = close_partners(topo, vertices, points, tolerance);
+  // In order: each merge decides which vertices are still free for the next. Only merged
+  // vertices move, and they are done, so the distances below are those of the search.
   std::vector<std::uint8_t> done(vertices.size(), 0);
-  std::vector<std::uint32_t> near;
   for (std::uint32_t i = 0; i < vertices.size(); ++i) {
     if (done[i] != 0) continue;
     const std::uint32_t v = vertices[i];
-    tree.radius_search(points[i], static_cast<float>(tolerance), near);
     std::uint32_t best = UINT32_MAX;
     double best_d2 = tolerance * tolerance;
-    for (const std::uint32_t j : near) {
-      const std::uint32_t w = vertices[j];
-      if (done[j] != 0 || topo.source_of_vertex(w) == topo.source_of_vertex(v)) continue;
-      const Vec3d d = topo.position(w) - topo.position(v);
-      // near is in index order: on equal distances the smaller index stays.
+    for (const std::uint32_t j : partners[i]) {
+      if (done[j] != 0) continue;
+      const Vec3d d = topo.position(vertices[j]) - topo.position(v);
+      // partners are in index order: on equal distances the smaller index stays.
       if (best == UINT32_MAX ? dot(d, d) <= best_d2 : dot(d, d) < best_d2) {
         best = j;
         best_d2 = dot(d, d);
@@ -122,40 +142,55 @@ bool touches_source(const MeshTopology& topo, std::uint32_t v, std::int32_t sour
   return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return topo.merged().source_acq[t] == source; });
 }
 
-/// For every boundary vertex, the nearest boundary edge of another source passing within the
-/// tolerance, where the vertex projects well inside the edge.
-std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const DirectedEdge> edges, double tolerance) {
-  std::vector<Box3f> boxes;
-  const auto pad = static_cast<float>(tolerance);
-  for (const DirectedEdge& e : edges) {
-    const Vec3f a = topo.merged().mesh.positions[e.from], b = topo.merged().mesh.positions[e.to];
-    boxes.push_back({Vec3f{std::min(a.x, b.x) - pad, std::min(a.y, b.y) - pad, std::min(a.z, b.z) - pad},
-                     Vec3f{std::max(a.x, b.x) + pad, std::max(a.y, b.y) + pad, std::max(a.z, b.z) + pad}});
-  }
-  const BoxTree tree(std::move(boxes));
-  std::vector<Insertion> out;
-  std::vector<std::uint32_t> hits;
-  for (const std::uint32_t v : vertices_of(edges)) {
-    tree.containing(topo.merged().mesh.positions[v], hits);
-    std::sort(hits.begin(), hits.end());
-    const Vec3d p = topo.position(v);
-    Insertion best{SIZE_MAX, 0, v};
-    double best_d2 = tolerance * tolerance;
-    for (const std::uint32_t h : hits) {
-      const DirectedEdge& e = edges[h];
-      if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle])) continue;
-      const Vec3d a = topo.position(e.from), ab = topo.position(e.to) - a;
-      const double len2 = dot(ab, ab);
-      if (!(len2 > 0)) continue;
-      const double t = dot(p - a, ab) / len2;
-      if (t < 0.05 || t > 0.95) continue;  // near an end: a merge's business, or a sliver
-      const Vec3d d = a + ab * t - p;
-      if (dot(d, d) < best_d2) {
-        best_d2 = dot(d, d);
-        best = {h, t, v};
-      }
+/// The nearest boundary edge (of `tree`, over `edges`) of another source passing within the
+/// tolerance of boundary vertex v, where v projects well inside the edge; edge SIZE_MAX when
+/// there is none.
+Insertion nearest_insertion(const MeshTopology& topo, std::span<const DirectedEdge> edges, const BoxTree& tree,
+                            std::uint32_t v, double tolerance, std::vector<std::uint32_t>& hits) {
+  tree.containing(topo.merged().mesh.positions[v], hits);
+  std::sort(hits.begin(), hits.end());
+  const Vec3d p = topo.position(v);
+  Insertion best{SIZE_MAX, 0, v};
+  double best_d2 = tolerance * tolerance;
+  for (const std::uint32_t h : hits) {
+    const DirectedEdge& e = edges[h];
+    if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle])) continue;
+    const Vec3d a = topo.position(e.from), ab = topo.position(e.to) - a;
+    const double len2 = dot(ab, ab);
+    if (!(len2 > 0)) continue;
+    const double t = dot(p - a, ab) / len2;
+    if (t < 0.05 || t > 0.95) continue;  // near an end: a merge's business, or a sliver
+    const Vec3d d = a + ab * t - p;
+    if (dot(d, d) < best_d2) {
+      best_d2 = dot(d, d);
+      best = {h, t, v};
     }
-    if (best.edge != SIZE_MAX) out.push_back(best);
+  }
+  return best;
+}
+
+/// For every boundary vertex, its nearest_insertion, sorted by edge. The searches only read
+/// the mesh: they run on the pool, and the result does not depend on the thread count.
+std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const DirectedEdge> edges, double tolerance) {
+  std::vector<Box3f> boxes(edges.size());
+  const auto pad = static_cast<float>(tolerance);
+  parallel_for_blocks(edges.size(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3f a = topo.merged().mesh.positions[edges[i].from], b = topo.merged().mesh.positions[edges[i].to];
+      boxes[i] = {Vec3f{std::min(a.x, b.x) - pad, std::min(a.y, b.y) - pad, std::min(a.z, b.z) - pad},
+                  Vec3f{std::max(a.x, b.x) + pad, std::max(a.y, b.y) + pad, std::max(a.z, b.z) + pad}};
+    }
+  });
+  const BoxTree tree(std::move(boxes));
+  const std::vector<std::uint32_t> vertices = vertices_of(edges);
+  std::vector<Insertion> nearest(vertices.size());
+  parallel_for_blocks(vertices.size(), 1024, [&](std::size_t begin, std::size_t end) {
+    std::vector<std::uint32_t> hits;
+    for (std::size_t i = begin; i < end; ++i) nearest[i] = nearest_insertion(topo, edges, tree, vertices[i], tolerance, hits);
+  });
+  std::vector<Insertion> out;
+  for (const Insertion& x : nearest) {
+    if (x.edge != SIZE_MAX) out.push_back(x);
   }
   std::sort(out.begin(), out.end());
   return out;
