@@ -65,10 +65,13 @@ class Cover {
   Cover(const MergedMesh& merged, const ClipParams& params)
       : merged_(merged), near_(merged.mesh, params.tolerance), params_(params),
         min_cos_(std::cos(params.max_angle_deg * std::numbers::pi / 180.0)), precedence_(source_precedence(merged)) {
-    for (std::size_t t = 0; t < merged.mesh.triangle_count(); ++t) {
-      const TriangleCorners c = merged.mesh.corners(t);
-      normal_.push_back(Vec3f(unit_or_zero(cross(c[1] - c[0], c[2] - c[0]))));
-    }
+    normal_.resize(merged.mesh.triangle_count());
+    parallel_for_blocks(normal_.size(), 16384, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t t = begin; t < end; ++t) {
+        const TriangleCorners c = merged.mesh.corners(t);
+        normal_[t] = Vec3f(unit_or_zero(cross(c[1] - c[0], c[2] - c[0])));
+      }
+    });
   }
 
   [[nodiscard]] bool over(const Vec3d& p, std::int32_t source, const Vec3d& n) const {

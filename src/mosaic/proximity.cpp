@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "citymesh/core/geometry.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/spatial/box_tree.h"
 
 namespace citymesh {
@@ -31,12 +32,14 @@ bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
 
 MeshProximity::MeshProximity(const Mesh& mesh, double max_reach) : mesh_(mesh) {
   std::vector<Box3f> boxes(mesh.triangle_count());
-  for (std::size_t t = 0; t < boxes.size(); ++t) {
-    Box3d b;
-    for (const Vec3d& p : mesh.corners(t)) b.extend(p);
-    b = b.grown(max_reach + 1e-5);
-    boxes[t] = {Vec3f(b.min), Vec3f(b.max)};
-  }
+  parallel_for_blocks(boxes.size(), 16384, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      Box3d b;
+      for (const Vec3d& p : mesh.corners(t)) b.extend(p);
+      b = b.grown(max_reach + 1e-5);
+      boxes[t] = {Vec3f(b.min), Vec3f(b.max)};
+    }
+  });
   tree_ = std::make_unique<BoxTree>(std::move(boxes));
 }
 
