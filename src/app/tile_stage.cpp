@@ -143,8 +143,10 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   std::uint64_t input = 0;
   for (const std::size_t k : tiles) input += store.tiles[k].owned();
   Progress progress(tiles.size(), input);
-  if (cluster.root()) schedule.emplace(tile_schedule(config, store, fingerprint, tiles));
-  if (cluster.root()) warn_tiles_over_budget(config, store, tiles);
+  if (cluster.root()) {
+    schedule.emplace(tile_schedule(config, store, fingerprint, tiles));
+    warn_tiles_over_budget(config, store, tiles);
+  }
   MemoryGate gate(config.run.memory);
   const auto on_finish = [&](std::size_t item) {
     report.processed[tiles[item]] = 1;

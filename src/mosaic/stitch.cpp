@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <numeric>
 #include <optional>
+#include <string_view>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -245,20 +246,24 @@ double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
+  // Where the time goes, at --log-level debug (the seam pass of a city runs mostly serial).
+  const auto phase_done = [&clock](std::string_view phase) {
+    log::debug("stitch: {} at {:.2f} s", phase, clock.seconds());
+  };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
   std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged);
   const double before = length_of(merged.mesh, unclipped->boundary_edges());
-  log::debug("stitch: topology and boundary at {:.2f} s", clock.seconds());
+  phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
     unclipped.reset();
     clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle});
   }
-  log::debug("stitch: clipped at {:.2f} s", clock.seconds());
+  phase_done("clipped");
   mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
-  log::debug("stitch: snapped at {:.2f} s", clock.seconds());
+  phase_done("snapped");
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
   c.stats.open_boundary_before = before;
   c.stats.triangles_uncovered = clipped.triangles_removed;
@@ -267,7 +272,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   c.stats.edges_split = snapped.edges_split;
   c.stats.rejected = snapped.rejected;
   match_vertices(c);
-  log::debug("stitch: boundary matched at {:.2f} s", clock.seconds());
+  phase_done("boundary matched");
   // Open chains (broken at pinched vertices) are walked from their head, so that each is
   // one walk; closed loops from their smallest vertex.
   std::unordered_set<std::uint32_t> visited;
@@ -277,16 +282,16 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   for (const std::uint32_t v : c.boundary.vertices) {
     if (!visited.contains(v)) stitch_loop(c, v, visited);
   }
-  log::debug("stitch: zippered at {:.2f} s", clock.seconds());
+  phase_done("zippered");
   if (params.gap > 0) {
     const mosaic_detail::GapFillStats gaps =
         mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = kGapPerimeterInWidths * params.gap});
     c.stats.gaps_filled = gaps.gaps_filled + gaps.gaps_split;
     c.stats.triangles_added += gaps.triangles_added;
   }
-  log::debug("stitch: gaps at {:.2f} s", clock.seconds());
+  phase_done("gaps");
   weld(c);
-  log::debug("stitch: welded at {:.2f} s", clock.seconds());
+  phase_done("welded");
   // From fresh incidence lists (the weld merged vertices and dropped collapsed triangles, so
   // topo's lists are stale): sorting every edge of a city's output instead took a third of
   // the pass. open_boundary_length() stays the sort-based reference the tests compare with.

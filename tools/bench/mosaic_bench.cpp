@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bench_scene.h"
+#include "bench_stats.h"
 #include "citymesh/change/detect.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
@@ -116,8 +117,7 @@ int main(int argc, char** argv) {
     walls.push_back(run_clock.seconds());
     print_selection(fmt::format("mosaic ({} threads)", threads == 0 ? available_threads() : threads), energy, walls.back());
   }
-  std::sort(walls.begin(), walls.end());
-  const double wall = walls[walls.size() / 2];
+  const double wall = bench::median(walls);
   fmt::print("mosaic median of {} runs: {:.3f} s\n", walls.size(), wall);
   if (mosaic_only) return 0;
   Stopwatch clock;

@@ -14,6 +14,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "citymesh/config/config.h"
@@ -21,6 +22,7 @@
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/tiler/tiler.h"
+#include "bench_stats.h"
 
 using namespace citymesh;
 
@@ -62,15 +64,14 @@ Timing timed(Work&& work) {
   return {clock.seconds(), cpu_seconds() - cpu};
 }
 
-/// The median of each field over the rounds (the lower middle one for an even count).
-Timing median(std::vector<Timing> rounds) {
-  const auto middle = [&](auto field) {
-    std::vector<double> v;
-    for (const Timing& t : rounds) v.push_back(t.*field);
-    std::nth_element(v.begin(), v.begin() + (v.size() - 1) / 2, v.end());
-    return v[(v.size() - 1) / 2];
-  };
-  return {middle(&Timing::wall), middle(&Timing::cpu)};
+/// The median of each field over the rounds.
+Timing median(const std::vector<Timing>& rounds) {
+  std::vector<double> wall, cpu;
+  for (const Timing& t : rounds) {
+    wall.push_back(t.wall);
+    cpu.push_back(t.cpu);
+  }
+  return {bench::median(std::move(wall)), bench::median(std::move(cpu))};
 }
 
 std::string wall_list(const std::vector<Timing>& rounds) {
