@@ -14,8 +14,7 @@
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
-#include "citymesh/core/varint.h"
-#include "tile_block_format.h"
+#include "tile_block_writer.h"
 
 namespace citymesh {
 
@@ -28,92 +27,70 @@ std::string_view bytes_of(const std::vector<T>& values) {
   return {reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T)};
 }
 
-/// The varint part of a version-3 payload: per vertex its id and sensor position (float bits),
-/// each against the previous vertex's; per triangle its corners against the previous corner,
-/// its face and index against the previous triangle's, and fan << 2 | role.
-VarintWriter encode_varints(const TilePiece& piece) {
+/// `piece` through the writer, whole.
+std::vector<std::string_view> write_piece(const TilePiece& piece, TileBlockWriter& writer) {
   const Mesh& m = piece.mesh;
-  // Per vertex four 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 2
-  // | role (34 bits).
-  const std::size_t per_vertex = 4 * max_varint_bytes(32);
-  const std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(34);
-  VarintWriter w(piece.vertex_ids.size() * per_vertex + m.triangle_count() * per_triangle);
-  std::uint32_t id = 0;
-  std::array<std::uint32_t, 3> sensor{};
-  for (std::size_t v = 0; v < piece.vertex_ids.size(); ++v) {
-    w.put_next(piece.vertex_ids[v], id);
-    const Vec3f& p = m.sensor_positions[v];
-    w.put_next(float_bits(p.x), sensor[0]);
-    w.put_next(float_bits(p.y), sensor[1]);
-    w.put_next(float_bits(p.z), sensor[2]);
+  const std::uint32_t flags = flags_of(m);
+  writer.start(flags, m.vertex_count(), m.triangle_count());
+  for (std::size_t v = 0; v < m.vertex_count(); ++v) {
+    writer.add_vertex(piece.vertex_ids[v], m.positions[v], m.sensor_positions[v],
+                      (flags & kHasIntensity) != 0 ? m.intensities[v] : 0.0f,
+                      (flags & kHasColor) != 0 ? m.colors[v] : Rgb8{});
   }
-  std::uint32_t corner = 0, index = 0;
-  std::uint64_t face = 0;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    for (const std::uint32_t c : m.triangles[t]) w.put_next(c, corner);
-    w.put_next(m.triangle_ids[t].face, face);
-    w.put_next(piece.triangle_index[t], index);
-    w.put(std::uint64_t{m.triangle_ids[t].fan} << 2 | static_cast<std::uint8_t>(piece.roles[t]));
+    const TriangleId& id = m.triangle_ids[t];
+    writer.add_triangle(m.triangles[t], id.face, piece.triangle_index[t], id.fan, piece.roles[t]);
   }
-  return w;
+  return writer.finish();
 }
-
-/// One block as consecutive byte ranges: the header, then the payload in file order.
-struct BlockParts {
-  BlockHeader header{};
-  VarintWriter varints;
-  std::vector<std::string_view> parts;
-
-  explicit BlockParts(const TilePiece& piece) : varints(encode_varints(piece)) {
-    const Mesh& m = piece.mesh;
-    std::memcpy(header.start.magic, kMagic, sizeof kMagic);
-    header.start.version = kVersion;
-    header.start.flags = flags_of(m);
-    header.vertices = m.vertex_count();
-    header.triangles = m.triangle_count();
-    parts = {bytes_of(m.positions)};
-    if ((header.start.flags & kHasIntensity) != 0) parts.push_back(bytes_of(m.intensities));
-    if ((header.start.flags & kHasColor) != 0) parts.push_back(bytes_of(m.colors));
-    parts.push_back(varints.bytes());
-    BulkChecksum sum;
-    for (const std::string_view part : parts) {
-      sum.add(part.data(), part.size());
-      header.payload_bytes += part.size();
-    }
-    header.checksum = sum.value();
-    parts.insert(parts.begin(), std::string_view(reinterpret_cast<const char*>(&header), sizeof header));
-  }
-  BlockParts(const BlockParts&) = delete;
-  BlockParts& operator=(const BlockParts&) = delete;
-};
 
 }  // namespace
 
-void TilePiece::clear() {
-  mesh.positions.clear();
-  mesh.sensor_positions.clear();
-  mesh.intensities.clear();
-  mesh.colors.clear();
-  mesh.triangles.clear();
-  mesh.triangle_ids.clear();
-  vertex_ids.clear();
-  triangle_index.clear();
-  roles.clear();
+namespace tiler_detail {
+
+void TileBlockWriter::start(std::uint32_t flags, std::size_t max_vertices, std::size_t max_triangles) {
+  // Per vertex four 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 2
+  // | role (34 bits).
+  constexpr std::size_t per_vertex = 4 * max_varint_bytes(32);
+  constexpr std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(34);
+  flags_ = flags;
+  positions_.clear();
+  intensities_.clear();
+  colors_.clear();
+  vertex_varints_.reset(max_vertices * per_vertex);
+  triangle_varints_.reset(max_triangles * per_triangle);
+  id_ = corner_ = index_ = 0;
+  sensor_ = {};
+  face_ = 0;
+  triangles_ = 0;
 }
 
-std::string encode_tile_block(const TilePiece& piece) {
-  const BlockParts block(piece);
-  std::string out;
-  out.reserve(sizeof(BlockHeader) + block.header.payload_bytes);
-  for (const std::string_view part : block.parts) out += part;
-  return out;
+std::vector<std::string_view> TileBlockWriter::finish() {
+  header_ = {};
+  std::memcpy(header_.start.magic, kMagic, sizeof kMagic);
+  header_.start.version = kVersion;
+  header_.start.flags = flags_;
+  header_.vertices = positions_.size();
+  header_.triangles = triangles_;
+  std::vector<std::string_view> parts{bytes_of(positions_)};
+  if ((flags_ & kHasIntensity) != 0) parts.push_back(bytes_of(intensities_));
+  if ((flags_ & kHasColor) != 0) parts.push_back(bytes_of(colors_));
+  parts.push_back(vertex_varints_.bytes());
+  parts.push_back(triangle_varints_.bytes());
+  BulkChecksum sum;
+  for (const std::string_view part : parts) {
+    sum.add(part.data(), part.size());
+    header_.payload_bytes += part.size();
+  }
+  header_.checksum = sum.value();
+  parts.insert(parts.begin(), std::string_view(reinterpret_cast<const char*>(&header_), sizeof header_));
+  return parts;
 }
 
-std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
-  const BlockParts block(piece);
+std::uint64_t append_block(const std::filesystem::path& file, const std::vector<std::string_view>& parts) {
   std::vector<iovec> io;
   std::size_t total = 0;
-  for (const std::string_view part : block.parts) {
+  for (const std::string_view part : parts) {
     io.push_back({const_cast<char*>(part.data()), part.size()});
     total += part.size();
   }
@@ -130,6 +107,32 @@ std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePie
   if (fd >= 0) ::close(fd);
   if (!ok) throw OutputError(fmt::format("{}: cannot append a tile block: {}", file.string(), std::strerror(err)));
   return total;
+}
+
+}  // namespace tiler_detail
+
+void TilePiece::clear() {
+  mesh.positions.clear();
+  mesh.sensor_positions.clear();
+  mesh.intensities.clear();
+  mesh.colors.clear();
+  mesh.triangles.clear();
+  mesh.triangle_ids.clear();
+  vertex_ids.clear();
+  triangle_index.clear();
+  roles.clear();
+}
+
+std::string encode_tile_block(const TilePiece& piece) {
+  TileBlockWriter writer;
+  std::string out;
+  for (const std::string_view part : write_piece(piece, writer)) out += part;
+  return out;
+}
+
+std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
+  TileBlockWriter writer;
+  return append_block(file, write_piece(piece, writer));
 }
 
 void sync_tile_files(const std::filesystem::path& dir) {

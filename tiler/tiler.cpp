@@ -15,6 +15,7 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "store_files.h"
+#include "tile_block_writer.h"
 
 namespace citymesh {
 
@@ -99,6 +100,8 @@ class AcquisitionTiler {
       if (kind == PlyReader::ChunkKind::vertices) {
         vertices_.append(vertices);
         slots_.resize(vertices_.positions.size(), 0);
+        flags_ = (vertices_.intensities.empty() ? 0 : tiler_detail::kHasIntensity) |
+                 (vertices_.colors.empty() ? 0 : tiler_detail::kHasColor);
         continue;
       }
       for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
@@ -179,10 +182,11 @@ class AcquisitionTiler {
     for (const auto& [key, s] : slot_of_) {
       auto& counts = out_.counts[key];
       for (std::size_t r = 0; r < 3; ++r) counts[r] += tiles_[s].counts[r];
-      build_piece(key, std::span(sorted_).subspan(start[s], start[s + 1] - start[s]));
+      const std::vector<std::string_view> block =
+          build_block(key, std::span(sorted_).subspan(start[s], start[s + 1] - start[s]));
       const std::filesystem::path chunk = dir_ / chunk_name(key);
       std::filesystem::create_directories(chunk.parent_path());
-      out_.stats.bytes_written += append_tile_block(chunk, piece_);
+      out_.stats.bytes_written += tiler_detail::append_block(chunk, block);
       ++out_.stats.blocks;
     }
     batch_.clear();
@@ -192,36 +196,31 @@ class AcquisitionTiler {
     largest_tile_ = 0;
   }
 
-  /// One tile's block of the batch in piece_: its triangles (`copies`: batch triangle << 2 |
-  /// role) in input order, their vertices in order of first use, in the tile's frame.
-  void build_piece(TileKey key, std::span<const std::uint32_t> copies) {
-    piece_.clear();
-    Mesh& m = piece_.mesh;
-    m.origin = grid_.corner(key);
+  /// One tile's block of the batch (`copies`: batch triangle << 2 | role): its triangles in
+  /// input order, their vertices in order of first use, in the tile's frame.
+  std::vector<std::string_view> build_block(TileKey key, std::span<const std::uint32_t> copies) {
+    origin_ = grid_.corner(key);
     ++stamp_;  // every slot of an earlier block is stale
+    block_.start(flags_, 3 * copies.size(), copies.size());
     for (const std::uint32_t copy : copies) {
       const BatchTriangle& t = batch_[copy >> 2];
       Triangle local{};
       for (std::size_t k = 0; k < 3; ++k) local[k] = local_vertex(t.corners[k]);
-      m.triangles.push_back(local);
-      m.triangle_ids.push_back({acquisition_, t.fan, t.face});
-      piece_.triangle_index.push_back(t.index);
-      piece_.roles.push_back(static_cast<TileRole>(copy & 3u));
+      block_.add_triangle(local, t.face, t.index, t.fan, static_cast<TileRole>(copy & 3u));
     }
+    return block_.finish();
   }
 
-  /// v's index in piece_, added to it the first time this block uses v.
+  /// v's index in the block, added to it the first time the block uses v.
   std::uint32_t local_vertex(std::uint32_t v) {
     std::uint64_t& slot = slots_[v];
     if (slot >> 32 == stamp_) return static_cast<std::uint32_t>(slot);
-    const auto index = static_cast<std::uint32_t>(piece_.vertex_ids.size());
+    const std::uint32_t index = block_.vertex_count();
     slot = std::uint64_t{stamp_} << 32 | index;
-    Mesh& m = piece_.mesh;
-    piece_.vertex_ids.push_back(v);
-    m.positions.push_back(to_local(vertices_.positions[v], m.origin));
-    m.sensor_positions.push_back(to_local(vertices_.sensors[v], m.origin));
-    if (!vertices_.intensities.empty()) m.intensities.push_back(vertices_.intensities[v]);
-    if (!vertices_.colors.empty()) m.colors.push_back(vertices_.colors[v]);
+    const std::vector<float>& intensities = vertices_.intensities;
+    const std::vector<Rgb8>& colors = vertices_.colors;
+    block_.add_vertex(v, to_local(vertices_.positions[v], origin_), to_local(vertices_.sensors[v], origin_),
+                      intensities.empty() ? 0.0f : intensities[v], colors.empty() ? Rgb8{} : colors[v]);
     return index;
   }
 
@@ -242,7 +241,9 @@ class AcquisitionTiler {
   std::uint32_t largest_tile_ = 0;  ///< copies of the batch's largest tile
   // Reused by every flush.
   std::vector<std::uint32_t> sorted_;
-  TilePiece piece_;
+  tiler_detail::TileBlockWriter block_;
+  Vec3d origin_;          ///< of the tile whose block is being built
+  std::uint32_t flags_ = 0;  ///< the acquisition's vertex attributes (tiler_detail::kHasIntensity, ...)
   std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in piece_
   std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };

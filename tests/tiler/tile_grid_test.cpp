@@ -30,6 +30,25 @@ TEST(TileGrid, EveryPointHasExactlyTheOwnerWhoseSquareContainsIt) {
   EXPECT_EQ((TileKey{12, -4}).name(), "12_-4");
 }
 
+TEST(TileGrid, OwnerEqualsTheFloorOfTheDivisionEvenOnTileSides) {
+  // owner() multiplies by 1 / tile_size and falls back to the division near a side: compare
+  // with the division at points on, and a few units in the last place around, every side.
+  std::mt19937 rng(9);
+  for (const double size : {50.0, 0.3, 7.7, 1.0 / 3.0, 100.0}) {
+    const std::array<double, 2> origin{651000.125, -6860000.3};
+    const TileGrid grid({.tile_size = size, .halo = size / 4, .origin = origin});
+    std::uniform_int_distribution<int> k(-2000, 2000), step(-4, 4);
+    for (int n = 0; n < 20000; ++n) {
+      Vec3d p{origin[0] + k(rng) * size, origin[1] + k(rng) * size, 0};
+      for (int s = step(rng); s != 0; s += s > 0 ? -1 : 1) p.x = std::nextafter(p.x, s > 0 ? 1e300 : -1e300);
+      for (int s = step(rng); s != 0; s += s > 0 ? -1 : 1) p.y = std::nextafter(p.y, s > 0 ? 1e300 : -1e300);
+      const TileKey expected{static_cast<std::int32_t>(std::floor((p.x - origin[0]) / size)),
+                             static_cast<std::int32_t>(std::floor((p.y - origin[1]) / size))};
+      ASSERT_EQ(grid.owner(p), expected) << "size " << size << " at " << p.x << ", " << p.y;
+    }
+  }
+}
+
 TEST(TileGrid, HaloTilesEqualBruteForce) {
   const TileGrid grid({.tile_size = 10, .halo = 1.5, .origin = {0, 0}});
   std::mt19937 rng(4);

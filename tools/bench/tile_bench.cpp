@@ -42,36 +42,42 @@ std::uint64_t read_only(const Config& config) {
   return triangles;
 }
 
-/// CPU seconds (user and system) of this process so far: next to the wall time, it tells
-/// the tiler's own work from its waits on the disk.
-double cpu_seconds() {
+/// CPU seconds of this process so far, in all and in the kernel: next to the wall time, they
+/// tell the tiler's own work from its waits on the disk and from the kernel's work of putting
+/// written bytes into the page cache.
+struct CpuSeconds {
+  double all = 0, system = 0;
+};
+CpuSeconds cpu_seconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   const auto seconds = [](const timeval& t) { return double(t.tv_sec) + double(t.tv_usec) / 1e6; };
-  return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+  return {seconds(usage.ru_utime) + seconds(usage.ru_stime), seconds(usage.ru_stime)};
 }
 
 /// Wall and CPU seconds of one measurement.
 struct Timing {
-  double wall = 0, cpu = 0;
+  double wall = 0, cpu = 0, system = 0;
 };
 
 template <class Work>
 Timing timed(Work&& work) {
   Stopwatch clock;
-  const double cpu = cpu_seconds();
+  const CpuSeconds before = cpu_seconds();
   work();
-  return {clock.seconds(), cpu_seconds() - cpu};
+  const CpuSeconds after = cpu_seconds();
+  return {clock.seconds(), after.all - before.all, after.system - before.system};
 }
 
 /// The median of each field over the rounds.
 Timing median(const std::vector<Timing>& rounds) {
-  std::vector<double> wall, cpu;
+  std::vector<double> wall, cpu, system;
   for (const Timing& t : rounds) {
     wall.push_back(t.wall);
     cpu.push_back(t.cpu);
+    system.push_back(t.system);
   }
-  return {bench::median(std::move(wall)), bench::median(std::move(cpu))};
+  return {bench::median(std::move(wall)), bench::median(std::move(cpu)), bench::median(std::move(system))};
 }
 
 std::string wall_list(const std::vector<Timing>& rounds) {
@@ -117,12 +123,12 @@ int main(int argc, char** argv) {
   fmt::print("read only : {:7.2f} s  {:6.2f} M triangles/s (one file after another; CPU {:.2f} s; rounds: {} s)\n",
              read_m.wall, per_second(read_m), read_m.cpu, wall_list(read));
   fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; one acquisition at a time; "
-             "CPU {:.2f} s; rounds: {} s)\n",
-             tile_m.wall, per_second(tile_m), tile_m.wall / read_m.wall, tile_m.cpu, wall_list(tile));
+             "CPU {:.2f} s, kernel {:.2f} s; rounds: {} s)\n",
+             tile_m.wall, per_second(tile_m), tile_m.wall / read_m.wall, tile_m.cpu, tile_m.system, wall_list(tile));
   fmt::print("tiler     : {:7.2f} s  {:6.2f} M triangles/s  ({:.2f} x the read time; {} at a time, as `run`; "
-             "CPU {:.2f} s; rounds: {} s; target <= 2)\n",
+             "CPU {:.2f} s, kernel {:.2f} s; rounds: {} s; target <= 2)\n",
              parallel_m.wall, per_second(parallel_m), parallel_m.wall / read_m.wall, at_once, parallel_m.cpu,
-             wall_list(tile_parallel));
+             parallel_m.system, wall_list(tile_parallel));
   fmt::print("ratio     : {:.2f} .. {:.2f} x the read of the same round (tiling as `run`)\n", ratios.front(),
              ratios.back());
   fmt::print("tiles     : {} of {:.0f} m, halo copies {:.2f} M, empty-space copies {:.2f} M, {} blocks, {:.0f} MB "

@@ -21,7 +21,17 @@ constexpr std::size_t max_varint_bytes(unsigned bits) { return (bits + 1 + 6) / 
 /// buffer is not zeroed: only the bytes written are ever touched.
 class VarintWriter {
  public:
-  explicit VarintWriter(std::size_t room) : buffer_(new char[room]), at_(buffer_.get()) {}
+  explicit VarintWriter(std::size_t room = 0) : buffer_(new char[room]), capacity_(room), at_(buffer_.get()) {}
+
+  /// Forgets what was written and makes sure of `room` bytes, keeping the buffer when it is
+  /// large enough: a writer reused for block after block touches no fresh memory.
+  void reset(std::size_t room) {
+    if (room > capacity_) {
+      buffer_.reset(new char[room]);
+      capacity_ = room;
+    }
+    at_ = buffer_.get();
+  }
 
   void put(std::uint64_t v) {
     while (v >= 0x80) {
@@ -48,6 +58,7 @@ class VarintWriter {
 
  private:
   std::unique_ptr<char[]> buffer_;
+  std::size_t capacity_;
   char* at_;
 };
 

@@ -76,6 +76,7 @@ class TileGrid {
   [[nodiscard]] bool clearly_within(const Box3d& box, TileKey key) const;
 
   TileGridParams params_;
+  double inverse_size_;  ///< 1 / tile_size, for owner() and cells_near()
 };
 
 }  // namespace citymesh
