@@ -131,6 +131,15 @@ TileAttributes gather(const TilesetVertices& all, const TileMesh& mesh) {
   return a;
 }
 
+/// Tiles on the longest path from the root to a leaf (a parent may skip levels of the grid).
+std::size_t tree_depth(const TileTree& tree) {
+  std::vector<std::size_t> depth(tree.nodes.size(), 1);
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) {  // children come before their parents
+    for (const std::uint32_t c : tree.nodes[n].children) depth[n] = std::max(depth[n], depth[c] + 1);
+  }
+  return depth.back();
+}
+
 }  // namespace
 
 std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid) {
@@ -190,7 +199,7 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
 
   stats.tiles = tree.nodes.size();
   stats.json_files = files.size();
-  stats.levels = static_cast<std::size_t>(tree.root().level) + 1;
+  stats.levels = tree_depth(tree);
   for (const TileNode& node : tree.nodes) {
     stats.all_triangles += node.mesh.triangles.size();
     if (node.level == 0) {

@@ -55,7 +55,8 @@ Box3d mesh_box(const TilesetVertices& vertices, const TileMesh& m) {
 }
 
 /// Merges the children's meshes and simplifies the result with locked borders.
-void build_parent(const TilesetVertices& vertices, TileTree& tree, TileNode& parent, const TileTreeParams& params) {
+void build_parent(const TilesetVertices& vertices, const TileTree& tree, TileNode& parent,
+                  const TileTreeParams& params) {
   std::vector<Triangle> merged;
   double child_error = 0.0;
   for (const std::uint32_t c : parent.children) {
@@ -78,6 +79,58 @@ void build_parent(const TilesetVertices& vertices, TileTree& tree, TileNode& par
   parent.geometric_error = std::max(child_error + simplified.error, params.min_geometric_error);
 }
 
+/// A node that has no parent yet, under its key at the level being built.
+struct OpenNode {
+  std::uint32_t node;
+  TileKey key;
+  bool alone_is_final = false;  ///< simplifying it alone was tried and kept too much
+};
+
+/// A parent of one child must keep at most this share of the child's triangles: above it, the
+/// level repeats its child (once locked borders stop the simplifier, every further level of an
+/// isolated street was the same mesh again, encoded again: 18 of a city's 164 tiles).
+constexpr double kMaxSingleChildShare = 0.5;
+
+/// Groups the open nodes by their keys one level up and gives each group a parent at `level`
+/// (built in parallel); returns the nodes open above it. A node alone in its group whose
+/// parent would keep too much of it is carried up instead, marked so that it is not tried
+/// alone again (the same mesh simplifies the same way).
+std::vector<OpenNode> add_level(const TilesetVertices& vertices, TileTree& tree, std::span<const OpenNode> open,
+                                int level, const TileTreeParams& params) {
+  std::map<TileKey, std::vector<const OpenNode*>> groups;
+  for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(&o);
+  std::vector<TileNode> parents;
+  for (const auto& [key, members] : groups) {
+    if (members.size() == 1 && members[0]->alone_is_final) continue;
+    std::vector<std::uint32_t> children;
+    for (const OpenNode* m : members) children.push_back(m->node);
+    parents.push_back({.level = level, .key = key, .mesh = {}, .geometric_error = 0, .box = {},
+                       .children = std::move(children)});
+  }
+  parallel_for_blocks(parents.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) build_parent(vertices, tree, parents[p], params);
+  });
+  std::vector<OpenNode> above;
+  auto parent = parents.begin();
+  for (const auto& [key, members] : groups) {
+    const OpenNode& first = *members[0];
+    if (members.size() == 1 && first.alone_is_final) {
+      above.push_back({first.node, key, true});
+      continue;
+    }
+    const double child_triangles = static_cast<double>(tree.nodes[first.node].mesh.triangles.size());
+    if (members.size() == 1 &&
+        static_cast<double>(parent->mesh.triangles.size()) > kMaxSingleChildShare * child_triangles) {
+      above.push_back({first.node, key, true});
+    } else {
+      above.push_back({static_cast<std::uint32_t>(tree.nodes.size()), key, false});
+      tree.nodes.push_back(std::move(*parent));
+    }
+    ++parent;
+  }
+  return above;
+}
+
 }  // namespace
 
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
@@ -94,23 +147,10 @@ TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triang
       leaf.box = mesh_box(vertices, leaf.mesh);
     }
   });
-  std::size_t level_begin = 0;
-  for (int level = 1; tree.nodes.size() - level_begin > 1; ++level) {
-    std::map<TileKey, std::vector<std::uint32_t>> parents;
-    for (std::size_t n = level_begin; n < tree.nodes.size(); ++n) {
-      const TileKey k = tree.nodes[n].key;
-      parents[{k.i >> 1, k.j >> 1}].push_back(static_cast<std::uint32_t>(n));
-    }
-    level_begin = tree.nodes.size();
-    for (auto& [key, children] : parents) {
-      tree.nodes.push_back({.level = level, .key = key, .mesh = {}, .geometric_error = 0, .box = {},
-                            .children = std::move(children)});
-    }
-    const std::size_t count = tree.nodes.size() - level_begin;
-    parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t n = begin; n < end; ++n) build_parent(vertices, tree, tree.nodes[level_begin + n], params);
-    });
-  }
+  // The nodes still without a parent, with their keys at the level being built.
+  std::vector<OpenNode> open;
+  for (std::uint32_t n = 0; n < tree.nodes.size(); ++n) open.push_back({n, tree.nodes[n].key, false});
+  for (int level = 1; open.size() > 1; ++level) open = add_level(vertices, tree, open, level, params);
   return tree;
 }
 

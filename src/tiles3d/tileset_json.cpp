@@ -18,28 +18,26 @@ nlohmann::json box_json(const Box3d& box, const TilesetJsonParams& params) {
             half(box.min.z, box.max.z)}}};
 }
 
-/// The levels of tiles one file holds below its root: 1 + 4 + ... + 4^depth <= max.
-int levels_per_file(std::size_t max_tiles) {
-  int depth = 0;
-  std::size_t total = 1, width = 1;
-  while (total + width * 4 <= max_tiles) {
-    width *= 4;
-    total += width;
-    ++depth;
+/// Tiles in each node's subtree, itself included (children come before their parents).
+std::vector<std::size_t> subtree_sizes(const TileTree& tree) {
+  std::vector<std::size_t> size(tree.nodes.size(), 1);
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
+    for (const std::uint32_t c : tree.nodes[n].children) size[n] += size[c];
   }
-  return depth;
+  return size;
 }
 
 class Writer {
  public:
   Writer(const TileTree& tree, const TilesetJsonParams& params)
-      : tree_(tree), params_(params), depth_(levels_per_file(params.max_tiles_per_file)) {}
+      : tree_(tree), params_(params), subtree_(subtree_sizes(tree)) {}
 
   void write_file(std::uint32_t root, const std::string& file_name, bool main) {
     files_.emplace_back(file_name, std::string());
     const std::size_t slot = files_.size() - 1;
     const TileNode& node = tree_.nodes[root];
-    nlohmann::json tile = tile_json(root, 0);
+    std::size_t room = params_.max_tiles_per_file - 1;  // the root's tile is in
+    nlohmann::json tile = tile_json(root, room);
     if (main) tile["transform"] = params_.transform;
     const double diagonal = norm(node.box.max - node.box.min);
     nlohmann::json tileset{{"asset", {{"version", "1.1"}, {"generator", "citymesh"}}},
@@ -51,30 +49,48 @@ class Writer {
   std::vector<std::pair<std::string, std::string>> take() { return std::move(files_); }
 
  private:
-  nlohmann::json tile_json(std::uint32_t n, int depth) {
+  /// Tile n (already counted) with its children: a child's whole subtree when it fits in the
+  /// `room` left in this file (keeping one tile for each later child), otherwise a tile that
+  /// points at an external tileset holding that subtree. Files thus hold whole subtrees, as
+  /// many tiles as allowed, whatever the depth (a parent may skip levels of the grid).
+  nlohmann::json tile_json(std::uint32_t n, std::size_t& room) {
     const TileNode& node = tree_.nodes[n];
     nlohmann::json tile{{"boundingVolume", box_json(node.box, params_)},
                         {"geometricError", node.geometric_error},
                         {"refine", "REPLACE"}};
-    if (depth == depth_ && !node.children.empty()) {
-      // The rest of this subtree lives in an external tileset whose root is this tile.
-      const std::string external = node.name() + ".json";
-      tile["content"] = {{"uri", external}};
-      write_file(n, external, false);
-      return tile;
-    }
     if (!node.mesh.triangles.empty()) tile["content"] = {{"uri", node.name() + ".glb"}};
-    if (!node.children.empty()) {
-      nlohmann::json children = nlohmann::json::array();
-      for (const std::uint32_t c : node.children) children.push_back(tile_json(c, depth + 1));
-      tile["children"] = std::move(children);
+    if (node.children.empty()) return tile;
+    nlohmann::json children = nlohmann::json::array();
+    for (std::size_t k = 0; k < node.children.size(); ++k) {
+      const std::uint32_t c = node.children[k];
+      const std::size_t later = node.children.size() - k - 1;
+      if (subtree_[c] + later <= room) {
+        room -= subtree_[c];
+        std::size_t descendants = subtree_[c] - 1;  // room for exactly those: all inline
+        children.push_back(tile_json(c, descendants));
+      } else {
+        room -= 1;
+        children.push_back(external_tile(c));
+      }
     }
+    tile["children"] = std::move(children);
     return tile;
+  }
+
+  /// Tile c as a pointer to the external tileset "<name>.json" whose root it is.
+  nlohmann::json external_tile(std::uint32_t c) {
+    const TileNode& node = tree_.nodes[c];
+    const std::string external = node.name() + ".json";
+    write_file(c, external, false);
+    return {{"boundingVolume", box_json(node.box, params_)},
+            {"geometricError", node.geometric_error},
+            {"refine", "REPLACE"},
+            {"content", {{"uri", external}}}};
   }
 
   const TileTree& tree_;
   const TilesetJsonParams& params_;
-  int depth_;
+  std::vector<std::size_t> subtree_;
   std::vector<std::pair<std::string, std::string>> files_;
 };
 

@@ -51,6 +51,10 @@ struct TileTreeParams {
 };
 
 /// Builds the tree from the triangles (global vertex indices) and each triangle's leaf key.
+/// Level by level, the nodes without a parent are grouped by their keys one level up and each
+/// group gets a parent, except a node alone in its group whose simplification keeps more than
+/// half of it: that node is carried up unchanged (a parent would only repeat it) until it meets
+/// another, so a parent's children may lie several levels below it.
 /// The result depends only on the input, never on the thread count. An empty input gives an
 /// empty tree.
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
