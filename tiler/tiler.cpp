@@ -58,10 +58,10 @@ struct BatchTile {
 
 std::string chunk_name(TileKey key);
 
-/// Upper bound of the memory one copy takes in the piece and block of its tile while that
-/// tile is written (triangle 33 bytes, up to a vertex of ~35 bytes, block bytes): only the
+/// Upper bound of the memory one copy takes in the block of its tile while that
+/// tile is written (its varints up to 35 bytes, a new vertex up to 32 more): only the
 /// largest tile of a batch is ever built at once.
-constexpr std::uint64_t kPieceBytesPerCopy = 96;
+constexpr std::uint64_t kBlockBytesPerCopy = 96;
 /// A batch is written once it holds this much, even when the budget allows more: larger
 /// batches gain nothing (their blocks go to the same files) and touch fresh memory, whose
 /// page faults took a fifth of the tiler's time with batches of a quarter of a 2 GiB budget.
@@ -71,7 +71,7 @@ constexpr std::size_t kMaxBatchTriangles = (std::size_t{1} << 30) - 1;
 
 /// Tiles one acquisition in batches: each triangle's destinations (owner, halo tiles, tiles
 /// its empty space crosses) are recorded as it is read; when the batch is full, its copies are
-/// sorted by tile and each tile's block is built in one reused piece and appended to the
+/// sorted by tile and each tile's block is encoded by one reused writer and appended to the
 /// tile's chunk file. A tile's triangles keep their input order and its vertices their order
 /// of first use, so the blocks do not depend on how the work is done.
 class AcquisitionTiler {
@@ -135,10 +135,10 @@ class AcquisitionTiler {
     slots_.reserve(n);
   }
 
-  /// What the batch holds, and the largest tile's piece and block while it is written.
+  /// What the batch holds, and the largest tile's block while it is written.
   [[nodiscard]] std::uint64_t batch_bytes() const {
     return batch_.size() * sizeof(BatchTriangle) + copies_.size() * (sizeof(TileCopy) + sizeof(std::uint32_t)) +
-           std::uint64_t{largest_tile_} * kPieceBytesPerCopy;
+           std::uint64_t{largest_tile_} * kBlockBytesPerCopy;
   }
 
   void add_triangle(const BatchTriangle& triangle) {
@@ -244,7 +244,7 @@ class AcquisitionTiler {
   tiler_detail::TileBlockWriter block_;
   Vec3d origin_;          ///< of the tile whose block is being built
   std::uint32_t flags_ = 0;  ///< the acquisition's vertex attributes (tiler_detail::kHasIntensity, ...)
-  std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in piece_
+  std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in the block
   std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };
 
