@@ -58,9 +58,10 @@ struct BatchTile {
 
 std::string chunk_name(TileKey key);
 
-/// Upper bound of the memory one copy takes in the block of its tile while that
-/// tile is written (its varints up to 35 bytes, a new vertex up to 32 more): only the
-/// largest tile of a batch is ever built at once.
+/// Memory one copy takes in the block of its tile while that tile is written: its varints up
+/// to 35 bytes and a new vertex up to 32 more (a tile's copies bring fewer new vertices than
+/// that on average: a mesh has about half as many vertices as triangles). Only the largest
+/// tile of a batch is ever built at once.
 constexpr std::uint64_t kBlockBytesPerCopy = 96;
 /// A batch is written once it holds this much, even when the budget allows more: larger
 /// batches gain nothing (their blocks go to the same files) and touch fresh memory, whose
