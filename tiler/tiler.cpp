@@ -33,6 +33,11 @@ struct AcquisitionVertices {
     intensities.insert(intensities.end(), c.intensities.begin(), c.intensities.end());
     colors.insert(colors.end(), c.colors.begin(), c.colors.end());
   }
+
+  /// The block flags of the attributes the acquisition has (tiler_detail::kHasIntensity, ...).
+  [[nodiscard]] std::uint32_t flags() const {
+    return (intensities.empty() ? 0 : tiler_detail::kHasIntensity) | (colors.empty() ? 0 : tiler_detail::kHasColor);
+  }
 };
 
 /// A triangle of the current batch: what its copies need once the batch is written.
@@ -101,8 +106,6 @@ class AcquisitionTiler {
       if (kind == PlyReader::ChunkKind::vertices) {
         vertices_.append(vertices);
         slots_.resize(vertices_.positions.size(), 0);
-        flags_ = (vertices_.intensities.empty() ? 0 : tiler_detail::kHasIntensity) |
-                 (vertices_.colors.empty() ? 0 : tiler_detail::kHasColor);
         continue;
       }
       for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
@@ -202,7 +205,7 @@ class AcquisitionTiler {
   std::vector<std::string_view> build_block(TileKey key, std::span<const std::uint32_t> copies) {
     origin_ = grid_.corner(key);
     ++stamp_;  // every slot of an earlier block is stale
-    block_.start(flags_, 3 * copies.size(), copies.size());
+    block_.start(vertices_.flags(), 3 * copies.size(), copies.size());
     for (const std::uint32_t copy : copies) {
       const BatchTriangle& t = batch_[copy >> 2];
       Triangle local{};
@@ -243,8 +246,7 @@ class AcquisitionTiler {
   // Reused by every flush.
   std::vector<std::uint32_t> sorted_;
   tiler_detail::TileBlockWriter block_;
-  Vec3d origin_;          ///< of the tile whose block is being built
-  std::uint32_t flags_ = 0;  ///< the acquisition's vertex attributes (tiler_detail::kHasIntensity, ...)
+  Vec3d origin_;  ///< of the tile whose block is being built
   std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in the block
   std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };

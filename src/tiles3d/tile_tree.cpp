@@ -99,9 +99,13 @@ std::vector<OpenNode> add_level(const TilesetVertices& vertices, TileTree& tree,
                                 int level, const TileTreeParams& params) {
   std::map<TileKey, std::vector<const OpenNode*>> groups;
   for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(&o);
+  // A group of one node already found not to simplify alone gets no parent to try.
+  const auto settled_alone = [](const std::vector<const OpenNode*>& members) {
+    return members.size() == 1 && members[0]->alone_is_final;
+  };
   std::vector<TileNode> parents;
   for (const auto& [key, members] : groups) {
-    if (members.size() == 1 && members[0]->alone_is_final) continue;
+    if (settled_alone(members)) continue;
     std::vector<std::uint32_t> children;
     for (const OpenNode* m : members) children.push_back(m->node);
     parents.push_back({.level = level, .key = key, .mesh = {}, .geometric_error = 0, .box = {},
@@ -114,7 +118,7 @@ std::vector<OpenNode> add_level(const TilesetVertices& vertices, TileTree& tree,
   auto parent = parents.begin();
   for (const auto& [key, members] : groups) {
     const OpenNode& first = *members[0];
-    if (members.size() == 1 && first.alone_is_final) {
+    if (settled_alone(members)) {
       above.push_back({first.node, key, true});
       continue;
     }

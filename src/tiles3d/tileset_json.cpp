@@ -55,9 +55,7 @@ class Writer {
   /// many tiles as allowed, whatever the depth (a parent may skip levels of the grid).
   nlohmann::json tile_json(std::uint32_t n, std::size_t& room) {
     const TileNode& node = tree_.nodes[n];
-    nlohmann::json tile{{"boundingVolume", box_json(node.box, params_)},
-                        {"geometricError", node.geometric_error},
-                        {"refine", "REPLACE"}};
+    nlohmann::json tile = tile_header(node);
     if (!node.mesh.triangles.empty()) tile["content"] = {{"uri", node.name() + ".glb"}};
     if (node.children.empty()) return tile;
     nlohmann::json children = nlohmann::json::array();
@@ -82,10 +80,16 @@ class Writer {
     const TileNode& node = tree_.nodes[c];
     const std::string external = node.name() + ".json";
     write_file(c, external, false);
+    nlohmann::json tile = tile_header(node);
+    tile["content"] = {{"uri", external}};
+    return tile;
+  }
+
+  /// What every tile of `node` says, in this file or pointing at another.
+  [[nodiscard]] nlohmann::json tile_header(const TileNode& node) const {
     return {{"boundingVolume", box_json(node.box, params_)},
             {"geometricError", node.geometric_error},
-            {"refine", "REPLACE"},
-            {"content", {{"uri", external}}}};
+            {"refine", "REPLACE"}};
   }
 
   const TileTree& tree_;
