@@ -63,7 +63,7 @@ void TileAssembly::add(TileResult result) {
   }
 }
 
-MergedMesh TileAssembly::merged() const {
+MergedMesh TileAssembly::take_merged() {
   // Every selected triangle by its flat number (piece_start[p] + t), gathered per
   // acquisition as (triangle index, flat number): sorted, the output order is the input's.
   std::vector<std::uint32_t> piece_start{0};
@@ -134,6 +134,7 @@ MergedMesh TileAssembly::merged() const {
     }
     std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(order);
   }
+  std::vector<TilePiece>().swap(pieces_);
   return out;
 }
 

@@ -21,8 +21,9 @@ class TileAssembly {
   void add(TileResult result);
 
   /// The selected triangles sorted by (acquisition, triangle index), with their global ids;
-  /// vertices shared within an acquisition across tiles.
-  [[nodiscard]] MergedMesh merged() const;
+  /// vertices shared within an acquisition across tiles. Hands over the tiles' pieces: they
+  /// are freed once merged (the seam pass then has their memory), so it is called once.
+  [[nodiscard]] MergedMesh take_merged();
 
   /// The labels as the change step gives them for the whole input (consistent pairs sorted,
   /// unique; statistics: triangle and pair counts). Only with `labels`.

@@ -75,6 +75,15 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                        const TileStageReport& tiles, const PictureOptions& pictures, nlohmann::json seconds,
                        int ranks) {
   Stopwatch total, clock;
+  // Each stage hands the memory it freed back to the system: the next one then starts from
+  // what is still in use, and the pass peaks at its largest stage rather than at the heap
+  // every stage left behind (city: 1.37 -> 0.99 GiB).
+  const auto stage_done = [&](const char* stage) {
+    release_freed_memory();
+    seconds[stage] = clock.restart();
+    log::debug("final pass: {} done, resident {} MiB (peak {} MiB)", stage, resident_bytes() >> 20,
+               peak_resident_bytes() >> 20);
+  };
   TileAssembly assembly(store, config.output.labels);
   std::vector<nlohmann::json> per_tile;
   // Results are read (and checked) a few at a time in parallel, then added in tile order; a
@@ -92,17 +101,17 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     for (std::size_t i = 0; i < count; ++i) add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0,
                                                             std::move(batch[i]), assembly, per_tile);
   }
-  MergedMesh merged = assembly.merged();
+  MergedMesh merged = assembly.take_merged();
   const std::uint64_t selected = merged.mesh.triangle_count();
-  seconds["assembly"] = clock.restart();
+  stage_done("assembly");
   if (config.output.labels) write_labels(config, assembly, pictures);
-  seconds["labels"] = clock.restart();
+  stage_done("labels");
   // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
   // like seams inside a tile.
   const nlohmann::json stitched = config.mosaic.method == MosaicMethod::energy
                                       ? stitch_and_report(config, merged)
                                       : nlohmann::json::object();
-  seconds["stitch"] = clock.restart();
+  stage_done("stitch");
   MosaicStats stats;
   stats.candidates = assembly.candidates();
   stats.seen_through = assembly.seen_through();
@@ -118,9 +127,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                         .seconds = seconds,
                         .stitch = stitched,
                         .solved_per_tile = true});
-  seconds["outputs"] = clock.restart();
+  stage_done("outputs");
   const nlohmann::json exported = write_tileset_outputs(config, merged);
-  seconds["export"] = clock.restart();
+  stage_done("export");
 
   double wall = total.seconds();
   for (const auto& [stage, s] : seconds.items()) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <unordered_map>
 
 #include "citymesh/core/geometry.h"
@@ -159,6 +160,14 @@ std::vector<Cut> find_cuts(const Mesh& m, const Cover& cover, const VertexFrames
 
 /// Appends the cuts' vertices; returns edge key -> new vertex.
 std::unordered_map<std::uint64_t, std::uint32_t> add_cut_vertices(Mesh& m, const std::vector<Cut>& cuts) {
+  // Room for the cut vertices at once: growing by doubling left half of every per-vertex
+  // array of a city's output unused.
+  const std::size_t room = m.vertex_count() + cuts.size();
+  m.positions.reserve(room);
+  if (!m.sensor_positions.empty()) m.sensor_positions.reserve(room);
+  if (!m.times.empty()) m.times.reserve(room);
+  if (!m.intensities.empty()) m.intensities.reserve(room);
+  if (!m.colors.empty()) m.colors.reserve(room);
   std::unordered_map<std::uint64_t, std::uint32_t> vertex_of;
   for (const Cut& cut : cuts) vertex_of[edge_key(cut.c, cut.u)] = append_between(m, cut.c, cut.u, cut.fraction);
   return vertex_of;
@@ -189,38 +198,43 @@ std::vector<Triangle> triangulate(const Mesh& m, const std::vector<std::uint32_t
   return {{p[0], p[1], p[3]}, {p[1], p[2], p[3]}};
 }
 
+/// v[from[i]] for every i: one array rebuilt at a time, so that only it is ever held twice.
+template <class T>
+void gather(std::vector<T>& v, std::span<const std::uint32_t> from) {
+  std::vector<T> out(from.size());
+  for (std::size_t i = 0; i < from.size(); ++i) out[i] = v[from[i]];
+  v = std::move(out);
+}
+
 /// Replaces each triangle in place by its uncovered part (nothing when covered whole).
 ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& covered,
                           const std::unordered_map<std::uint64_t, std::uint32_t>& cut) {
-  const Mesh& m = merged.mesh;
+  Mesh& m = merged.mesh;
   ClipStats stats;
-  MergedMesh out;
-  out.mesh.triangles.reserve(m.triangle_count());
-  out.mesh.triangle_ids.reserve(m.triangle_count());
-  out.source_acq.reserve(m.triangle_count());
-  out.source_triangle.reserve(m.triangle_count());
-  const auto keep = [&](const Triangle& part, std::size_t t) {
-    out.mesh.triangles.push_back(part);
-    out.mesh.triangle_ids.push_back(m.triangle_ids[t]);
-    out.source_acq.push_back(merged.source_acq[t]);
-    out.source_triangle.push_back(merged.source_triangle[t]);
-  };
+  std::vector<Triangle> triangles;
+  std::vector<std::uint32_t> from;  ///< per new triangle, the triangle it is (part of)
+  triangles.reserve(m.triangle_count());
+  from.reserve(m.triangle_count());
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const Triangle& tri = m.triangles[t];
     const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
     if (corners_covered == 0) {
-      keep(tri, t);  // nearly every triangle of a city: no polygon built
+      triangles.push_back(tri);  // nearly every triangle of a city: no polygon built
+      from.push_back(static_cast<std::uint32_t>(t));
     } else if (corners_covered == 3) {
       ++stats.triangles_removed;
     } else {
-      for (const Triangle& part : triangulate(m, uncovered_part(tri, covered, cut))) keep(part, t);
+      for (const Triangle& part : triangulate(m, uncovered_part(tri, covered, cut))) {
+        triangles.push_back(part);
+        from.push_back(static_cast<std::uint32_t>(t));
+      }
       ++stats.triangles_cut;
     }
   }
-  merged.mesh.triangles = std::move(out.mesh.triangles);
-  merged.mesh.triangle_ids = std::move(out.mesh.triangle_ids);
-  merged.source_acq = std::move(out.source_acq);
-  merged.source_triangle = std::move(out.source_triangle);
+  m.triangles = std::move(triangles);
+  gather(m.triangle_ids, from);
+  gather(merged.source_acq, from);
+  gather(merged.source_triangle, from);
   return stats;
 }
 

@@ -9,6 +9,7 @@
 #include <unordered_set>
 
 #include "citymesh/core/log.h"
+#include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/spatial/kd_tree.h"
@@ -248,7 +249,8 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   Stopwatch clock;
   // Where the time goes, at --log-level debug (the seam pass of a city runs mostly serial).
   const auto phase_done = [&clock](std::string_view phase) {
-    log::debug("stitch: {} at {:.2f} s", phase, clock.seconds());
+    log::debug("stitch: {} at {:.2f} s, resident {} MiB (peak {} MiB)", phase, clock.seconds(), resident_bytes() >> 20,
+               peak_resident_bytes() >> 20);
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.

@@ -112,10 +112,11 @@ struct Node {
   }
 };
 
-/// Nodes over consecutive groups of kFanout boxes.
-std::vector<Node> pack(std::span<const Box3f> boxes) {
-  std::vector<Node> nodes((boxes.size() + kFanout - 1) / kFanout);
-  for (std::size_t i = 0; i < boxes.size(); ++i) nodes[i / kFanout].set(i % kFanout, boxes[i]);
+/// Nodes over consecutive groups of kFanout boxes, box i being box_at(i).
+template <class BoxAt>
+std::vector<Node> pack(std::size_t count, BoxAt box_at) {
+  std::vector<Node> nodes((count + kFanout - 1) / kFanout);
+  for (std::size_t i = 0; i < count; ++i) nodes[i / kFanout].set(i % kFanout, box_at(i));
   return nodes;
 }
 
@@ -137,18 +138,16 @@ BoxTree::BoxTree(std::vector<Box3f> boxes) : impl_(std::make_unique<Impl>()) {
     for (std::size_t i = begin; i < end; ++i) order[i] = {frame.code(boxes[i]), static_cast<std::uint32_t>(i)};
   });
   radix_sort_pairs(order);  // ties broken by index: the same tree on any thread count
-  std::vector<Box3f> sorted(boxes.size());
   impl_->original.resize(boxes.size());
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    sorted[i] = boxes[order[i].second];
-    impl_->original[i] = order[i].second;
-  }
-  impl_->levels.push_back(pack(sorted));
+  for (std::size_t i = 0; i < order.size(); ++i) impl_->original[i] = order[i].second;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(order);
+  // Packed straight from the caller's boxes in curve order, which are then freed: a sorted
+  // copy beside them was the peak of a city's seam pass (three arrays of every box at once).
+  impl_->levels.push_back(pack(boxes.size(), [&](std::size_t i) { return boxes[impl_->original[i]]; }));
+  std::vector<Box3f>().swap(boxes);
   while (impl_->levels.back().size() > 1) {
     const std::vector<Node>& below = impl_->levels.back();
-    std::vector<Box3f> bounds(below.size());
-    for (std::size_t i = 0; i < below.size(); ++i) bounds[i] = below[i].bounds();
-    impl_->levels.push_back(pack(bounds));
+    impl_->levels.push_back(pack(below.size(), [&](std::size_t i) { return below[i].bounds(); }));
   }
 }
 

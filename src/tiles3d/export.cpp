@@ -47,38 +47,60 @@ std::uint16_t feature_of(std::int32_t source) {
 }
 
 SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source_acq, std::span<const Vec3f> local) {
-  // Every step runs on the pool (a city's output has millions of triangles: done serially,
-  // this was a quarter of the export's time on two threads). Each writes fixed slots, and the
-  // sort orders plain integers, so the bytes do not depend on the thread count.
+  // The split vertices in (vertex, feature) order. Nearly every vertex has one feature, its
+  // smallest; only the pairs beyond it (vertices that stitch triangles share with a source)
+  // are listed and sorted. Sorting a key per corner took three times the output's triangle
+  // array, twice over: the peak of a city's export.
+  constexpr std::uint32_t kUnused = UINT32_MAX;
   auto key = [](std::uint32_t v, std::uint16_t f) { return (std::uint64_t{v} << 16) | f; };
   const std::size_t n = mesh.triangle_count();
-  std::vector<std::uint64_t> keys(n * 3);
-  parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t t = begin; t < end; ++t) {
-      const std::uint16_t f = feature_of(source_acq[t]);
-      for (std::size_t k = 0; k < 3; ++k) keys[3 * t + k] = key(mesh.triangles[t][k], f);
+  std::vector<std::uint32_t> first(mesh.vertex_count(), kUnused);  ///< per vertex: its smallest feature
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::uint32_t f = feature_of(source_acq[t]);
+    for (const std::uint32_t v : mesh.triangles[t]) first[v] = std::min(first[v], f);
+  }
+  std::vector<std::uint64_t> extra;  ///< (vertex, feature) pairs beyond the vertex's first, sorted
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::uint16_t f = feature_of(source_acq[t]);
+    for (const std::uint32_t v : mesh.triangles[t]) {
+      if (f != first[v]) extra.push_back(key(v, f));
     }
-  });
-  parallel_sort(keys);
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  }
+  std::sort(extra.begin(), extra.end());
+  extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
+  std::vector<std::uint32_t> start(mesh.vertex_count() + 1, 0);  ///< per vertex: its first split vertex
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) start[v + 1] = first[v] != kUnused ? 1 : 0;
+  for (const std::uint64_t k : extra) ++start[(k >> 16) + 1];
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) start[v + 1] += start[v];
+  const auto index = [&](std::uint32_t v, std::uint16_t f) -> std::uint32_t {
+    if (f == first[v]) return start[v];
+    const auto it = std::lower_bound(extra.begin(), extra.end(), key(v, f));
+    const auto v_first = std::lower_bound(extra.begin(), it, key(v, 0));
+    return start[v] + 1 + static_cast<std::uint32_t>(it - v_first);
+  };
   SplitMesh out;
   TilesetVertices& vx = out.vertices;
-  vx.positions.resize(keys.size());
-  vx.feature_ids.resize(keys.size());
-  if (!mesh.intensities.empty()) vx.intensities.resize(keys.size());
-  if (!mesh.colors.empty()) vx.colors.resize(keys.size());
-  parallel_for_blocks(keys.size(), 16384, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const auto v = static_cast<std::uint32_t>(keys[i] >> 16);
-      vx.positions[i] = local[v];
-      vx.feature_ids[i] = static_cast<std::uint16_t>(keys[i] & 0xFFFF);
-      if (!vx.intensities.empty()) vx.intensities[i] = mesh.intensities[v];
-      if (!vx.colors.empty()) vx.colors[i] = mesh.colors[v];
+  const std::size_t count = start.back();
+  vx.positions.resize(count);
+  vx.feature_ids.resize(count);
+  if (!mesh.intensities.empty()) vx.intensities.resize(count);
+  if (!mesh.colors.empty()) vx.colors.resize(count);
+  const auto put = [&](std::uint32_t v, std::uint16_t f, std::uint32_t i) {
+    vx.positions[i] = local[v];
+    vx.feature_ids[i] = f;
+    if (!vx.intensities.empty()) vx.intensities[i] = mesh.intensities[v];
+    if (!vx.colors.empty()) vx.colors[i] = mesh.colors[v];
+  };
+  parallel_for_blocks(mesh.vertex_count(), 16384, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      if (first[v] != kUnused) put(static_cast<std::uint32_t>(v), static_cast<std::uint16_t>(first[v]), start[v]);
     }
   });
-  auto index = [&](std::uint32_t v, std::uint16_t f) {
-    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), key(v, f)) - keys.begin());
-  };
+  for (const std::uint64_t k : extra) {
+    const auto v = static_cast<std::uint32_t>(k >> 16);
+    const auto f = static_cast<std::uint16_t>(k & 0xFFFF);
+    put(v, f, index(v, f));
+  }
   out.triangles.resize(n);
   parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
@@ -163,8 +185,8 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   TilesetExportStats stats;
   stats.origin = source.crs.to_geodetic(frame_origin(mesh));
   const EnuFrame frame(stats.origin);
-  const std::vector<Vec3f> local = local_positions(mesh, source.crs, frame);
-  const SplitMesh split = split_by_source(mesh, source.source_acq, local);
+  // The positions in the local frame live only while the split copies them.
+  const SplitMesh split = split_by_source(mesh, source.source_acq, local_positions(mesh, source.crs, frame));
   const TileTree tree = build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
                                         params.tree);
   GlbParams glb{.draco = params.draco, .draco_params = shared_lattice(split.vertices.positions, params),

@@ -140,17 +140,36 @@ std::vector<OpenNode> add_level(const TilesetVertices& vertices, TileTree& tree,
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
                          std::span<const TileKey> leaf_keys, const TileTreeParams& params) {
   TileTree tree;
-  std::map<TileKey, std::vector<Triangle>> leaves;
-  for (std::size_t t = 0; t < triangles.size(); ++t) leaves[leaf_keys[t]].push_back(triangles[t]);
-  for (auto& [key, tris] : leaves) tree.nodes.push_back({.level = 0, .key = key, .mesh = {}, .geometric_error = 0,
-                                                         .box = {}, .children = {}});
+  // The triangles grouped by leaf as indices (a counting sort), not as copies: a vector of
+  // triangles per leaf, grown by doubling, was the peak of a city's export.
+  std::map<TileKey, std::uint32_t> leaf_of;
+  for (const TileKey& key : leaf_keys) leaf_of.try_emplace(key, 0);
+  for (auto& [key, leaf] : leaf_of) {
+    leaf = static_cast<std::uint32_t>(tree.nodes.size());
+    tree.nodes.push_back({.level = 0, .key = key, .mesh = {}, .geometric_error = 0, .box = {}, .children = {}});
+  }
+  std::vector<std::uint32_t> start(tree.nodes.size() + 1, 0);
+  std::vector<std::uint32_t> leaf_index(triangles.size());
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    leaf_index[t] = leaf_of.at(leaf_keys[t]);
+    ++start[leaf_index[t] + 1];
+  }
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) start[n + 1] += start[n];
+  std::vector<std::uint32_t> order(triangles.size());
+  std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+  for (std::size_t t = 0; t < triangles.size(); ++t) order[at[leaf_index[t]]++] = static_cast<std::uint32_t>(t);
+  std::vector<std::uint32_t>().swap(leaf_index);
   parallel_for_blocks(tree.nodes.size(), 1, [&](std::size_t begin, std::size_t end) {
+    std::vector<Triangle> own;
     for (std::size_t n = begin; n < end; ++n) {
+      own.clear();
+      for (std::uint32_t i = start[n]; i < start[n + 1]; ++i) own.push_back(triangles[order[i]]);
       TileNode& leaf = tree.nodes[n];
-      leaf.mesh = compact(leaves.at(leaf.key), vertices.positions.size());
+      leaf.mesh = compact(own, vertices.positions.size());
       leaf.box = mesh_box(vertices, leaf.mesh);
     }
   });
+  std::vector<std::uint32_t>().swap(order);
   // The nodes still without a parent, with their keys at the level being built.
   std::vector<OpenNode> open;
   for (std::uint32_t n = 0; n < tree.nodes.size(); ++n) open.push_back({n, tree.nodes[n].key, false});

@@ -117,6 +117,31 @@ TEST(TilesetExport, NeighbouringLeavesDecodeSharedVerticesBitIdentically) {
   EXPECT_GE(shared.size(), 26u);
 }
 
+TEST(TilesetExport, EveryLeafTriangleCarriesItsSourceAsOneFeatureId) {
+  // Vertices on the band borders (columns 40 and 80) belong to two sources, and those where a
+  // border meets the stitch row (j = 60) to three: each source's triangles need their own copy.
+  test::TempDir tmp;
+  const Scene s = scene();
+  export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "tiles"));
+  std::map<std::uint16_t, std::size_t> expected, found;
+  for (const std::int32_t source : s.source) {
+    ++expected[source < 0 ? kNullFeatureId : static_cast<std::uint16_t>(source)];
+  }
+  for (const auto& entry : std::filesystem::directory_iterator(tmp / "tiles")) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("t0_", 0) != 0 || entry.path().extension() != ".glb") continue;
+    const DecodedMesh m = decode(entry.path());
+    ASSERT_EQ(m.feature_ids.size(), m.positions.size()) << name;
+    for (const Triangle& t : m.triangles) {
+      const std::uint16_t f = m.feature_ids[t[0]];
+      EXPECT_EQ(m.feature_ids[t[1]], f) << name;
+      EXPECT_EQ(m.feature_ids[t[2]], f) << name;
+      ++found[f];
+    }
+  }
+  EXPECT_EQ(found, expected);
+}
+
 TEST(TilesetExport, RootTransformPutsAKnownPointWhereProjDoes) {
   test::TempDir tmp;
   const Scene s = scene();
