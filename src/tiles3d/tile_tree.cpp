@@ -151,7 +151,9 @@ TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triang
   std::vector<std::uint32_t> start(tree.nodes.size() + 1, 0);
   std::vector<std::uint32_t> leaf_index(triangles.size());
   for (std::size_t t = 0; t < triangles.size(); ++t) {
-    leaf_index[t] = leaf_of.at(leaf_keys[t]);
+    // Consecutive triangles mostly share a leaf (the output is in input order): look up only
+    // when the key changes.
+    leaf_index[t] = t > 0 && leaf_keys[t] == leaf_keys[t - 1] ? leaf_index[t - 1] : leaf_of.at(leaf_keys[t]);
     ++start[leaf_index[t] + 1];
   }
   for (std::size_t n = 0; n < tree.nodes.size(); ++n) start[n + 1] += start[n];
