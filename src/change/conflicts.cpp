@@ -15,9 +15,10 @@ namespace {
 /// about one voxel long and each slab's box is marked.
 void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& grid) {
   const TetrahedronCorners q = f.empty_space(g);
+  const EmptySpaceSlabs slabs(q);
   const int n = slab_count(q, grid.voxel_size());
   for (int k = 0; k < n; ++k) {
-    const Box3f box = empty_space_slab(q, k, n);
+    const Box3f box = slabs.slab(k, n);
     grid.mark_box(box.min, box.max);
   }
 }
@@ -76,7 +77,7 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
     for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
       if (partners.has(g, j)) continue;
       ++stats.conflict_candidates;
-      const Box3f box = f.bounds(g);
+      const Box3f& box = f.bounds(g);
       if (params.prefilter && !grids[j].any_in_box(box.min, box.max)) {
         ++stats.prefilter_skipped;
         continue;
@@ -138,7 +139,7 @@ EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j) {
   parallel_for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const TetrahedronCorners q = f.empty_space(out.boxed.ids[i]);
-      out.boxed.boxes[i] = empty_space_slab(q, 0, 1);
+      out.boxed.boxes[i] = EmptySpaceSlabs(q).slab(0, 1);
       out.planes[i] = FacePlanes(q);
     }
   });

@@ -84,21 +84,14 @@ TetrahedronCorners TriangleFrames::empty_space(std::size_t g) const {
 }
 
 namespace {
-/// Boxes are padded by a hair so that rounding to float never loses a touching pair.
-Box3f padded_box(std::span<const Vec3d> points) {
-  Box3d b;
-  for (const Vec3d& p : points) b.extend(p);
+/// b padded by a hair so that rounding to float never loses a touching pair.
+Box3f padded(Box3d b) {
   const double pad = 1e-5 + 1e-6 * std::max({std::abs(b.min.x), std::abs(b.min.y), std::abs(b.min.z), std::abs(b.max.x),
                                              std::abs(b.max.y), std::abs(b.max.z)});
   b = b.grown(pad);
   return {Vec3f(b.min), Vec3f(b.max)};
 }
 }  // namespace
-
-Box3f TriangleFrames::bounds(std::size_t g) const {
-  const TriangleCorners c = corners(g);
-  return padded_box(c);
-}
 
 double empty_space_scale(const TriangleCorners& c, const Vec3d& viewpoint, double height, const ChangeParams& params) {
   const double margin = params.conflict_margin;
@@ -117,14 +110,22 @@ int slab_count(const TetrahedronCorners& q, double length) {
   return static_cast<int>(std::clamp(std::ceil(reach / length), 1.0, 100000.0));
 }
 
-Box3f empty_space_slab(const TetrahedronCorners& q, int k, int n) {
-  const double s0 = double(k) / n, s1 = double(k + 1) / n;
-  std::array<Vec3d, 6> cut;
-  for (int i = 0; i < 3; ++i) {
-    cut[static_cast<std::size_t>(i)] = q[0] + (q[i + 1] - q[0]) * s0;
-    cut[static_cast<std::size_t>(i + 3)] = q[0] + (q[i + 1] - q[0]) * s1;
+EmptySpaceSlabs::EmptySpaceSlabs(const TetrahedronCorners& q) : apex_(q[0]), low_(q[1] - q[0]), high_(low_) {
+  for (std::size_t i = 2; i < 4; ++i) {
+    const Vec3d d = q[i] - q[0];
+    low_ = {std::min(low_.x, d.x), std::min(low_.y, d.y), std::min(low_.z, d.z)};
+    high_ = {std::max(high_.x, d.x), std::max(high_.y, d.y), std::max(high_.z, d.z)};
   }
-  return padded_box(cut);
+}
+
+Box3f EmptySpaceSlabs::slab(int k, int n) const {
+  const double s0 = double(k) / n, s1 = double(k + 1) / n;
+  Box3d b;
+  for (int a = 0; a < 3; ++a) {
+    b.min[a] = std::min(apex_[a] + low_[a] * s0, apex_[a] + low_[a] * s1);
+    b.max[a] = std::max(apex_[a] + high_[a] * s0, apex_[a] + high_[a] * s1);
+  }
+  return padded(b);
 }
 
 TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params) {
@@ -139,6 +140,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
   f.normal.resize(n);
   f.viewpoint.resize(n);
   f.empty_scale.resize(n);
+  f.box.resize(n);
   for (std::size_t a = 0; a < input.meshes.size(); ++a) {
     const Mesh& m = input.meshes[a];
     const std::size_t base = f.index.offsets[a];
@@ -162,6 +164,9 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
         f.normal[g] = Vec3f(normal);
         f.viewpoint[g] = Vec3f(v);
         f.empty_scale[g] = static_cast<float>(empty_space_scale({p0, p1, p2}, v, h, params));
+        Box3d box;
+        for (const Vec3d& p : {p0, p1, p2}) box.extend(p);
+        f.box[g] = padded(box);
       }
     });
   }
