@@ -58,9 +58,12 @@ inline constexpr std::uint64_t kMinVarintsPerVertex = 4, kMinVarintsPerTriangle 
 inline std::uint64_t fixed_vertex_bytes(std::uint32_t flags) { return 4 + 12 + raw_vertex_bytes(flags); }
 inline constexpr std::uint64_t kFixedTriangleBytes = 12 + 8 + 4 + 4 + 1;
 
-inline std::uint32_t flags_of(const Mesh& m) {
-  return (m.intensities.empty() ? 0 : kHasIntensity) | (m.colors.empty() ? 0 : kHasColor);
+/// The block flags of the per-vertex attributes present.
+inline std::uint32_t attribute_flags(bool has_intensities, bool has_colors) {
+  return (has_intensities ? kHasIntensity : 0) | (has_colors ? kHasColor : 0);
 }
+
+inline std::uint32_t flags_of(const Mesh& m) { return attribute_flags(!m.intensities.empty(), !m.colors.empty()); }
 
 inline std::uint32_t float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
 

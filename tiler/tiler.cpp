@@ -34,9 +34,9 @@ struct AcquisitionVertices {
     colors.insert(colors.end(), c.colors.begin(), c.colors.end());
   }
 
-  /// The block flags of the attributes the acquisition has (tiler_detail::kHasIntensity, ...).
+  /// The block flags of the attributes the acquisition has.
   [[nodiscard]] std::uint32_t flags() const {
-    return (intensities.empty() ? 0 : tiler_detail::kHasIntensity) | (colors.empty() ? 0 : tiler_detail::kHasColor);
+    return tiler_detail::attribute_flags(!intensities.empty(), !colors.empty());
   }
 };
 
