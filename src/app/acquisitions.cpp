@@ -9,11 +9,24 @@
 
 namespace citymesh::app {
 
-std::vector<std::int32_t> LoadedAcquisitions::source_faces(std::size_t acquisition) const {
-  const Mesh& m = meshes[acquisition];
+std::vector<std::int32_t> source_faces(const Mesh& m) {
   std::vector<std::int32_t> faces(m.triangle_count());
   for (std::size_t t = 0; t < faces.size(); ++t) faces[t] = static_cast<std::int32_t>(m.triangle_ids[t].face);
   return faces;
+}
+
+Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin) {
+  MeshReadParams params;
+  params.ply = config.ply_read_params();
+  params.acquisition = a.index;
+  params.origin = origin;
+  MeshReadResult r = read_mesh(a.path, params);
+  if (r.stats.faces > std::uint64_t{INT32_MAX}) {
+    throw InputError(
+        fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", a.path.string(), r.stats.faces));
+  }
+  log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());
+  return std::move(r.mesh);
 }
 
 LoadedAcquisitions load_acquisitions(const Config& config) {
@@ -21,17 +34,8 @@ LoadedAcquisitions load_acquisitions(const Config& config) {
   out.acquisitions = config.acquisition_list();
   if (out.acquisitions.empty()) throw ConfigError(fmt::format("{}: no [[acquisition]]", config.file.string()));
   for (const Acquisition& a : out.acquisitions) {
-    MeshReadParams params;
-    params.ply = config.ply_read_params();
-    params.acquisition = a.index;
-    if (!out.meshes.empty()) params.origin = out.meshes.front().origin;
-    MeshReadResult r = read_mesh(a.path, params);
-    if (r.stats.faces > std::uint64_t{INT32_MAX}) {
-      throw InputError(
-          fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", a.path.string(), r.stats.faces));
-    }
-    log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());
-    out.meshes.push_back(std::move(r.mesh));
+    out.meshes.push_back(read_acquisition(config, a, out.meshes.empty() ? std::nullopt
+                                                                         : std::optional(out.meshes.front().origin)));
     out.dates.push_back(a.date);
   }
   return out;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "citymesh/config/config.h"
@@ -14,9 +15,14 @@ struct LoadedAcquisitions {
   std::vector<Acquisition> acquisitions;  ///< config order
   std::vector<Mesh> meshes;               ///< one per acquisition, all with the first one's origin
   std::vector<TimePoint> dates;
-  /// Per acquisition, per triangle: the face index in the file (the provenance id).
-  [[nodiscard]] std::vector<std::int32_t> source_faces(std::size_t acquisition) const;
 };
+
+/// Per triangle of an acquisition's mesh: the face index in the file (the provenance id).
+std::vector<std::int32_t> source_faces(const Mesh& acquisition);
+
+/// Reads acquisition `a` (with `origin`, the local frame every mesh of a run shares, when
+/// given). Throws InputError naming the file.
+Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin);
 
 /// How the summaries describe acquisition k: index, name, date, input file.
 nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k);

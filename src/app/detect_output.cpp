@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
@@ -31,35 +32,30 @@ std::string file_stem(const Config& config, std::size_t k) {
 }
 
 void write_labelled_ply(const std::filesystem::path& path, const Mesh& mesh, std::span<const std::int32_t> source_face,
-                        const ChangeResult& r, std::size_t begin) {
+                        const LabelView& labels) {
   const std::size_t n = mesh.triangle_count();
   std::vector<std::uint8_t> state(n);
   std::vector<double> first(n), last(n);
   for (std::size_t t = 0; t < n; ++t) {
-    state[t] = static_cast<std::uint8_t>(r.state[begin + t]);
-    first[t] = unix_seconds(r.first_seen[begin + t]);
-    last[t] = unix_seconds(r.last_seen[begin + t]);
+    state[t] = static_cast<std::uint8_t>(labels.state[t]);
+    first[t] = unix_seconds(labels.first_seen[t]);
+    last[t] = unix_seconds(labels.last_seen[t]);
   }
-  const auto slice = [&](const std::vector<std::uint8_t>& v) {
-    return std::span<const std::uint8_t>(v.data() + begin, n);
-  };
   write_mesh_ply(path, mesh,
                  {{kSourceFaceProperty, source_face},
                   {kStateProperty, std::span<const std::uint8_t>(state)},
                   {"first_seen", std::span<const double>(first)},
                   {"last_seen", std::span<const double>(last)},
-                  {"sustainable", slice(r.sustainable)},
-                  {kKeptProperty, slice(r.kept)},
-                  {"refutes", slice(r.refutes)}});
+                  {"sustainable", labels.sustainable},
+                  {kKeptProperty, labels.kept},
+                  {"refutes", labels.refutes}});
 }
 
-void write_picture(const std::filesystem::path& path, const Mesh& mesh, const ChangeResult& r, std::size_t begin,
-                   double pixel_size) {
+void write_picture(const std::filesystem::path& path, const Mesh& mesh, const LabelView& labels, double pixel_size) {
   RenderLayer layer{&mesh, {}};
   layer.face_colors.resize(mesh.triangle_count());
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const std::size_t g = begin + t;
-    layer.face_colors[t] = detect_color(r.state[g], r.kept[g] != 0, r.refutes[g] != 0);
+    layer.face_colors[t] = detect_color(labels.state[t], labels.kept[t] != 0, labels.refutes[t] != 0);
   }
   ViewParams view;
   view.pixel_size = pixel_size;
@@ -73,7 +69,19 @@ nlohmann::json counts_json(const StateCounts& c) {
 
 }  // namespace
 
-void write_detect_outputs(const Config& config, const LoadedAcquisitions& input, const ChangeResult& r,
+LabelView InMemoryDetectOutput::labels(std::size_t k) {
+  return label_view(result_, result_.index.offsets[k], result_.index.offsets[k + 1]);
+}
+
+std::uint64_t InMemoryDetectOutput::write_pairs(const std::filesystem::path& path) {
+  std::vector<std::uint32_t> flat;
+  flat.reserve(2 * result_.consistent_pairs.size());
+  for (const auto& [a, b] : result_.consistent_pairs) flat.insert(flat.end(), {a, b});
+  write_u32_records(path, kPairsMagic, flat);
+  return result_.consistent_pairs.size();
+}
+
+void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,
                           const DetectOutputParams& params) {
   Stopwatch clock;
   std::filesystem::create_directories(params.dir);
@@ -82,28 +90,34 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& input,
   summary["policy"] = unconfirmed_policy_name(config.change.unconfirmed);
   summary["empty_space"] = empty_space_reach_name(config.change.empty_space);
   summary["sustainability"] = format_duration(config.change.sustainability);
-  for (std::size_t k = 0; k < input.meshes.size(); ++k) {
-    const std::size_t begin = r.index.offsets[k];
+  StateCounts totals;
+  std::uint64_t triangles = 0;
+  for (std::size_t k = 0; k < described.acquisitions.size(); ++k) {
     const std::string stem = file_stem(config, k);
-    const std::vector<std::int32_t> faces = input.source_faces(k);
-    write_labelled_ply(params.dir / (stem + ".ply"), input.meshes[k], faces, r, begin);
-    if (params.pictures) write_picture(params.dir / (stem + ".png"), input.meshes[k], r, begin, params.pixel_size);
-    nlohmann::json entry = acquisition_json(config, input, k);
+    const Mesh& mesh = source.mesh(k);
+    const LabelView labels = source.labels(k);
+    if (labels.size() != mesh.triangle_count()) {
+      throw InputError(fmt::format("{}: {} triangles now, {} labelled (run with --force)",
+                                   described.acquisitions[k].path.string(), mesh.triangle_count(), labels.size()));
+    }
+    write_labelled_ply(params.dir / (stem + ".ply"), mesh, source_faces(mesh), labels);
+    if (params.pictures) write_picture(params.dir / (stem + ".png"), mesh, labels, params.pixel_size);
+    nlohmann::json entry = acquisition_json(config, described, k);
     entry["ply"] = stem + ".ply";
     entry["png"] = params.pictures ? stem + ".png" : "";
-    entry["triangles"] = input.meshes[k].triangle_count();
-    entry["counts"] = counts_json(count_states(r, begin, r.index.offsets[k + 1]));
+    entry["triangles"] = mesh.triangle_count();
+    const StateCounts counts = count_states(labels);
+    entry["counts"] = counts_json(counts);
+    totals += counts;
+    triangles += mesh.triangle_count();
     summary["acquisitions"].push_back(std::move(entry));
   }
-  std::vector<std::uint32_t> flat;
-  flat.reserve(2 * r.consistent_pairs.size());
-  for (const auto& [a, b] : r.consistent_pairs) flat.insert(flat.end(), {a, b});
-  write_u32_records(params.dir / kPairsFile, kPairsMagic, flat);
+  const std::uint64_t pairs = source.write_pairs(params.dir / kPairsFile);
   summary["pairs"] = kPairsFile;
-  const ChangeStats& s = r.stats;
-  summary["totals"] = counts_json(count_states(r, 0, r.index.size()));
-  summary["totals"]["triangles"] = s.triangles;
-  summary["consistent_pairs"] = s.consistent_pairs;
+  const ChangeStats s = source.stats();
+  summary["totals"] = counts_json(totals);
+  summary["totals"]["triangles"] = triangles;
+  summary["consistent_pairs"] = pairs;
   summary["prefilter"] = {{"enabled", config.change.prefilter}, {"voxel_size", config.change.voxel_size},
                           {"marked_voxels", s.marked_voxels},   {"candidates", s.conflict_candidates},
                           {"skipped", s.prefilter_skipped},     {"hit_rate", s.prefilter_hit_rate()},

@@ -26,10 +26,42 @@ struct DetectOutputParams {
   double read_seconds = 0;
 };
 
+/// What the change step's outputs are written from, one acquisition at a time: `citymesh
+/// detect` has every mesh and label in memory; a tiled run reads each acquisition again when
+/// its turn comes and keeps its labels compact (a city's inputs do not fit in memory together).
+class DetectOutputSource {
+ public:
+  virtual ~DetectOutputSource() = default;
+  /// Acquisition k's mesh (all in one local frame), valid until the next call.
+  virtual const Mesh& mesh(std::size_t k) = 0;
+  /// Acquisition k's labels, valid until the next call.
+  virtual LabelView labels(std::size_t k) = 0;
+  /// Writes the consistent pairs, sorted and unique, to `path` (kPairsMagic records);
+  /// returns how many.
+  virtual std::uint64_t write_pairs(const std::filesystem::path& path) = 0;
+  /// The change step's statistics (pre-filter, seconds); the pair count comes from write_pairs.
+  [[nodiscard]] virtual ChangeStats stats() const = 0;
+};
+
 /// Writes <dir>/<k>_<name>.ply and .png per acquisition, <dir>/pairs.bin and
-/// <dir>/summary.json (last), each atomically.
-void write_detect_outputs(const Config& config, const LoadedAcquisitions& input, const ChangeResult& result,
+/// <dir>/summary.json (last), each atomically. `described`: the acquisitions and dates (its
+/// meshes are not used).
+void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,
                           const DetectOutputParams& params);
+
+/// `citymesh detect`'s source: the meshes and the result it has in memory.
+class InMemoryDetectOutput final : public DetectOutputSource {
+ public:
+  InMemoryDetectOutput(const LoadedAcquisitions& input, const ChangeResult& result) : input_(input), result_(result) {}
+  const Mesh& mesh(std::size_t k) override { return input_.meshes[k]; }
+  LabelView labels(std::size_t k) override;
+  std::uint64_t write_pairs(const std::filesystem::path& path) override;
+  [[nodiscard]] ChangeStats stats() const override { return result_.stats; }
+
+ private:
+  const LoadedAcquisitions& input_;
+  const ChangeResult& result_;
+};
 
 /// The picture colours, as in the paper's figures.
 Rgb8 detect_color(TriangleState state, bool kept, bool refutes);

@@ -46,7 +46,8 @@ DetectStep run_detect_step(const Config& config, const PictureOptions& pictures)
   step.result = detect_changes({step.input.meshes, step.input.dates}, config.change);
   step.detect_seconds = clock.restart();
   const std::filesystem::path dir = config.project.output / "detect";
-  write_detect_outputs(config, step.input, step.result,
+  InMemoryDetectOutput source(step.input, step.result);
+  write_detect_outputs(config, step.input, source,
                        {.dir = dir,
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,

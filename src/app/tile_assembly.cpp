@@ -11,22 +11,34 @@
 
 namespace citymesh::app {
 
-TileAssembly::TileAssembly(const TileStore& store, bool labels) : store_(store), labels_(labels) {
+namespace {
+
+constexpr std::uint8_t kKeptBit = 1u << 2, kSustainableBit = 1u << 3, kRefutesBit = 1u << 4, kStateMask = 3u;
+
+}  // namespace
+
+TileAssembly::TileAssembly(const TileStore& store, std::optional<std::filesystem::path> pairs_dir) : store_(store) {
   index_.offsets.assign(1, 0);
   for (const std::uint64_t n : store.triangles) index_.offsets.push_back(index_.offsets.back() + n);
   if (index_.size() > UINT32_MAX) {
     throw ProcessingError(fmt::format("{} triangles in all: global ids are 32-bit", index_.size()));
   }
-  if (!labels_) return;
-  ChangeResult& c = change_.emplace();
-  c.index = index_;
+  if (!pairs_dir) return;
+  labels_ = true;
   const std::size_t n = index_.size();
-  c.state.assign(n, TriangleState::single);
-  c.first_seen.assign(n, TimePoint{});
-  c.last_seen.assign(n, TimePoint{});
-  c.sustainable.assign(n, 0);
-  c.kept.assign(n, 0);
-  c.refutes.assign(n, 0);
+  flags_.assign(n, static_cast<std::uint8_t>(TriangleState::single));
+  first_.assign(n, 0);
+  last_.assign(n, 0);
+  pairs_.emplace(*pairs_dir);
+}
+
+std::uint16_t TileAssembly::date_index(std::int64_t ms) {
+  // A handful of dates (the acquisitions'): a scan beats a map.
+  const auto it = std::find(dates_ms_.begin(), dates_ms_.end(), ms);
+  if (it != dates_ms_.end()) return static_cast<std::uint16_t>(it - dates_ms_.begin());
+  if (dates_ms_.size() > UINT16_MAX) throw ProcessingError("tile assembly: more than 65536 distinct label dates");
+  dates_ms_.push_back(ms);
+  return static_cast<std::uint16_t>(dates_ms_.size() - 1);
 }
 
 void TileAssembly::add(TileResult result) {
@@ -44,19 +56,19 @@ void TileAssembly::add(TileResult result) {
     seen_through_ += (l.notes & kNoteSeenThrough) != 0 ? 1 : 0;
     filled_ += (l.notes & kNoteFilled) != 0 ? 1 : 0;
     fill_left_out_ += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
-    if (!change_) continue;
-    ChangeResult& c = *change_;
-    c.state[g] = l.state;
-    c.kept[g] = l.kept;
-    c.sustainable[g] = l.sustainable;
-    c.refutes[g] = l.refutes;
-    c.first_seen[g] = TimePoint(Duration(l.first_ms));
-    c.last_seen[g] = TimePoint(Duration(l.last_ms));
+    if (!labels_) continue;
+    flags_[g] = static_cast<std::uint8_t>(static_cast<std::uint8_t>(l.state) | (l.kept != 0 ? kKeptBit : 0) |
+                                          (l.sustainable != 0 ? kSustainableBit : 0) | (l.refutes != 0 ? kRefutesBit : 0));
+    first_[g] = date_index(l.first_ms);
+    last_[g] = date_index(l.last_ms);
   }
-  if (change_) {
+  if (labels_) {
+    std::vector<TrianglePair> pairs;
+    pairs.reserve(result.pairs.size());
     for (const LabelPair& p : result.pairs) {
-      change_->consistent_pairs.emplace_back(global(p.a_acquisition, p.a_index), global(p.b_acquisition, p.b_index));
+      pairs.emplace_back(global(p.a_acquisition, p.a_index), global(p.b_acquisition, p.b_index));
     }
+    pairs_->add(pairs);
   }
   for (TilePiece& p : result.selected) {
     if (p.triangle_count() > 0) pieces_.push_back(std::move(p));
@@ -138,18 +150,42 @@ MergedMesh TileAssembly::take_merged() {
   return out;
 }
 
-ChangeResult TileAssembly::change() const {
-  if (!change_) throw ProcessingError("tile assembly: labels were not gathered");
+void TileAssembly::check_labelled() const {
+  if (!labels_) throw ProcessingError("tile assembly: labels were not gathered");
   if (owned_ != index_.size()) {
     throw ProcessingError(fmt::format("tile assembly: {} triangles owned by the tiles, the input has {}", owned_,
                                       index_.size()));
   }
-  ChangeResult c = *change_;
-  std::sort(c.consistent_pairs.begin(), c.consistent_pairs.end());
-  c.consistent_pairs.erase(std::unique(c.consistent_pairs.begin(), c.consistent_pairs.end()), c.consistent_pairs.end());
-  c.stats.triangles = index_.size();
-  c.stats.consistent_pairs = c.consistent_pairs.size();
+}
+
+ChangeResult TileAssembly::labels(std::size_t k) const {
+  check_labelled();
+  const std::size_t begin = index_.offsets[k], n = index_.offsets[k + 1] - begin;
+  ChangeResult c;
+  c.index.offsets = {0, n};
+  c.state.resize(n);
+  c.first_seen.resize(n);
+  c.last_seen.resize(n);
+  c.sustainable.resize(n);
+  c.kept.resize(n);
+  c.refutes.resize(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    const std::uint8_t f = flags_[begin + t];
+    c.state[t] = static_cast<TriangleState>(f & kStateMask);
+    c.kept[t] = (f & kKeptBit) != 0 ? 1 : 0;
+    c.sustainable[t] = (f & kSustainableBit) != 0 ? 1 : 0;
+    c.refutes[t] = (f & kRefutesBit) != 0 ? 1 : 0;
+    // A triangle no tile labelled keeps the default (check_labelled() rules that out).
+    c.first_seen[t] = dates_ms_.empty() ? TimePoint{} : TimePoint(Duration(dates_ms_[first_[begin + t]]));
+    c.last_seen[t] = dates_ms_.empty() ? TimePoint{} : TimePoint(Duration(dates_ms_[last_[begin + t]]));
+  }
+  c.stats.triangles = n;
   return c;
+}
+
+std::uint64_t TileAssembly::write_pairs(const std::filesystem::path& path, std::string_view magic) const {
+  check_labelled();
+  return pairs_->write_sorted(path, magic);
 }
 
 }  // namespace citymesh::app

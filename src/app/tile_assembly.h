@@ -3,19 +3,23 @@
 // triangles, and (when asked) the change step's labels of every input triangle.
 #pragma once
 
+#include <filesystem>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include "citymesh/change/detect.h"
 #include "citymesh/mosaic/merged_mesh.h"
+#include "pair_spill.h"
 #include "tile_job.h"
 
 namespace citymesh::app {
 
 class TileAssembly {
  public:
-  /// `labels`: also gather the per-triangle labels and consistent pairs of every acquisition.
-  TileAssembly(const TileStore& store, bool labels);
+  /// With a `pairs_dir`, also gathers every input triangle's labels (5 bytes each) and the
+  /// consistent pairs (spilled to files in that folder, which is removed with the assembly).
+  TileAssembly(const TileStore& store, std::optional<std::filesystem::path> pairs_dir);
 
   /// Takes one tile's result (any order: the output does not depend on it).
   void add(TileResult result);
@@ -25,9 +29,14 @@ class TileAssembly {
   /// are freed once merged (the seam pass then has their memory), so it is called once.
   [[nodiscard]] MergedMesh take_merged();
 
-  /// The labels as the change step gives them for the whole input (consistent pairs sorted,
-  /// unique; statistics: triangle and pair counts). Only with `labels`.
-  [[nodiscard]] ChangeResult change() const;
+  /// Acquisition k's labels as the change step gives them (the result's index holds that
+  /// acquisition only; no pairs). Only with labels; throws ProcessingError when the tiles did
+  /// not label every input triangle.
+  [[nodiscard]] ChangeResult labels(std::size_t k) const;
+
+  /// Writes the consistent pairs, sorted and unique, as `magic` records to `path`; returns
+  /// how many. Only with labels.
+  std::uint64_t write_pairs(const std::filesystem::path& path, std::string_view magic) const;
 
   [[nodiscard]] std::uint64_t owned() const { return owned_; }
   [[nodiscard]] std::uint64_t candidates() const { return candidates_; }
@@ -38,11 +47,20 @@ class TileAssembly {
   [[nodiscard]] std::uint64_t fill_left_out() const { return fill_left_out_; }
 
  private:
+  /// The index of a label's first_seen or last_seen among the dates met so far.
+  std::uint16_t date_index(std::int64_t ms);
+  void check_labelled() const;
+
   const TileStore& store_;
-  bool labels_;
   GlobalTriangles index_;
   std::vector<TilePiece> pieces_;
-  std::optional<ChangeResult> change_;
+  // Labels, per global triangle: state | kept << 2 | sustainable << 3 | refutes << 4, and
+  // first_seen and last_seen as indices into dates_ms_ (a city's labels in 140 MB, not 560).
+  bool labels_ = false;
+  std::vector<std::uint8_t> flags_;
+  std::vector<std::uint16_t> first_, last_;
+  std::vector<std::int64_t> dates_ms_;
+  std::optional<PairSpill> pairs_;
   std::uint64_t owned_ = 0, candidates_ = 0, seen_through_ = 0, filled_ = 0, fill_left_out_ = 0;
 };
 

@@ -34,24 +34,46 @@ LoadedAcquisitions describe_acquisitions(const Config& config) {
   return d;
 }
 
-/// The change step's outputs from the tiles' labels; the acquisitions are read again, one
-/// PLY each, to carry the labels.
-void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {
-  Stopwatch clock;
-  LoadedAcquisitions input = load_acquisitions(config);
-  const ChangeResult change = assembly.change();
-  for (std::size_t k = 0; k < input.meshes.size(); ++k) {
-    if (input.meshes[k].triangle_count() != change.index.offsets[k + 1] - change.index.offsets[k]) {
-      throw InputError(fmt::format("{}: {} triangles now, {} when it was tiled (run with --force)",
-                                   input.acquisitions[k].path.string(), input.meshes[k].triangle_count(),
-                                   change.index.offsets[k + 1] - change.index.offsets[k]));
-    }
+/// The change step's outputs from the tiles' labels, one acquisition at a time: its file is
+/// read again, its labels expanded from the assembly's compact ones, both dropped before the
+/// next (a city's inputs and labels together are several times the budget).
+class TiledDetectOutput final : public DetectOutputSource {
+ public:
+  TiledDetectOutput(const Config& config, const LoadedAcquisitions& described, const TileAssembly& assembly)
+      : config_(config), described_(described), assembly_(assembly) {}
+
+  const Mesh& mesh(std::size_t k) override {
+    mesh_ = Mesh{};  // the previous acquisition's memory goes first
+    mesh_ = read_acquisition(config_, described_.acquisitions[k], origin_);
+    if (!origin_) origin_ = mesh_.origin;  // every mesh in the first one's frame, as `detect` reads them
+    return mesh_;
   }
-  write_detect_outputs(config, input, change,
-                       {.dir = config.project.output / "detect",
-                        .pixel_size = pictures.pixel_size,
-                        .pictures = pictures.pictures,
-                        .read_seconds = clock.seconds()});
+  LabelView labels(std::size_t k) override {
+    labels_ = ChangeResult{};
+    labels_ = assembly_.labels(k);
+    return label_view(labels_, 0, labels_.state.size());
+  }
+  std::uint64_t write_pairs(const std::filesystem::path& path) override {
+    mesh_ = Mesh{};
+    labels_ = ChangeResult{};
+    return assembly_.write_pairs(path, kPairsMagic);
+  }
+  [[nodiscard]] ChangeStats stats() const override { return {}; }
+
+ private:
+  const Config& config_;
+  const LoadedAcquisitions& described_;
+  const TileAssembly& assembly_;
+  std::optional<Vec3d> origin_;
+  Mesh mesh_;
+  ChangeResult labels_;
+};
+
+void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {
+  const LoadedAcquisitions described = describe_acquisitions(config);
+  TiledDetectOutput source(config, described, assembly);
+  write_detect_outputs(config, described, source,
+                       {.dir = config.project.output / "detect", .pixel_size = pictures.pixel_size, .pictures = pictures.pictures});
 }
 
 
@@ -84,7 +106,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     log::debug("final pass: {} done, resident {} MiB (peak {} MiB)", stage, resident_bytes() >> 20,
                peak_resident_bytes() >> 20);
   };
-  TileAssembly assembly(store, config.output.labels);
+  // The pairs wait on disk (a city has 0.7 GB of them), in a folder of this process's own.
+  TileAssembly assembly(store, config.output.labels ? std::optional(config.project.work / ("pairs." + process_tag()))
+                                                    : std::nullopt);
   std::vector<nlohmann::json> per_tile;
   // Results are read (and checked) a few at a time in parallel, then added in tile order; a
   // read result is several times the piece the assembly keeps of it, so not all at once.

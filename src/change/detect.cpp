@@ -73,15 +73,34 @@ void compute_time_series(const TriangleFrames& f, const PartnerBits& partners, c
 
 }  // namespace
 
-StateCounts count_states(const ChangeResult& r, std::size_t begin, std::size_t end) {
+LabelView label_view(const ChangeResult& r, std::size_t begin, std::size_t end) {
+  const std::size_t n = end - begin;
+  return {std::span(r.state).subspan(begin, n),       std::span(r.first_seen).subspan(begin, n),
+          std::span(r.last_seen).subspan(begin, n),   std::span(r.sustainable).subspan(begin, n),
+          std::span(r.kept).subspan(begin, n),        std::span(r.refutes).subspan(begin, n)};
+}
+
+StateCounts& StateCounts::operator+=(const StateCounts& o) {
+  for (std::size_t s = 0; s < state.size(); ++s) state[s] += o.state[s];
+  kept += o.kept;
+  sustainable += o.sustainable;
+  refutes += o.refutes;
+  return *this;
+}
+
+StateCounts count_states(const LabelView& labels) {
   StateCounts c;
-  for (std::size_t g = begin; g < end; ++g) {
-    ++c.state[static_cast<std::size_t>(r.state[g])];
-    c.kept += r.kept[g];
-    c.sustainable += r.sustainable[g];
-    c.refutes += r.refutes[g];
+  for (std::size_t t = 0; t < labels.size(); ++t) {
+    ++c.state[static_cast<std::size_t>(labels.state[t])];
+    c.kept += labels.kept[t];
+    c.sustainable += labels.sustainable[t];
+    c.refutes += labels.refutes[t];
   }
   return c;
+}
+
+StateCounts count_states(const ChangeResult& r, std::size_t begin, std::size_t end) {
+  return count_states(label_view(r, begin, end));
 }
 
 ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params) {

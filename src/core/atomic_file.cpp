@@ -57,6 +57,12 @@ void AtomicFile::write(const void* data, std::size_t size) {
   if (size != 0 && std::fwrite(data, 1, size, file_) != size) fail(temp_path_, "write");
 }
 
+void AtomicFile::write_at(std::uint64_t offset, const void* data, std::size_t size) {
+  if (std::fseek(file_, static_cast<long>(offset), SEEK_SET) != 0) fail(temp_path_, "seek");
+  write(data, size);
+  if (std::fseek(file_, 0, SEEK_END) != 0) fail(temp_path_, "seek");
+}
+
 void AtomicFile::commit() {
   if (std::fflush(file_) != 0) fail(temp_path_, "flush");
   if (::fsync(::fileno(file_)) != 0) fail(temp_path_, "fsync");

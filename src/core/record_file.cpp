@@ -20,13 +20,29 @@ constexpr std::size_t kFrame = kMagicSize + 2 * sizeof(std::uint64_t);  // magic
 }  // namespace
 
 void write_u32_records(const std::filesystem::path& path, std::string_view magic, std::span<const std::uint32_t> values) {
-  AtomicFile file(path);
-  const std::uint64_t count = values.size(), sum = fnv1a(values.data(), values.size_bytes());
-  file.write(magic.data(), kMagicSize);
-  file.write(&count, sizeof count);
-  file.write(values.data(), values.size_bytes());
-  file.write(&sum, sizeof sum);
+  U32RecordWriter file(path, magic);
+  file.add(values);
   file.commit();
+}
+
+U32RecordWriter::U32RecordWriter(const std::filesystem::path& path, std::string_view magic)
+    : file_(std::make_unique<AtomicFile>(path)), sum_(fnv1a(nullptr, 0)) {
+  file_->write(magic.data(), kMagicSize);
+  file_->write(&count_, sizeof count_);  // filled in by commit()
+}
+
+U32RecordWriter::~U32RecordWriter() = default;
+
+void U32RecordWriter::add(std::span<const std::uint32_t> values) {
+  file_->write(values.data(), values.size_bytes());
+  sum_ = fnv1a(values.data(), values.size_bytes(), sum_);
+  count_ += values.size();
+}
+
+void U32RecordWriter::commit() {
+  file_->write(&sum_, sizeof sum_);
+  file_->write_at(kMagicSize, &count_, sizeof count_);
+  file_->commit();
 }
 
 std::vector<std::uint32_t> read_u32_records(const std::filesystem::path& path, std::string_view magic,

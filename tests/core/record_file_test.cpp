@@ -44,5 +44,26 @@ TEST(RecordFile, RoundTripsAndRejectsDamagedFiles) {
   expect_input_error(dir / "huge.bin", "count");
 }
 
+TEST(RecordFile, WrittenInPartsEqualsWrittenWholeAndNothingBeforeCommit) {
+  test::TempDir dir;
+  const std::vector<std::uint32_t> values{7, 0, 0xFFFFFFFFu, 12, 99, 3, 5};
+  write_u32_records(dir / "whole.bin", "CMTEST01", values);
+  {
+    U32RecordWriter parts(dir / "parts.bin", "CMTEST01");
+    parts.add(std::span(values).first(2));
+    parts.add({});
+    parts.add(std::span(values).subspan(2));
+    EXPECT_EQ(parts.count(), values.size());
+    parts.commit();
+  }
+  EXPECT_EQ(test::read_text(dir / "parts.bin"), test::read_text(dir / "whole.bin"));
+  {
+    U32RecordWriter abandoned(dir / "abandoned.bin", "CMTEST01");
+    abandoned.add(values);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "abandoned.bin"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), std::filesystem::directory_iterator{}), 2);
+}
+
 }  // namespace
 }  // namespace citymesh

@@ -66,11 +66,26 @@ struct ChangeResult {
   ChangeStats stats;
 };
 
-/// Triangles per state, kept, sustainable and refuting, over global triangles [begin, end).
+/// The labels of a run of triangles (one acquisition's, usually): views into a ChangeResult,
+/// or into labels a tiled run expands one acquisition at a time.
+struct LabelView {
+  std::span<const TriangleState> state;
+  std::span<const TimePoint> first_seen, last_seen;
+  std::span<const std::uint8_t> sustainable, kept, refutes;
+  [[nodiscard]] std::size_t size() const { return state.size(); }
+};
+
+/// The labels of global triangles [begin, end) of `result`.
+LabelView label_view(const ChangeResult& result, std::size_t begin, std::size_t end);
+
+/// Triangles per state, kept, sustainable and refuting.
 struct StateCounts {
   std::array<std::uint64_t, 3> state{};  ///< indexed by TriangleState
   std::uint64_t kept = 0, sustainable = 0, refutes = 0;
+  StateCounts& operator+=(const StateCounts& o);
 };
+StateCounts count_states(const LabelView& labels);
+/// Over global triangles [begin, end).
 StateCounts count_states(const ChangeResult& result, std::size_t begin, std::size_t end);
 
 /// Runs consistency, conflicts and the time series. Same input and params give the same

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <string>
@@ -23,6 +24,9 @@ class AtomicFile {
 
   void write(const void* data, std::size_t size);
   void write(std::string_view text) { write(text.data(), text.size()); }
+  /// Overwrites bytes already written at `offset` (a header whose values are known last),
+  /// then goes on writing at the end.
+  void write_at(std::uint64_t offset, const void* data, std::size_t size);
   /// Flushes, fsyncs, renames onto the final path and fsyncs the folder.
   void commit();
 

@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// The consistent pairs of a tiled run, on disk until they are written: a city has ~90 M of
+// them (0.7 GB), more than the final pass can hold next to the output mesh.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <span>
+#include <string_view>
+
+#include "citymesh/change/detect.h"
+
+namespace citymesh::app {
+
+/// Pairs appended in any order to files by range of their first triangle; written out sorted
+/// and unique, one range at a time, so that memory holds one range's pairs at most.
+class PairSpill {
+ public:
+  /// Pairs whose first triangle lies in [r * range, (r + 1) * range) share a file.
+  static constexpr std::uint32_t kDefaultRange = 1u << 22;
+
+  /// Creates `dir` (emptied first); it is removed with the spill.
+  explicit PairSpill(std::filesystem::path dir, std::uint32_t range = kDefaultRange);
+  ~PairSpill();
+  PairSpill(const PairSpill&) = delete;
+  PairSpill& operator=(const PairSpill&) = delete;
+
+  /// Appends pairs (any order, repeats allowed). Throws OutputError naming the file.
+  void add(std::span<const TrianglePair> pairs);
+
+  /// Writes every pair added, sorted and without repeats, as `magic` records (a0 b0 a1 b1
+  /// ...) to `path` atomically; returns how many pairs. Throws InputError when a spill file
+  /// was damaged, OutputError when `path` cannot be written.
+  std::uint64_t write_sorted(const std::filesystem::path& path, std::string_view magic) const;
+
+ private:
+  [[nodiscard]] std::filesystem::path file(std::uint32_t range_index) const;
+
+  std::filesystem::path dir_;
+  std::uint32_t range_;
+  std::uint32_t ranges_ = 0;  ///< 1 + the largest range index written
+};
+
+}  // namespace citymesh::app

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: MIT
+// The tiled run's labels: the consistent pairs spilled to disk come back sorted and unique,
+// and the assembly's compact labels expand to exactly what the tiles handed in.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/record_file.h"
+#include "detect_output.h"
+#include "pair_spill.h"
+#include "test_support.h"
+#include "tile_assembly.h"
+
+namespace citymesh::app {
+namespace {
+
+std::vector<std::uint32_t> flat(const std::set<TrianglePair>& pairs) {
+  std::vector<std::uint32_t> v;
+  for (const auto& [a, b] : pairs) v.insert(v.end(), {a, b});
+  return v;
+}
+
+TEST(PairSpill, WritesEveryPairOnceInOrderWhateverTheOrderAdded) {
+  test::TempDir tmp;
+  std::minstd_rand rng(7);
+  std::set<TrianglePair> expected;
+  {
+    // A small range: pairs land in dozens of files, each appended to many times.
+    PairSpill spill(tmp / "spill", 1000);
+    for (int batch = 0; batch < 40; ++batch) {
+      std::vector<TrianglePair> pairs;
+      for (int k = 0; k < 500; ++k) {
+        const auto a = static_cast<std::uint32_t>(rng() % 50000), b = a + 1 + static_cast<std::uint32_t>(rng() % 100);
+        pairs.emplace_back(a, b);
+        if (k % 7 == 0) pairs.emplace_back(a, b);  // repeats, as neighbouring tiles give
+        expected.emplace(a, b);
+      }
+      std::shuffle(pairs.begin(), pairs.end(), rng);
+      spill.add(pairs);
+    }
+    EXPECT_EQ(spill.write_sorted(tmp / "pairs.bin", kPairsMagic), expected.size());
+    EXPECT_TRUE(std::filesystem::exists(tmp / "spill"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(tmp / "spill")) << "the spill folder outlived the spill";
+  EXPECT_EQ(read_u32_records(tmp / "pairs.bin", kPairsMagic, "pairs"), flat(expected));
+  // The same file as written in one piece.
+  write_u32_records(tmp / "whole.bin", kPairsMagic, flat(expected));
+  EXPECT_EQ(test::read_text(tmp / "pairs.bin"), test::read_text(tmp / "whole.bin"));
+}
+
+TEST(PairSpill, NoPairsGiveAnEmptyListAndADamagedSpillAnError) {
+  test::TempDir tmp;
+  PairSpill empty(tmp / "empty");
+  EXPECT_EQ(empty.write_sorted(tmp / "none.bin", kPairsMagic), 0u);
+  EXPECT_TRUE(read_u32_records(tmp / "none.bin", kPairsMagic, "pairs").empty());
+
+  PairSpill spill(tmp / "spill", 10);
+  spill.add(std::vector<TrianglePair>{{3, 4}, {25, 30}});
+  std::filesystem::resize_file(tmp / "spill/2.pairs", 5);  // torn: not whole pairs
+  EXPECT_THROW((void)spill.write_sorted(tmp / "bad.bin", kPairsMagic), InputError);
+  EXPECT_FALSE(std::filesystem::exists(tmp / "bad.bin"));
+}
+
+/// One tile's labels for triangles [begin, end) of each acquisition, random values over a few
+/// dates, and random pairs among them.
+TileResult tile_of(std::uint32_t begin, std::uint32_t end, std::minstd_rand& rng) {
+  TileResult r;
+  r.key = {static_cast<std::int32_t>(begin), 0};
+  const std::int64_t dates[] = {1767607200000, 1770199200000, 1770544800000};
+  for (std::uint32_t a = 0; a < 2; ++a) {
+    for (std::uint32_t t = begin; t < end; ++t) {
+      OwnedLabel l{.acquisition = a, .index = t, .state = static_cast<TriangleState>(rng() % 3),
+                   .kept = static_cast<std::uint8_t>(rng() % 2), .sustainable = static_cast<std::uint8_t>(rng() % 2),
+                   .refutes = static_cast<std::uint8_t>(rng() % 2)};
+      l.first_ms = dates[rng() % 3];
+      l.last_ms = dates[rng() % 3];
+      r.labels.push_back(l);
+      r.pairs.push_back({0, t, 1, begin + static_cast<std::uint32_t>(rng() % (end - begin))});
+    }
+  }
+  return r;
+}
+
+TEST(TileAssembly, CompactLabelsExpandToWhatTheTilesGave) {
+  test::TempDir tmp;
+  TileStore store;
+  store.triangles = {300, 300};
+  std::minstd_rand rng(11);
+  std::vector<TileResult> tiles{tile_of(0, 120, rng), tile_of(120, 250, rng), tile_of(250, 300, rng)};
+  std::set<TrianglePair> pairs;
+  for (const TileResult& r : tiles) {
+    for (const LabelPair& p : r.pairs) pairs.emplace(p.a_acquisition * 300 + p.a_index, p.b_acquisition * 300 + p.b_index);
+  }
+  TileAssembly assembly(store, tmp / "pairs");
+  for (const std::size_t k : {2, 0, 1}) assembly.add(tiles[k]);  // any order
+  for (std::uint32_t a = 0; a < 2; ++a) {
+    const ChangeResult c = assembly.labels(a);
+    ASSERT_EQ(c.state.size(), 300u);
+    for (const TileResult& r : tiles) {
+      for (const OwnedLabel& l : r.labels) {
+        if (l.acquisition != a) continue;
+        EXPECT_EQ(c.state[l.index], l.state);
+        EXPECT_EQ(c.kept[l.index], l.kept);
+        EXPECT_EQ(c.sustainable[l.index], l.sustainable);
+        EXPECT_EQ(c.refutes[l.index], l.refutes);
+        EXPECT_EQ(c.first_seen[l.index].time_since_epoch().count(), l.first_ms);
+        EXPECT_EQ(c.last_seen[l.index].time_since_epoch().count(), l.last_ms);
+      }
+    }
+  }
+  EXPECT_EQ(assembly.write_pairs(tmp / "pairs.bin", kPairsMagic), pairs.size());
+  EXPECT_EQ(read_u32_records(tmp / "pairs.bin", kPairsMagic, "pairs"), flat(pairs));
+}
+
+TEST(TileAssembly, RefusesLabelsWhenATileIsMissing) {
+  test::TempDir tmp;
+  TileStore store;
+  store.triangles = {300, 300};
+  std::minstd_rand rng(3);
+  TileAssembly assembly(store, tmp / "pairs");
+  assembly.add(tile_of(0, 120, rng));
+  EXPECT_THROW((void)assembly.labels(0), ProcessingError);
+  TileAssembly without(store, std::nullopt);
+  EXPECT_THROW((void)without.labels(0), ProcessingError);
+}
+
+}  // namespace
+}  // namespace citymesh::app
