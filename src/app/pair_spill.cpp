@@ -32,15 +32,14 @@ std::filesystem::path PairSpill::file(std::uint32_t range_index) const {
   return dir_ / fmt::format("{}.pairs", range_index);
 }
 
-void PairSpill::add(std::span<const TrianglePair> pairs) {
-  if (pairs.empty()) return;
-  // Grouped by range (stable), then one append per file.
-  std::vector<TrianglePair> grouped(pairs.begin(), pairs.end());
-  std::stable_sort(grouped.begin(), grouped.end(),
-                   [&](const TrianglePair& x, const TrianglePair& y) { return x.first / range_ < y.first / range_; });
-  for (auto begin = grouped.begin(); begin != grouped.end();) {
+void PairSpill::add(std::vector<TrianglePair> pairs) {
+  // Grouped by range, then one append per file. A tile's pairs come sorted by their first
+  // triangle, hence grouped already: checked in one pass, sorted (stably) only if not.
+  const auto by_range = [&](const TrianglePair& x, const TrianglePair& y) { return x.first / range_ < y.first / range_; };
+  if (!std::is_sorted(pairs.begin(), pairs.end(), by_range)) std::stable_sort(pairs.begin(), pairs.end(), by_range);
+  for (auto begin = pairs.begin(); begin != pairs.end();) {
     const std::uint32_t r = begin->first / range_;
-    const auto end = std::find_if(begin, grouped.end(), [&](const TrianglePair& p) { return p.first / range_ != r; });
+    const auto end = std::find_if(begin, pairs.end(), [&](const TrianglePair& p) { return p.first / range_ != r; });
     const std::filesystem::path spilled = file(r);
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(spilled.c_str(), "ab"), &std::fclose);
     const auto count = static_cast<std::size_t>(end - begin);

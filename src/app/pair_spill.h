@@ -5,7 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <span>
+#include <vector>
 #include <string_view>
 
 #include "citymesh/change/detect.h"
@@ -25,8 +25,9 @@ class PairSpill {
   PairSpill(const PairSpill&) = delete;
   PairSpill& operator=(const PairSpill&) = delete;
 
-  /// Appends pairs (any order, repeats allowed). Throws OutputError naming the file.
-  void add(std::span<const TrianglePair> pairs);
+  /// Appends pairs (any order, repeats allowed; taken by value: grouped in place). Throws
+  /// OutputError naming the file.
+  void add(std::vector<TrianglePair> pairs);
 
   /// Writes every pair added, sorted and without repeats, as `magic` records (a0 b0 a1 b1
   /// ...) to `path` atomically; returns how many pairs. Throws InputError when a spill file

@@ -68,7 +68,7 @@ void TileAssembly::add(TileResult result) {
     for (const LabelPair& p : result.pairs) {
       pairs.emplace_back(global(p.a_acquisition, p.a_index), global(p.b_acquisition, p.b_index));
     }
-    pairs_->add(pairs);
+    pairs_->add(std::move(pairs));
   }
   for (TilePiece& p : result.selected) {
     if (p.triangle_count() > 0) pieces_.push_back(std::move(p));
@@ -175,9 +175,9 @@ ChangeResult TileAssembly::labels(std::size_t k) const {
     c.kept[t] = (f & kKeptBit) != 0 ? 1 : 0;
     c.sustainable[t] = (f & kSustainableBit) != 0 ? 1 : 0;
     c.refutes[t] = (f & kRefutesBit) != 0 ? 1 : 0;
-    // A triangle no tile labelled keeps the default (check_labelled() rules that out).
-    c.first_seen[t] = dates_ms_.empty() ? TimePoint{} : TimePoint(Duration(dates_ms_[first_[begin + t]]));
-    c.last_seen[t] = dates_ms_.empty() ? TimePoint{} : TimePoint(Duration(dates_ms_[last_[begin + t]]));
+    // check_labelled(): every triangle was labelled, so dates_ms_ holds its dates.
+    c.first_seen[t] = TimePoint(Duration(dates_ms_[first_[begin + t]]));
+    c.last_seen[t] = TimePoint(Duration(dates_ms_[last_[begin + t]]));
   }
   c.stats.triangles = n;
   return c;
