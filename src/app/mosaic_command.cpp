@@ -6,6 +6,7 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "command.h"
+#include "leftovers.h"
 #include "mosaic_step.h"
 #include "pipeline.h"
 
@@ -31,6 +32,7 @@ class MosaicCommand final : public Command {
     const Config config = options_.load();
     const ThreadLimit limit(options_.threads.value_or(config.run.threads));
     Stopwatch clock;
+    remove_leftovers_of_ended_runs(config);
     const LoadedAcquisitions input = load_acquisitions(config);
     const ChangeResult change = read_detect_result(config.project.output / "detect", input);
     run_mosaic_step(config, input, change, options_.pictures(), {{"read", clock.seconds()}});

@@ -8,6 +8,7 @@
 
 #include "citymesh/core/stopwatch.h"
 #include "detect_output.h"
+#include "leftovers.h"
 
 namespace citymesh::app {
 
@@ -41,6 +42,7 @@ Config PipelineOptions::load() const { return load_config(config, {.overrides = 
 DetectStep run_detect_step(const Config& config, const PictureOptions& pictures) {
   DetectStep step;
   Stopwatch clock;
+  remove_leftovers_of_ended_runs(config);
   step.input = load_acquisitions(config);
   step.read_seconds = clock.restart();
   step.result = detect_changes({step.input.meshes, step.input.dates}, config.change);

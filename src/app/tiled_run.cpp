@@ -15,6 +15,7 @@
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "detect_output.h"
+#include "leftovers.h"
 #include "mosaic_output.h"
 #include "mosaic_step.h"
 #include "run_state.h"
@@ -214,7 +215,10 @@ void run_subset(const Config& config, const TileStore& store, std::uint64_t fing
 void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cluster) {
   Stopwatch clock;
   const auto keys = result_keys(config);
-  if (cluster.root()) check_run_config(config.project.work, keys, options.force);
+  if (cluster.root()) {
+    check_run_config(config.project.work, keys, options.force);
+    remove_leftovers_of_ended_runs(config);
+  }
   const std::uint64_t result_fingerprint = fingerprint(keys, false);
   const TileStore store = prepare_tile_store(config, fingerprint(keys, true), cluster, options.subset);
   // Each stage's arrays differ from the last one's: the memory one freed goes back to the
@@ -233,6 +237,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
 void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const auto keys = result_keys(config);
   check_run_config(config.project.work, keys, false);
+  remove_leftovers_of_ended_runs(config);
   const std::uint64_t result_fingerprint = fingerprint(keys, false);
   const std::optional<TileStore> store = finished_tile_store(config, fingerprint(keys, true));
   if (!store) {

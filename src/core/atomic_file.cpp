@@ -3,6 +3,7 @@
 #include "citymesh/core/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -34,6 +35,21 @@ std::string process_tag() {
   char host[256] = {};
   if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
   return fmt::format("{}.{}", host, ::getpid());
+}
+
+bool tag_of_ended_local_process(std::string_view tag) {
+  const std::size_t dot = tag.rfind('.');
+  if (dot == std::string_view::npos || dot + 1 == tag.size() || tag.size() - dot > 10) return false;
+  long pid = 0;
+  for (const char c : tag.substr(dot + 1)) {
+    if (c < '0' || c > '9') return false;
+    pid = pid * 10 + (c - '0');
+  }
+  char host[256] = {};
+  if (pid <= 0 || pid == ::getpid() || ::gethostname(host, sizeof host - 1) != 0) return false;
+  if (tag.substr(0, dot) != std::string_view(host)) return false;
+  // ESRCH: no such process. EPERM means it runs under another user: alive.
+  return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
 }
 
 AtomicFile::AtomicFile(std::filesystem::path final_path) : final_path_(std::move(final_path)) {

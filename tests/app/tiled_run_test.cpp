@@ -90,6 +90,14 @@ TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {
   const auto resumed = test::run_citymesh(run_args(sim, "k", tiles));
   ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
   EXPECT_TRUE(test::result_bytes(dir / "sim/k") == reference) << "a killed and resumed run differs";
+  // What the killed runs left (temporary files, pair and staging folders) went with the resumed run.
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(dir / "sim")) {
+    const std::string name = entry.path().filename().string();
+    const bool pair_folder = entry.is_directory() && name.starts_with("pairs.");
+    EXPECT_TRUE(name.find(".tmp.") == std::string::npos && !pair_folder &&
+                entry.path().parent_path().filename() != "staging")
+        << entry.path() << " left by a killed run";
+  }
   // A re-run reuses every tile.
   const auto again = test::run_citymesh(run_args(sim, "k", tiles));
   ASSERT_EQ(again.exit_code, 0) << again.err;

@@ -1,8 +1,10 @@
 // SPDX-License-Identifier: MIT
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "ended_process.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -50,6 +52,20 @@ TEST(AtomicFile, CreatesParentFoldersAndReportsUnwritablePaths) {
     EXPECT_NE(std::string(e.what()).find("child.txt"), std::string::npos);
     EXPECT_EQ(e.exit_code(), ExitCode::output);
   }
+}
+
+TEST(ProcessTag, NamesEndedProcessesOfThisMachineOnly) {
+  const std::string host = test::host_name();
+  const pid_t ended = test::ended_process();
+  EXPECT_TRUE(tag_of_ended_local_process(fmt::format("{}.{}", host, ended)));
+  EXPECT_FALSE(tag_of_ended_local_process(process_tag())) << "this process runs";
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("{}.{}", host, ::getppid()))) << "the parent runs";
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("other-{}.{}", host, ended))) << "another machine";
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("{}.x{}", host, ended)));
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("{}.", host)));
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("{}.0", host)));
+  EXPECT_FALSE(tag_of_ended_local_process(fmt::format("{}.123456789012", host)));
+  EXPECT_FALSE(tag_of_ended_local_process(""));
 }
 
 }  // namespace

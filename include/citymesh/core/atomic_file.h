@@ -43,6 +43,12 @@ class AtomicFile {
 /// processes of every machine sharing a folder.
 std::string process_tag();
 
+/// Whether `tag` ("<host>.<pid>", as process_tag() makes it) names a process of this machine
+/// that is no longer running: what such a process left behind (a temporary file, a folder of
+/// its own) is nobody's. False for another machine's tag (its processes cannot be checked from
+/// here), for a live process and for anything that is not a tag.
+bool tag_of_ended_local_process(std::string_view tag);
+
 /// Writes `content` to `path` atomically.
 void write_file_atomically(const std::filesystem::path& path, std::string_view content);
 
