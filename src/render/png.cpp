@@ -35,6 +35,9 @@ void write_png(const std::filesystem::path& path, const Image& image) {
   png_set_write_fn(png, &encoded, append, no_flush);
   png_set_IHDR(png, info, image.width, image.height, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+  // One row filter instead of trying all five per row: a city picture (5000 x 4300) encodes in
+  // 0.25 s less and takes 3 % more bytes (session 33; SUB+UP: 0.1 s less, 2 % fewer bytes).
+  png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
   png_write_info(png, info);
   for (std::uint32_t row = 0; row < image.height; ++row) {
     auto* data = const_cast<Rgb8*>(image.pixels.data() + std::size_t(row) * image.width);

@@ -1,46 +1,35 @@
 // SPDX-License-Identifier: MIT
-// Orthographic ray casting through the Embree-backed RayScene.
+// Orthographic pictures by z-buffer rasterisation: each pixel shows the nearest triangle whose
+// projection holds the pixel's centre, as a ray cast through that centre would find it (the
+// Embree ray caster did this before: 3.7 s and ~1 GB for one 4.7 M-triangle acquisition on a
+// 5000 x 4300 picture; most triangles of a city are smaller than a pixel and hold no centre).
 #include <fmt/format.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/render/render.h"
-#include "citymesh/spatial/ray_scene.h"
 
 namespace citymesh {
 
 namespace {
 
-struct Flattened {
-  Vec3d origin;
-  std::vector<Vec3f> vertices;
-  std::vector<Triangle> triangles;
-  std::vector<Rgb8> colors;
-  Box3d box;  ///< relative to origin
-};
-
-Flattened flatten(std::span<const RenderLayer> layers) {
-  Flattened f;
-  if (!layers.empty()) f.origin = layers.front().mesh->origin;
+/// Every layer's vertices in the first layer's frame: their box frames the picture.
+Box3d layers_box(std::span<const RenderLayer> layers, const Vec3d& origin) {
+  Box3d box;
   for (const RenderLayer& l : layers) {
     if (l.face_colors.size() != l.mesh->triangle_count()) {
       throw ProcessingError(fmt::format("render: {} colours for {} triangles", l.face_colors.size(),
                                         l.mesh->triangle_count()));
     }
-    const auto base = static_cast<std::uint32_t>(f.vertices.size());
-    const Vec3f shift(l.mesh->origin - f.origin);
-    for (const Vec3f& p : l.mesh->positions) {
-      f.vertices.push_back(p + shift);
-      f.box.extend(Vec3d(p + shift));
-    }
-    for (const Triangle& t : l.mesh->triangles) f.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
-    f.colors.insert(f.colors.end(), l.face_colors.begin(), l.face_colors.end());
+    const Vec3f shift(l.mesh->origin - origin);
+    for (const Vec3f& p : l.mesh->positions) box.extend(Vec3d(p + shift));
   }
-  return f;
+  return box;
 }
 
 struct Camera {
@@ -76,35 +65,146 @@ Camera make_camera(const Box3d& box, const ViewParams& p) {
   return c;
 }
 
-Rgb8 shade(Rgb8 color, const Flattened& f, std::uint32_t triangle, const Vec3d& forward) {
-  const Triangle& t = f.triangles[triangle];
-  const Vec3d n = cross(Vec3d(f.vertices[t[1]] - f.vertices[t[0]]), Vec3d(f.vertices[t[2]] - f.vertices[t[0]]));
+Rgb8 shade(Rgb8 color, const Mesh& mesh, const Triangle& t, const Vec3d& forward) {
+  const std::vector<Vec3f>& v = mesh.positions;
+  const Vec3d n = cross(Vec3d(v[t[1]] - v[t[0]]), Vec3d(v[t[2]] - v[t[0]]));
   const double lambert = std::abs(dot(n, forward)) / std::max(norm(n), 1e-12);
   const double k = 0.35 + 0.65 * lambert;
   return {static_cast<std::uint8_t>(color.r * k), static_cast<std::uint8_t>(color.g * k),
           static_cast<std::uint8_t>(color.b * k)};
 }
 
+/// A vertex on the picture: x and y in pixels (pixel centres at whole numbers, rows down),
+/// depth along the view from the camera plane.
+struct Projected {
+  float x, y, depth;
+};
+
+/// A triangle whose box holds at least one pixel centre.
+struct Candidate {
+  std::array<std::uint32_t, 3> corners;  ///< into the projected vertices
+  std::uint32_t layer, triangle;
+  std::int32_t row0, row1;  ///< the rows of pixel centres its box holds
+};
+
+/// Twice the signed area of (a, b, p), computed the same way whichever way round the edge
+/// (a, b) is given: two triangles sharing an edge agree exactly on the side of every pixel
+/// centre, so the picture has neither gaps nor doubled pixels along shared edges.
+double edge(const Projected& a, const Projected& b, double px, double py) {
+  const bool ordered = a.y < b.y || (a.y == b.y && a.x < b.x);
+  const Projected& u = ordered ? a : b;
+  const Projected& w = ordered ? b : a;
+  const double e = (double(w.x) - u.x) * (py - u.y) - (double(w.y) - u.y) * (px - u.x);
+  return ordered ? e : -e;
+}
+
+/// Whether a centre exactly on edge (a, b) of a counter-clockwise triangle belongs to it: true
+/// for one of the two directions an edge is walked in by the triangles on either side.
+bool owns_edge(const Projected& a, const Projected& b) { return b.y < a.y || (b.y == a.y && b.x > a.x); }
+
+bool inside(double e, const Projected& a, const Projected& b) { return e > 0 || (e == 0 && owns_edge(a, b)); }
+
+constexpr std::int32_t kBandRows = 32;
+
+/// What one band of rows shows: per pixel the nearest candidate (lowest index on a tie, so the
+/// picture does not depend on the order of work).
+void draw_band(std::int32_t row0, std::int32_t row1, std::uint32_t width, std::span<const std::uint32_t> candidates,
+               std::span<const Candidate> all, std::span<const Projected> points, std::vector<float>& depth,
+               std::vector<std::uint32_t>& nearest) {
+  const std::size_t pixels = std::size_t(row1 - row0) * width;
+  depth.assign(pixels, std::numeric_limits<float>::infinity());
+  nearest.assign(pixels, UINT32_MAX);
+  for (const std::uint32_t index : candidates) {
+    const Candidate& c = all[index];
+    Projected a = points[c.corners[0]], b = points[c.corners[1]], d = points[c.corners[2]];
+    double area = edge(a, b, d.x, d.y);
+    if (area == 0) continue;  // seen edge-on
+    if (area < 0) {
+      std::swap(b, d);
+      area = -area;
+    }
+    const auto col0 = static_cast<std::int32_t>(std::ceil(std::min({a.x, b.x, d.x})));
+    const auto col1 = std::min<std::int32_t>(static_cast<std::int32_t>(std::floor(std::max({a.x, b.x, d.x}))),
+                                             static_cast<std::int32_t>(width) - 1);
+    for (std::int32_t row = std::max(c.row0, row0); row <= std::min(c.row1, row1 - 1); ++row) {
+      for (std::int32_t col = std::max(col0, 0); col <= col1; ++col) {
+        const double ea = edge(b, d, col, row), eb = edge(d, a, col, row), ed = edge(a, b, col, row);
+        if (!inside(ea, b, d) || !inside(eb, d, a) || !inside(ed, a, b)) continue;
+        const auto z = static_cast<float>((ea * a.depth + eb * b.depth + ed * d.depth) / area);
+        const std::size_t at = std::size_t(row - row0) * width + std::size_t(col);
+        if (z < depth[at]) {
+          depth[at] = z;
+          nearest[at] = index;
+        }
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Image render_orthographic(std::span<const RenderLayer> layers, const ViewParams& params) {
-  const Flattened f = flatten(layers);
   Image image;
-  if (f.triangles.empty()) return image;
-  const Camera cam = make_camera(f.box, params);
-  const RayScene scene(f.vertices, f.triangles);
+  if (layers.empty()) return image;
+  const Vec3d origin = layers.front().mesh->origin;
+  const Box3d box = layers_box(layers, origin);
+  if (box.empty()) return image;
+  const Camera cam = make_camera(box, params);
   image.width = cam.width;
   image.height = cam.height;
   image.pixels.assign(std::size_t(cam.width) * cam.height, params.background);
-  const Vec3f dir(cam.forward);
-  const float far = static_cast<float>(norm(f.box.max - f.box.min) + 2.0);
-  parallel_for_blocks(cam.height, 16, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t row = begin; row < end; ++row) {
-      for (std::uint32_t col = 0; col < cam.width; ++col) {
-        const double u = cam.u0 + (col + 0.5) * cam.pixel, v = cam.v1 - (static_cast<double>(row) + 0.5) * cam.pixel;
-        const Vec3f origin(cam.right * u + cam.up * v + cam.forward * cam.depth0);
-        const RayHit hit = scene.intersect(origin, dir, far);
-        if (hit.hit) image.pixels[row * cam.width + col] = shade(f.colors[hit.triangle], f, hit.triangle, cam.forward);
+
+  // Vertices onto the picture, and the triangles whose box holds a pixel centre, by band.
+  std::vector<Projected> points;
+  std::vector<Candidate> candidates;
+  const auto bands = static_cast<std::size_t>((cam.height + kBandRows - 1) / kBandRows);
+  std::vector<std::uint32_t> band_start(bands + 1, 0);
+  for (std::uint32_t l = 0; l < layers.size(); ++l) {
+    const Mesh& mesh = *layers[l].mesh;
+    const auto base = static_cast<std::uint32_t>(points.size());
+    const Vec3f shift(mesh.origin - origin);
+    for (const Vec3f& p : mesh.positions) {
+      const Vec3d q(p + shift);
+      points.push_back({static_cast<float>((dot(q, cam.right) - cam.u0) / cam.pixel - 0.5),
+                        static_cast<float>((cam.v1 - dot(q, cam.up)) / cam.pixel - 0.5),
+                        static_cast<float>(dot(q, cam.forward) - cam.depth0)});
+    }
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+      const Triangle& tri = mesh.triangles[t];
+      const Projected &a = points[base + tri[0]], &b = points[base + tri[1]], &d = points[base + tri[2]];
+      const auto row0 = static_cast<std::int32_t>(std::ceil(std::min({a.y, b.y, d.y})));
+      const auto row1 = std::min(static_cast<std::int32_t>(std::floor(std::max({a.y, b.y, d.y}))),
+                                 static_cast<std::int32_t>(cam.height) - 1);
+      const auto col0 = static_cast<std::int32_t>(std::ceil(std::min({a.x, b.x, d.x})));
+      const auto col1 = static_cast<std::int32_t>(std::floor(std::max({a.x, b.x, d.x})));
+      if (row0 > row1 || col0 > col1 || row1 < 0 || col1 < 0) continue;
+      candidates.push_back({{base + tri[0], base + tri[1], base + tri[2]}, l, t, std::max(row0, 0), row1});
+      for (std::int32_t band = std::max(row0, 0) / kBandRows; band <= row1 / kBandRows; ++band) ++band_start[band + 1];
+    }
+  }
+  for (std::size_t b = 0; b < bands; ++b) band_start[b + 1] += band_start[b];
+  std::vector<std::uint32_t> in_band(band_start.back());
+  std::vector<std::uint32_t> fill(band_start.begin(), band_start.end() - 1);
+  for (std::uint32_t k = 0; k < candidates.size(); ++k) {
+    for (std::int32_t band = candidates[k].row0 / kBandRows; band <= candidates[k].row1 / kBandRows; ++band) {
+      in_band[fill[band]++] = k;
+    }
+  }
+
+  parallel_for_blocks(bands, 1, [&](std::size_t begin, std::size_t end) {
+    std::vector<float> depth;
+    std::vector<std::uint32_t> nearest;
+    for (std::size_t band = begin; band < end; ++band) {
+      const auto row0 = static_cast<std::int32_t>(band) * kBandRows;
+      const std::int32_t row1 = std::min(row0 + kBandRows, static_cast<std::int32_t>(cam.height));
+      draw_band(row0, row1, cam.width, std::span(in_band).subspan(band_start[band], band_start[band + 1] - band_start[band]),
+                candidates, points, depth, nearest);
+      for (std::size_t at = 0; at < nearest.size(); ++at) {
+        if (nearest[at] == UINT32_MAX) continue;
+        const Candidate& c = candidates[nearest[at]];
+        const RenderLayer& layer = layers[c.layer];
+        image.pixels[std::size_t(row0) * cam.width + at] =
+            shade(layer.face_colors[c.triangle], *layer.mesh, layer.mesh->triangles[c.triangle], cam.forward);
       }
     }
   });

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Orthographic pictures of meshes by ray casting (top-down maps, oblique views), and PNG output.
+// Orthographic pictures of meshes (top-down maps, oblique views) by z-buffer rasterisation, and
+// PNG output.
 #pragma once
 
 #include <cstdint>
