@@ -172,6 +172,8 @@ Image render_orthographic(std::span<const RenderLayer> layers, const ViewParams&
     for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
       const Triangle& tri = mesh.triangles[t];
       const Projected &a = points[base + tri[0]], &b = points[base + tri[1]], &d = points[base + tri[2]];
+      // Nothing to draw, and no defined conversion to a pixel index, for a non-finite corner.
+      if (!std::isfinite(a.x + a.y + a.depth + b.x + b.y + b.depth + d.x + d.y + d.depth)) continue;
       const auto row0 = static_cast<std::int32_t>(std::ceil(std::min({a.y, b.y, d.y})));
       const auto row1 = std::min(static_cast<std::int32_t>(std::floor(std::max({a.y, b.y, d.y}))),
                                  static_cast<std::int32_t>(cam.height) - 1);

@@ -173,5 +173,22 @@ TEST(Render, ObliqueViewsFrameTheSceneAndWallsShowFromTheSide) {
   EXPECT_NEAR(double(red_pixels(oblique)), 100.0 * 86.6, 300.0);
 }
 
+TEST(Render, TrianglesWithANonFiniteCornerAreLeftOut) {
+  Mesh m;
+  m.positions = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {std::nanf(""), 1, 0}, {4, 4, 0}};
+  m.triangles = {{0, 1, 2}, {1, 3, 4}};
+  RenderLayer layer{&m, {Rgb8{0, 0, 200}, Rgb8{200, 0, 0}}};
+  ViewParams view;
+  view.pixel_size = 0.1;
+  const Image image = render_orthographic(std::span<const RenderLayer>(&layer, 1), view);
+  std::size_t blue = 0, red = 0;
+  for (const Rgb8& p : image.pixels) {
+    blue += p.b == 200 && p.r == 0;
+    red += p.r == 200 && p.b == 0;
+  }
+  EXPECT_NEAR(double(blue), 40.0 * 40.0 / 2, 60.0);  // the finite triangle, 8 m^2 at 0.01 m^2 per pixel
+  EXPECT_EQ(red, 0u);
+}
+
 }  // namespace
 }  // namespace citymesh
