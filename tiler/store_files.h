@@ -11,9 +11,6 @@
 
 namespace citymesh {
 
-/// Where acquisitions are tiled before they are renamed into place.
-inline constexpr const char* kStagingFolder = "staging";
-
 /// Writes <dir>/summary.json (atomically).
 void write_acquisition_tiling(const std::filesystem::path& dir, const AcquisitionTiling& tiling);
 

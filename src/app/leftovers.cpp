@@ -7,16 +7,17 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/log.h"
+#include "citymesh/tiler/tiler.h"
+#include "pair_spill.h"
 
 namespace citymesh::app {
 
 std::string_view process_tag_in_name(std::string_view name, std::string_view parent) {
-  constexpr std::string_view kTemporary = ".tmp.", kPairs = "pairs.";
-  if (const std::size_t at = name.rfind(kTemporary); at != std::string_view::npos && at > 0) {
-    return name.substr(at + kTemporary.size());
+  if (const std::size_t at = name.rfind(kTemporaryInfix); at != std::string_view::npos && at > 0) {
+    return name.substr(at + kTemporaryInfix.size());
   }
-  if (name.starts_with(kPairs)) return name.substr(kPairs.size());
-  if (parent == "staging" && name.size() > 1 && name[0] == 'a') {
+  if (name.starts_with(kPairSpillPrefix)) return name.substr(kPairSpillPrefix.size());
+  if (parent == kStagingFolder && name.size() > 1 && name[0] == 'a') {
     const std::size_t dot = name.find('.');
     const std::string_view index = name.substr(1, dot == std::string_view::npos ? 0 : dot - 1);
     if (!index.empty() && index.find_first_not_of("0123456789") == std::string_view::npos) return name.substr(dot + 1);

@@ -10,11 +10,16 @@
 #include <memory>
 #include <vector>
 
+#include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/radix_sort.h"
 #include "citymesh/core/record_file.h"
 
 namespace citymesh::app {
+
+std::filesystem::path pair_spill_folder(const std::filesystem::path& work) {
+  return work / (std::string(kPairSpillPrefix) + process_tag());
+}
 
 PairSpill::PairSpill(std::filesystem::path dir, std::uint32_t range) : dir_(std::move(dir)), range_(std::max(range, 1u)) {
   std::error_code ec;

@@ -12,6 +12,12 @@
 
 namespace citymesh::app {
 
+/// What the name of a final pass's spill folder starts with, before the process tag.
+inline constexpr std::string_view kPairSpillPrefix = "pairs.";
+
+/// This process's spill folder in the work folder `work`: <work>/pairs.<host>.<pid>.
+std::filesystem::path pair_spill_folder(const std::filesystem::path& work);
+
 /// Pairs appended in any order to files by range of their first triangle; written out sorted
 /// and unique, one range at a time, so that memory holds one range's pairs at most.
 class PairSpill {

@@ -108,7 +108,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                peak_resident_bytes() >> 20);
   };
   // The pairs wait on disk (a city has 0.7 GB of them), in a folder of this process's own.
-  TileAssembly assembly(store, config.output.labels ? std::optional(config.project.work / ("pairs." + process_tag()))
+  TileAssembly assembly(store, config.output.labels ? std::optional(pair_spill_folder(config.project.work))
                                                     : std::nullopt);
   std::vector<nlohmann::json> per_tile;
   // Results are read (and checked) a few at a time in parallel, then added in tile order; a

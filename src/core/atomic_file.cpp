@@ -31,11 +31,14 @@ void sync_directory(const std::filesystem::path& dir) {
   ::close(fd);
 }
 
-std::string process_tag() {
+/// This machine's name, empty when it cannot be had.
+std::string host_name() {
   char host[256] = {};
   if (::gethostname(host, sizeof host - 1) != 0) host[0] = '\0';
-  return fmt::format("{}.{}", host, ::getpid());
+  return host;
 }
+
+std::string process_tag() { return fmt::format("{}.{}", host_name(), ::getpid()); }
 
 bool tag_of_ended_local_process(std::string_view tag) {
   const std::size_t dot = tag.rfind('.');
@@ -45,16 +48,16 @@ bool tag_of_ended_local_process(std::string_view tag) {
     if (c < '0' || c > '9') return false;
     pid = pid * 10 + (c - '0');
   }
-  char host[256] = {};
-  if (pid <= 0 || pid == ::getpid() || ::gethostname(host, sizeof host - 1) != 0) return false;
-  if (tag.substr(0, dot) != std::string_view(host)) return false;
+  if (pid <= 0 || pid == ::getpid()) return false;
+  const std::string host = host_name();
+  if (host.empty() || tag.substr(0, dot) != host) return false;
   // ESRCH: no such process. EPERM means it runs under another user: alive.
   return ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH;
 }
 
 AtomicFile::AtomicFile(std::filesystem::path final_path) : final_path_(std::move(final_path)) {
   temp_path_ = final_path_;
-  temp_path_ += ".tmp." + process_tag();
+  temp_path_ += std::string(kTemporaryInfix) + process_tag();
   std::error_code ec;
   if (final_path_.has_parent_path()) std::filesystem::create_directories(final_path_.parent_path(), ec);
   file_ = std::fopen(temp_path_.c_str(), "wb");

@@ -83,7 +83,6 @@ class RowWriter {
     for (const RawColumn& c : columns_) row_bytes_ += c.size;
     buffer_.resize(std::max(kBlock, row_bytes_));
   }
-  ~RowWriter() = default;
   RowWriter(const RowWriter&) = delete;
   RowWriter& operator=(const RowWriter&) = delete;
 

@@ -7,13 +7,14 @@
 
 #include <string>
 
+#include "citymesh/core/atomic_file.h"
+
 namespace citymesh::test {
 
-/// This machine's name, as process_tag() writes it.
+/// This machine's name, as process_tag() writes it ("<host>.<pid>").
 inline std::string host_name() {
-  char host[256] = {};
-  ::gethostname(host, sizeof host - 1);
-  return host;
+  const std::string tag = process_tag();
+  return tag.substr(0, tag.rfind('.'));
 }
 
 /// The pid of a process that has ended: a child that exits at once, waited for (its pid is

@@ -12,6 +12,9 @@
 
 namespace citymesh {
 
+/// What AtomicFile puts between the final name and the process tag of its temporary file.
+inline constexpr std::string_view kTemporaryInfix = ".tmp.";
+
 class AtomicFile {
  public:
   /// Opens "<final>.tmp.<host>.<pid>" for writing (unique across the machines of a cluster

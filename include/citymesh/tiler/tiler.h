@@ -57,6 +57,10 @@ struct AcquisitionTiling {
   std::string fingerprint;  ///< what the caller says the tiling was made from
 };
 
+/// Where acquisitions are tiled (<dir>/staging/a<k>.<process tag>) before they are renamed
+/// into place.
+inline constexpr const char* kStagingFolder = "staging";
+
 /// Streams one acquisition once and writes <dir>/a<k>/<tile>.bin; each triangle goes
 /// to the tile owning its centroid, as halo to the tiles within `halo`, and as empty space to
 /// the other tiles its tetrahedron with the viewpoint (the barycentre of its vertices' sensor
