@@ -1,12 +1,15 @@
 // SPDX-License-Identifier: MIT
 #include "clip.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <span>
 #include <unordered_map>
 
+#include "citymesh/core/error.h"
 #include "citymesh/core/geometry.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/mosaic/proximity.h"
@@ -46,11 +49,18 @@ VertexFrames vertex_frames(const MergedMesh& merged) {
 
 /// Which source yields where two overlap: the one with fewer triangles in the mosaic (the
 /// smaller pieces are cut back to the larger ones), on a tie the earlier acquisition.
-std::vector<std::uint64_t> source_precedence(const MergedMesh& merged) {
-  std::vector<std::uint64_t> count;
+/// `sizes`: per source, its triangles in the whole output when the mesh is only part of it.
+std::vector<std::uint64_t> source_precedence(const MergedMesh& merged, std::span<const std::uint64_t> sizes) {
+  std::vector<std::uint64_t> count(sizes.begin(), sizes.end());
   for (const std::int32_t s : merged.source_acq) {
     if (s < 0) continue;
     const auto k = static_cast<std::size_t>(s);
+    if (!sizes.empty()) {
+      if (k >= sizes.size()) {
+        throw ProcessingError(fmt::format("clipping: source {} has no size among the {} given", s, sizes.size()));
+      }
+      continue;
+    }
     if (count.size() <= k) count.resize(k + 1, 0);
     ++count[k];
   }
@@ -63,9 +73,10 @@ std::vector<std::uint64_t> source_precedence(const MergedMesh& merged) {
 /// `source` with normal `n`.
 class Cover {
  public:
-  Cover(const MergedMesh& merged, const ClipParams& params)
+  Cover(const MergedMesh& merged, const ClipParams& params, std::span<const std::uint64_t> sizes)
       : merged_(merged), near_(merged.mesh, params.tolerance), params_(params),
-        min_cos_(std::cos(params.max_angle_deg * std::numbers::pi / 180.0)), precedence_(source_precedence(merged)) {
+        min_cos_(std::cos(params.max_angle_deg * std::numbers::pi / 180.0)),
+        precedence_(source_precedence(merged, sizes)) {
     normal_.resize(merged.mesh.triangle_count());
     parallel_for_blocks(normal_.size(), 16384, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
@@ -135,11 +146,20 @@ struct Cut {
   double fraction;
 };
 
+/// Whether every corner of `tri` belongs to another part (VertexRole done or later): such a
+/// triangle stays whole.
+bool of_other_parts(const Triangle& tri, std::span<const std::uint8_t> roles) {
+  const auto other = [&](std::uint32_t v) { return v < roles.size() && roles[v] != 0; };
+  return other(tri[0]) && other(tri[1]) && other(tri[2]);
+}
+
 /// One cut per edge with one covered end, in edge-key order.
 std::vector<Cut> find_cuts(const Mesh& m, const Cover& cover, const VertexFrames& f,
-                           const std::vector<std::uint8_t>& covered, const ClipParams& params) {
+                           const std::vector<std::uint8_t>& covered, const ClipParams& params,
+                           std::span<const std::uint8_t> roles) {
   std::vector<std::uint64_t> keys;
   for (const Triangle& tri : m.triangles) {
+    if (of_other_parts(tri, roles)) continue;
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
       if (covered[a] != covered[b]) keys.push_back(edge_key(a, b));
@@ -208,7 +228,8 @@ void gather(std::vector<T>& v, std::span<const std::uint32_t> from) {
 
 /// Replaces each triangle in place by its uncovered part (nothing when covered whole).
 ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& covered,
-                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut) {
+                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut,
+                          std::span<const std::uint8_t> roles) {
   Mesh& m = merged.mesh;
   ClipStats stats;
   std::vector<Triangle> triangles;
@@ -218,7 +239,7 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const Triangle& tri = m.triangles[t];
     const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
-    if (corners_covered == 0) {
+    if (corners_covered == 0 || of_other_parts(tri, roles)) {
       triangles.push_back(tri);  // nearly every triangle of a city: no polygon built
       from.push_back(static_cast<std::uint32_t>(t));
     } else if (corners_covered == 3) {
@@ -240,25 +261,30 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
 
 }  // namespace
 
-ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params) {
+ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const StitchSurroundings& around) {
   Mesh& m = merged.mesh;
   std::vector<std::uint8_t> covered(m.vertex_count(), 0);
   std::vector<Cut> cuts;
   {
     const VertexFrames frames = vertex_frames(merged);
-    const Cover cover(merged, params);
+    const Cover cover(merged, params, around.source_sizes);
+    const std::span<const std::uint8_t> roles = around.vertex_roles;
     parallel_for_blocks(m.vertex_count(), 4096, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
+        // Output stitched before stays: its vertices are never covered. A later part's
+        // vertex may be: the free triangles around it are cut now, the later part's own
+        // triangles (whole, of_other_parts) when their turn comes, at the same place.
+        if (v < roles.size() && roles[v] == static_cast<std::uint8_t>(VertexRole::done)) continue;
         covered[v] = cover.over(Vec3d(m.positions[v]), frames.source[v], Vec3d(frames.normal[v])) ? 1 : 0;
       }
     });
     if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {};
-    cuts = find_cuts(m, cover, frames, covered, params);
+    cuts = find_cuts(m, cover, frames, covered, params, roles);
   }  // the index and the normals go before the triangles are rebuilt (a city's peak memory)
   const std::size_t before = m.vertex_count();
   const auto vertex_of = add_cut_vertices(m, cuts);
   covered.resize(m.vertex_count(), 0);  // the cuts are where the cover ends: uncovered
-  ClipStats stats = replace_covered(merged, covered, vertex_of);
+  ClipStats stats = replace_covered(merged, covered, vertex_of, around.vertex_roles);
   stats.vertices_added = m.vertex_count() - before;
   return stats;
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/stitch.h"
 
 namespace citymesh::mosaic_detail {
 
@@ -36,6 +37,9 @@ struct ClipStats {
 /// New vertices interpolate every per-vertex attribute. Sources never share vertices here
 /// (stitching has not started). Deterministic: triangles keep their order, each replaced in
 /// place by its parts.
-ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params);
+/// With `around`: vertices of output stitched before (done) are never covered, triangles
+/// whose corners are all done or later stay whole (the free triangles around a covered later
+/// vertex are cut), and precedence counts each source's triangles in the whole output.
+ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const StitchSurroundings& around = {});
 
 }  // namespace citymesh::mosaic_detail

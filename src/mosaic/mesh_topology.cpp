@@ -7,8 +7,11 @@
 
 namespace citymesh::mosaic_detail {
 
-MeshTopology::MeshTopology(MergedMesh& merged)
-    : merged_(merged), offsets_(merged.mesh.vertex_count() + 1, 0), edited_(merged.mesh.vertex_count(), UINT32_MAX) {
+MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles)
+    : merged_(merged),
+      roles_(roles),
+      offsets_(merged.mesh.vertex_count() + 1, 0),
+      edited_(merged.mesh.vertex_count(), UINT32_MAX) {
   const auto& triangles = merged.mesh.triangles;
   for (const Triangle& tri : triangles) {
     for (const std::uint32_t v : tri) ++offsets_[v + 1];
@@ -19,6 +22,12 @@ MeshTopology::MeshTopology(MergedMesh& merged)
   for (std::uint32_t t = 0; t < triangles.size(); ++t) {
     for (const std::uint32_t v : triangles[t]) packed_[fill[v]++] = t;
   }
+}
+
+bool MeshTopology::joinable(std::uint32_t v) const {
+  if (v >= roles_.size() || roles_[v] != static_cast<std::uint8_t>(VertexRole::later)) return true;
+  const std::span<const std::uint32_t> around = triangles_of(v);
+  return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return !frozen_triangle(t); });
 }
 
 std::span<const std::uint32_t> MeshTopology::triangles_of(std::uint32_t v) const {

@@ -13,6 +13,7 @@
 
 #include "citymesh/mosaic/edges.h"
 #include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/stitch.h"
 
 namespace citymesh::mosaic_detail {
 
@@ -23,7 +24,9 @@ struct DirectedEdge {
 
 class MeshTopology {
  public:
-  explicit MeshTopology(MergedMesh& merged);
+  /// `roles`: per vertex, a VertexRole (vertices past its end are free); the caller keeps it
+  /// alive.
+  explicit MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles = {});
 
   [[nodiscard]] MergedMesh& merged() const { return merged_; }
   [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
@@ -32,6 +35,19 @@ class MeshTopology {
   [[nodiscard]] Vec3d winding(const Triangle& t) const {
     const Vec3d a = position(t[0]);
     return cross(position(t[1]) - a, position(t[2]) - a);
+  }
+
+  /// Whether v must stay where and what it is (a vertex of a part stitched before or after).
+  [[nodiscard]] bool frozen(std::uint32_t v) const { return v < roles_.size() && roles_[v] != 0; }
+  /// Whether seams may be joined to v: not a vertex of a part stitched afterwards, unless
+  /// this part's triangles use it too (it lies on the border between the two).
+  [[nodiscard]] bool joinable(std::uint32_t v) const;
+  /// Whether triangle t must stay as it is: its three corners are frozen. (A free triangle
+  /// whose corners all happen to be frozen is kept as it is too: nothing it could become
+  /// would leave them in place anyway but a split of its edges.)
+  [[nodiscard]] bool frozen_triangle(std::uint32_t t) const {
+    const Triangle& tri = triangle(t);
+    return frozen(tri[0]) && frozen(tri[1]) && frozen(tri[2]);
   }
 
   /// The triangles using vertex v, in the order they were added.
@@ -59,6 +75,7 @@ class MeshTopology {
 
  private:
   MergedMesh& merged_;
+  std::span<const std::uint8_t> roles_;
   std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
   std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
   std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows

@@ -55,7 +55,9 @@ bool moves_acceptable(const MeshTopology& topo, std::initializer_list<std::uint3
 /// Makes w one with v at their midpoint, unless a triangle of either would flip or
 /// degenerate or a directed edge would be used twice.
 bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
-  const Vec3d mid = (topo.position(v) + topo.position(w)) * 0.5;
+  if (topo.frozen(w)) std::swap(v, w);  // a frozen vertex stays where it is: the other comes to it
+  if (topo.frozen(w)) return false;
+  const Vec3d mid = topo.frozen(v) ? topo.position(v) : (topo.position(v) + topo.position(w)) * 0.5;
   std::vector<Triangle> renamed;
   const std::vector<std::uint32_t> around_w(topo.triangles_of(w).begin(), topo.triangles_of(w).end());
   for (const std::uint32_t t : around_w) {
@@ -85,10 +87,15 @@ std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
   parallel_for_blocks(vertices.size(), 1024, [&](std::size_t begin, std::size_t end) {
     std::vector<std::uint32_t> near;
     for (std::size_t i = begin; i < end; ++i) {
+      if (!topo.joinable(vertices[i])) continue;  // its own part snaps it
       tree.radius_search(points[i], static_cast<float>(tolerance), near);
       const std::int32_t source = topo.source_of_vertex(vertices[i]);
       for (const std::uint32_t j : near) {
-        if (topo.source_of_vertex(vertices[j]) != source) partners[i].push_back(j);
+        // Two frozen vertices stay two: neither may move.
+        const bool both_frozen = topo.frozen(vertices[i]) && topo.frozen(vertices[j]);
+        if (topo.source_of_vertex(vertices[j]) != source && !both_frozen && topo.joinable(vertices[j])) {
+          partners[i].push_back(j);
+        }
       }
     }
   });
@@ -147,14 +154,18 @@ bool touches_source(const MeshTopology& topo, std::uint32_t v, std::int32_t sour
 /// there is none.
 Insertion nearest_insertion(const MeshTopology& topo, std::span<const DirectedEdge> edges, const BoxTree& tree,
                             std::uint32_t v, double tolerance, std::vector<std::uint32_t>& hits) {
+  Insertion best{SIZE_MAX, 0, v};
+  if (!topo.joinable(v)) return best;  // its own part snaps it
   tree.containing(topo.merged().mesh.positions[v], hits);
   std::sort(hits.begin(), hits.end());
   const Vec3d p = topo.position(v);
-  Insertion best{SIZE_MAX, 0, v};
   double best_d2 = tolerance * tolerance;
   for (const std::uint32_t h : hits) {
     const DirectedEdge& e = edges[h];
-    if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle])) continue;
+    if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle]) ||
+        topo.frozen_triangle(e.triangle)) {
+      continue;
+    }
     const Vec3d a = topo.position(e.from), ab = topo.position(e.to) - a;
     const double len2 = dot(ab, ab);
     if (!(len2 > 0)) continue;
@@ -198,7 +209,7 @@ std::vector<Insertion> find_insertions(const MeshTopology& topo, std::span<const
 
 /// Moves v to q unless one of its triangles would flip or degenerate.
 bool try_move(MeshTopology& topo, std::uint32_t v, const Vec3d& q) {
-  if (!moves_acceptable(topo, {v}, q)) return false;
+  if (topo.frozen(v) || !moves_acceptable(topo, {v}, q)) return false;
   topo.merged().mesh.positions[v] = Vec3f(q);
   return true;
 }
@@ -233,6 +244,7 @@ Split split_fan(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const 
   const std::optional<std::uint32_t> found = topo.triangle_with(from, to);
   if (!found) return Split::refused;
   const std::uint32_t t = *found;
+  if (topo.frozen_triangle(t)) return Split::refused;
   const Triangle old = topo.triangle(t);
   int k = 0;
   while (old[k] != from) ++k;

@@ -37,7 +37,9 @@ bool split_boundary_edge_onto(MeshTopology& topo, std::uint32_t from, std::uint3
 /// fan; the new triangles keep its provenance; where that fan would fold, as over a sliver cut
 /// triangle, the vertices are moved onto the edge first: split_boundary_edge_onto). An operation is skipped when a triangle would
 /// flip or degenerate, or a directed edge would be used twice (the mesh stays edge-manifold
-/// and consistently oriented). Deterministic: vertices and edges in index order. The mesh is
+/// and consistently oriented). Frozen vertices (MeshTopology) never move: a free vertex merged
+/// with one goes to it, and no triangle of frozen corners is split. Deterministic: vertices
+/// and edges in index order. The mesh is
 /// topo's, which is kept up to date.
 SnapStats snap_boundaries(MeshTopology& topo, double tolerance);
 

@@ -80,11 +80,12 @@ void match_vertices(StitchContext& c) {
   std::vector<std::uint32_t> near;
   for (std::uint32_t i = 0; i < points.size(); ++i) {
     const std::uint32_t v = c.boundary.vertices[i];
+    if (!c.topo.joinable(v)) continue;  // its own part joins it
     tree.radius_search(points[i], static_cast<float>(c.params.reach), near);
     double best = c.params.reach * c.params.reach;
     for (const std::uint32_t j : near) {
       const std::uint32_t w = c.boundary.vertices[j];
-      if (c.source(w) == c.source(v)) continue;
+      if (c.source(w) == c.source(v) || !c.topo.joinable(w)) continue;
       const Vec3d d = position(m, w) - position(m, v);
       if (dot(d, d) <= best) {
         best = dot(d, d);
@@ -107,7 +108,10 @@ std::vector<std::uint32_t> facing_run(const StitchContext& c, std::uint32_t from
   std::vector<std::uint32_t> run{from};
   for (std::uint32_t v = from; v != to;) {
     const auto it = c.boundary.prev.find(v);
-    if (it == c.boundary.prev.end() || run.size() > limit || c.consumed.contains(it->second)) return {};
+    if (it == c.boundary.prev.end() || run.size() > limit || c.consumed.contains(it->second) ||
+        !c.topo.joinable(it->second)) {
+      return {};
+    }
     v = it->second;
     run.push_back(v);
   }
@@ -204,8 +208,11 @@ void weld(StitchContext& c) {
       while (target[v] != v) v = target[v];
       if (u == v) continue;
       const Vec3d d = position(m, u) - position(m, v);
-      if (dot(d, d) <= tol_sq) {
-        target[std::max(u, v)] = std::min(u, v);
+      const bool u_frozen = c.topo.frozen(u), v_frozen = c.topo.frozen(v);
+      if (dot(d, d) <= tol_sq && !(u_frozen && v_frozen)) {
+        // The frozen one stays; otherwise the smaller index.
+        const bool keep_u = u_frozen || (!v_frozen && u < v);
+        target[keep_u ? v : u] = keep_u ? u : v;
         ++c.stats.vertices_welded;
       }
     }
@@ -245,7 +252,7 @@ double length_of(const Mesh& m, std::span<const EdgeUse> edges) {
 
 double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(m.triangles)); }
 
-StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
+StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchSurroundings& around) {
   Stopwatch clock;
   // Where the time goes, at --log-level debug (the seam pass of a city runs mostly serial).
   const auto phase_done = [&clock](std::string_view phase) {
@@ -254,16 +261,16 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params) {
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
-  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged);
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around.vertex_roles);
   const double before = length_of(merged.mesh, unclipped->boundary_edges());
   phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
     unclipped.reset();
-    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle});
+    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle}, around);
   }
   phase_done("clipped");
-  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged);
+  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged, around.vertex_roles);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   phase_done("snapped");
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "citymesh/mosaic/merged_mesh.h"
 
@@ -36,6 +37,30 @@ struct StitchStats {
   double seconds = 0;
 };
 
+/// A vertex's part in a seam pass over one part of an output, when the output is stitched
+/// part by part (each part's triangles once, with what lies around them).
+enum class VertexRole : std::uint8_t {
+  free = 0,   ///< of this part's triangles only: stitching may move it, merge it, cut it away
+  done = 1,   ///< of output stitched before: stays as it is; this part's seams may join it
+  /// of a part stitched afterwards (and not done): stays where it is; the free triangles
+  /// around it may be cut back from it; seams are joined to it only where this part's
+  /// triangles use it too (on the border between the two parts), the rest is that part's
+  later = 2,
+};
+
+/// What a seam pass over one part of an output needs to know of the rest.
+struct StitchSurroundings {
+  /// Per vertex of the mesh (VertexRole; vertices past its end are free). Triangles whose
+  /// corners are all done or later come out unchanged; new triangles may use done vertices
+  /// and the joinable later ones.
+  /// Later triangles are there for clipping (what they cover of this part is cut now) and so
+  /// that this part's edges along them are not taken for seams.
+  std::span<const std::uint8_t> vertex_roles = {};
+  /// Per source: its triangles in the whole output, which decide who yields where two
+  /// overlap (clipping); empty: counted in the mesh itself.
+  std::span<const std::uint64_t> source_sizes = {};
+};
+
 /// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
 /// of pieces lying over a larger source's surface are first cut away (Turk and Levoy's
 /// clipping), so that a piece's boundary no longer runs across another's interior. Boundaries lying within
@@ -45,8 +70,9 @@ struct StitchStats {
 /// joined with strips of new triangles (source kNoSource), advancing along both boundaries
 /// and taking the shorter diagonal at each step. With `gap` > 0, the small holes still
 /// enclosed by boundaries of several sources are then triangulated. No operation may flip or degenerate a
-/// triangle or use a directed edge twice. Deterministic.
-StitchStats stitch(MergedMesh& mesh, const StitchParams& params);
+/// triangle or use a directed edge twice. `around` freezes what was stitched before (see
+/// StitchSurroundings). Deterministic.
+StitchStats stitch(MergedMesh& mesh, const StitchParams& params, const StitchSurroundings& around = {});
 
 /// Total length of the edges used by exactly one triangle.
 double open_boundary_length(const Mesh& mesh);
