@@ -388,11 +388,10 @@ TEST(GapFill, ClosesTwoGapsMeetingAtAPinchedVertex) {
   EXPECT_NEAR(added_area, 0.02, 1e-6);  // the two cells, nothing across the pinch
 }
 
-TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
-  // Source 0 above y = 0, source 1 below, joined along the seam except between a and b,
-  // where source 1's boundary bends 1 cm up into source 0 through x: the loop a -> b -> x
-  // winds the wrong way (two layers, not a hole), so a fill would face down. Splitting
-  // source 0's edge a -> b at x closes it with every triangle still facing up.
+/// Source 0 above y = 0, source 1 below, joined along the seam except between a and b,
+/// where source 1's boundary bends 1 cm up into source 0 through x: the loop a -> b -> x
+/// winds the wrong way (two layers, not a hole), so a fill would face down.
+MergedMesh overlap_sliver() {
   MergedMesh m;
   m.mesh.positions = {{-0.5f, 0, 0},   {0, 0, 0},     {0.5f, 0, 0},  {1, 0, 0},  // p0 a b p3
                       {0.25f, 0.01f, 0},                                     // x
@@ -400,6 +399,12 @@ TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
                       {-0.25f, -0.5f, 0}, {0.25f, -0.5f, 0}, {0.75f, -0.5f, 0}};  // d0 d1 d2
   add_triangles(m, 0, {{0, 1, 5}, {1, 2, 6}, {2, 3, 7}, {1, 6, 5}, {2, 7, 6}});
   add_triangles(m, 1, {{1, 0, 8}, {2, 4, 9}, {4, 1, 9}, {3, 2, 10}, {1, 8, 9}, {2, 9, 10}});
+  return m;
+}
+
+TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
+  // Splitting source 0's edge a -> b at x closes the loop with every triangle still facing up.
+  MergedMesh m = overlap_sliver();
   const double outline = open_boundary_length(m.mesh) - 0.5 - 2 * std::hypot(0.25, 0.01);
   const mosaic_detail::GapFillStats s = fill_gaps(m);
   EXPECT_EQ(s.gaps_filled, 0u);
@@ -413,6 +418,23 @@ TEST(GapFill, ClosesAnOverlapSliverBySplittingItsLongEdge) {
     EXPECT_GT(cross(c[1] - c[0], c[2] - c[0]).z, 0) << "triangle " << t << " faces down";
   }
   EXPECT_EQ(std::count(m.source_acq.begin(), m.source_acq.end(), 0), 6);  // the split keeps provenance
+}
+
+TEST(GapFill, DoesNotSplitATriangleOfOutputStitchedBefore) {
+  // The same loop with source 0 done (stitched part by part, StitchSurroundings): its
+  // triangle a -> b stays as it is and the loop stays open.
+  MergedMesh m = overlap_sliver();
+  std::vector<std::uint8_t> roles(m.mesh.vertex_count(), static_cast<std::uint8_t>(VertexRole::free));
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_acq[t] != 0) continue;
+    for (const std::uint32_t v : m.mesh.triangles[t]) roles[v] = static_cast<std::uint8_t>(VertexRole::done);
+  }
+  mosaic_detail::MeshTopology topo(m, roles);
+  const mosaic_detail::GapFillStats s = mosaic_detail::fill_seam_gaps(topo, {.max_width = 0.1, .max_perimeter = 2.0});
+  EXPECT_EQ(s.gaps_split + s.gaps_filled, 0u);
+  EXPECT_EQ(s.gaps_refused, 1u);
+  EXPECT_EQ(m.mesh.triangle_count(), 11u);
+  EXPECT_EQ(m.mesh.triangles[1], (Triangle{1, 2, 6}));
 }
 
 /// Source 0 (above y = 0) ends in a sliver cut triangle a -> b -> s, its apex s 5 mm above
