@@ -149,7 +149,7 @@ struct Cut {
 /// Whether every corner of `tri` belongs to another part (VertexRole done or later): such a
 /// triangle stays whole.
 bool of_other_parts(const Triangle& tri, std::span<const std::uint8_t> roles) {
-  const auto other = [&](std::uint32_t v) { return v < roles.size() && roles[v] != 0; };
+  const auto other = [&](std::uint32_t v) { return role_of(roles, v) != VertexRole::free; };
   return other(tri[0]) && other(tri[1]) && other(tri[2]);
 }
 
@@ -274,7 +274,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
         // Output stitched before stays: its vertices are never covered. A later part's
         // vertex may be: the free triangles around it are cut now, the later part's own
         // triangles (whole, of_other_parts) when their turn comes, at the same place.
-        if (v < roles.size() && roles[v] == static_cast<std::uint8_t>(VertexRole::done)) continue;
+        if (role_of(roles, static_cast<std::uint32_t>(v)) == VertexRole::done) continue;
         covered[v] = cover.over(Vec3d(m.positions[v]), frames.source[v], Vec3d(frames.normal[v])) ? 1 : 0;
       }
     });

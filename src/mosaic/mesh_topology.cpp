@@ -25,7 +25,7 @@ MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> rol
 }
 
 bool MeshTopology::joinable(std::uint32_t v) const {
-  if (v >= roles_.size() || roles_[v] != static_cast<std::uint8_t>(VertexRole::later)) return true;
+  if (role_of(roles_, v) != VertexRole::later) return true;
   const std::span<const std::uint32_t> around = triangles_of(v);
   return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return !frozen_triangle(t); });
 }

@@ -38,7 +38,7 @@ class MeshTopology {
   }
 
   /// Whether v must stay where and what it is (a vertex of a part stitched before or after).
-  [[nodiscard]] bool frozen(std::uint32_t v) const { return v < roles_.size() && roles_[v] != 0; }
+  [[nodiscard]] bool frozen(std::uint32_t v) const { return role_of(roles_, v) != VertexRole::free; }
   /// Whether seams may be joined to v: not a vertex of a part stitched afterwards, unless
   /// this part's triangles use it too (it lies on the border between the two).
   [[nodiscard]] bool joinable(std::uint32_t v) const;

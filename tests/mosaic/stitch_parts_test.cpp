@@ -6,37 +6,18 @@
 
 #include <algorithm>
 #include <array>
-#include <map>
 #include <set>
-#include <tuple>
 
 #include "citymesh/core/geometry.h"
 #include "citymesh/mosaic/stitch.h"
+#include "stitch_fixtures.h"
 
 namespace citymesh {
 namespace {
 
-/// A flat grid of nx x ny cells of size `step`, normals +z, appended with source `source`.
-void add_grid(MergedMesh& out, float x0, float y0, int nx, int ny, float step, std::int32_t source, float z) {
-  const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
-  for (int j = 0; j <= ny; ++j) {
-    for (int i = 0; i <= nx; ++i) out.mesh.positions.push_back({x0 + float(i) * step, y0 + float(j) * step, z});
-  }
-  const auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (nx + 1) + i); };
-  std::int32_t next = 0;
-  for (std::size_t t = 0; t < out.source_acq.size(); ++t) next += out.source_acq[t] == source ? 1 : 0;
-  for (int j = 0; j < ny; ++j) {
-    for (int i = 0; i < nx; ++i) {
-      for (const Triangle& t : {Triangle{id(i, j), id(i + 1, j), id(i + 1, j + 1)},
-                                Triangle{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
-        out.mesh.triangles.push_back(t);
-        out.mesh.triangle_ids.push_back({});
-        out.source_acq.push_back(source);
-        out.source_triangle.push_back(next++);
-      }
-    }
-  }
-}
+using test::add_grid;
+using test::non_manifold_edges;
+using test::repeated_directed_edges;
 
 /// Three sources with every kind of seam, all crossing the line y = 0.5: source 0 and,
 /// 4 cm beyond its side x = 2, a coarser source 1 (zippered); 1.5 cm beyond source 1's side
@@ -103,22 +84,6 @@ bool contains_all(const std::multiset<Corners>& all, const std::multiset<Corners
   return std::includes(all.begin(), all.end(), part.begin(), part.end());
 }
 
-/// Edges used by more than two triangles, and directed edges used twice.
-std::size_t topology_faults(const Mesh& m) {
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> undirected, directed;
-  for (const Triangle& t : m.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-      ++undirected[{std::min(a, b), std::max(a, b)}];
-      ++directed[{a, b}];
-    }
-  }
-  std::size_t faults = 0;
-  for (const auto& [e, n] : undirected) faults += n > 2 ? 1 : 0;
-  for (const auto& [e, n] : directed) faults += n > 1 ? 1 : 0;
-  return faults;
-}
-
 std::size_t flipped_or_flat(const Mesh& m) {
   std::size_t bad = 0;
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
@@ -167,9 +132,11 @@ TEST(StitchParts, TwoPartsLeaveWhatIsFrozenAsItWasAndCloseTheSeamsAsTheWholeDoes
   ASSERT_TRUE(contains_all(triangles_of(m, [](std::size_t) { return true; }), part1_output))
       << "part 2 changed part 1's output";
 
-  EXPECT_EQ(topology_faults(m.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
   EXPECT_EQ(flipped_or_flat(m.mesh), 0u);
-  EXPECT_EQ(topology_faults(whole.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(whole.mesh), 0u);
+  EXPECT_EQ(repeated_directed_edges(whole.mesh), 0u);
   // Unstitched: the outline of each piece, about 24 m; at once: mostly the union's outline.
   const double closed_at_once = at_once.open_boundary_before - at_once.open_boundary_after;
   const double closed_in_parts = first.open_boundary_before - second.open_boundary_after;
@@ -204,7 +171,8 @@ TEST(StitchParts, AFreeVertexSnapsOntoAFrozenOne) {
   }
   EXPECT_GE(moved_onto, 20u);
   EXPECT_LT(s.open_boundary_after, s.open_boundary_before - 1.9);
-  EXPECT_EQ(topology_faults(m.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
 }
 
 TEST(StitchParts, ClippingCutsOnlyFreeTriangles) {
@@ -216,18 +184,15 @@ TEST(StitchParts, ClippingCutsOnlyFreeTriangles) {
     add_grid(m, 0.85f, 0.2f, 6, 4, 0.1f, 0, 0.05f);
     return m;
   };
-  MergedMesh small_frozen = pieces();
-  const std::vector<std::uint8_t> frozen0 =
-      roles_for(small_frozen, [&](std::size_t t) { return small_frozen.source_acq[t] == 1; }, kDone);
-  const StitchStats a = stitch(small_frozen, {.snap = 0.02, .reach = 0.02, .weld = 0.005, .clip = 0.1},
-                               {.vertex_roles = frozen0});
+  // Stitched with the triangles of source `done` as output stitched before.
+  const auto with_done = [&](std::int32_t done) {
+    MergedMesh m = pieces();
+    const std::vector<std::uint8_t> roles = roles_for(m, [&](std::size_t t) { return m.source_acq[t] != done; }, kDone);
+    return stitch(m, {.snap = 0.02, .reach = 0.02, .weld = 0.005, .clip = 0.1}, {.vertex_roles = roles});
+  };
+  const StitchStats a = with_done(0);
   EXPECT_EQ(a.triangles_clipped + a.triangles_uncovered, 0u);
-
-  MergedMesh large_frozen = pieces();
-  const std::vector<std::uint8_t> frozen1 =
-      roles_for(large_frozen, [&](std::size_t t) { return large_frozen.source_acq[t] == 0; }, kDone);
-  const StitchStats b = stitch(large_frozen, {.snap = 0.02, .reach = 0.02, .weld = 0.005, .clip = 0.1},
-                               {.vertex_roles = frozen1});
+  const StitchStats b = with_done(1);
   EXPECT_GT(b.triangles_clipped + b.triangles_uncovered, 0u);
 
   // Precedence follows the sizes given: with source 0 said to be the larger, source 1 yields.

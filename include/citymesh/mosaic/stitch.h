@@ -48,6 +48,11 @@ enum class VertexRole : std::uint8_t {
   later = 2,
 };
 
+/// The role of vertex v in `roles` (a StitchSurroundings::vertex_roles): free past its end.
+inline VertexRole role_of(std::span<const std::uint8_t> roles, std::uint32_t v) {
+  return v < roles.size() ? static_cast<VertexRole>(roles[v]) : VertexRole::free;
+}
+
 /// What a seam pass over one part of an output needs to know of the rest.
 struct StitchSurroundings {
   /// Per vertex of the mesh (VertexRole; vertices past its end are free). Triangles whose

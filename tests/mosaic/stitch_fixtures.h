@@ -1,0 +1,53 @@
+// SPDX-License-Identifier: MIT
+// Meshes and checks shared by the stitching tests.
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <map>
+#include <utility>
+
+#include "citymesh/core/mesh.h"
+#include "citymesh/mosaic/merged_mesh.h"
+
+namespace citymesh::test {
+
+/// A flat grid of nx x ny cells of size `step` at x0, split into triangles, normals +z
+/// (counter-clockwise seen from above), appended to `out` with source `source`.
+inline void add_grid(MergedMesh& out, float x0, float y0, int nx, int ny, float step, std::int32_t source, float z = 0) {
+  const auto base = static_cast<std::uint32_t>(out.mesh.positions.size());
+  for (int j = 0; j <= ny; ++j) {
+    for (int i = 0; i <= nx; ++i) out.mesh.positions.push_back({x0 + float(i) * step, y0 + float(j) * step, z});
+  }
+  const auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (nx + 1) + i); };
+  for (int j = 0; j < ny; ++j) {
+    for (int i = 0; i < nx; ++i) {
+      for (const Triangle& t : {Triangle{id(i, j), id(i + 1, j), id(i + 1, j + 1)}, Triangle{id(i, j), id(i + 1, j + 1), id(i, j + 1)}}) {
+        out.mesh.triangles.push_back(t);
+        out.mesh.triangle_ids.push_back({});
+        out.source_acq.push_back(source);
+        out.source_triangle.push_back(static_cast<std::int32_t>(out.source_triangle.size()));
+      }
+    }
+  }
+}
+
+/// Edges used by more than two triangles.
+inline std::size_t non_manifold_edges(const Mesh& m) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const Triangle& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+  }
+  return static_cast<std::size_t>(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 2; }));
+}
+
+/// Directed edges used by more than one triangle (a fold, or an orientation flip).
+inline std::size_t repeated_directed_edges(const Mesh& m) {
+  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
+  for (const Triangle& t : m.triangles) {
+    for (int k = 0; k < 3; ++k) ++uses[{t[k], t[(k + 1) % 3]}];
+  }
+  return static_cast<std::size_t>(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 1; }));
+}
+
+}  // namespace citymesh::test
