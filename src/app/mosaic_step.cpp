@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <iostream>
 
 #include "citymesh/core/error.h"
@@ -13,6 +14,7 @@
 #include "citymesh/mosaic/merged_mesh.h"
 #include "citymesh/mosaic/mosaic.h"
 #include "citymesh/mosaic/stitch.h"
+#include "citymesh/mosaic/stitch_blocks.h"
 #include "detect_output.h"
 #include "face_table.h"
 #include "mosaic_eval.h"
@@ -30,22 +32,47 @@ MosaicSelection select(const Config& config, const LoadedAcquisitions& input, co
   return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in) : select_mosaic(in, config.mosaic);
 }
 
+StitchParams stitch_params(const Config& config) {
+  const double reach = config.mosaic.stitch_reach * config.change.distance_threshold;
+  return {.snap = reach,
+          .reach = reach,
+          .weld = kWeldInThresholds * config.change.distance_threshold,
+          .clip = config.mosaic.clip_overlaps ? config.mosaic.clip_reach * config.change.distance_threshold : 0.0,
+          .clip_angle = config.mosaic.clip_angle,
+          .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0};
+}
+
+/// Stitches block by block on the tile grid, bands as narrow as the stitching's reach allows.
+BlockStitchStats stitch_on_tile_grid(const Config& config, MergedMesh& merged, const StitchParams& params) {
+  const BlockStitchParams blocks{.origin_x = config.tiling.origin[0] - merged.mesh.origin.x,
+                                 .origin_y = config.tiling.origin[1] - merged.mesh.origin.y,
+                                 .size = config.tiling.tile_size,
+                                 .band = block_context(params)};
+  if (!(4 * blocks.band < blocks.size)) {
+    throw InputError(fmt::format("[run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m "
+                                 "(the stitching's reach); use tiles over {:.0f} m or seam_pass = \"whole\"",
+                                 blocks.size, blocks.band, std::ceil(4 * blocks.band)));
+  }
+  const BlockStitchStats s = stitch_in_blocks(merged, params, blocks);
+  std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
+                           "triangles with its surroundings\n",
+                           s.parts[0], s.parts[1], s.parts[2], s.parts[3], s.largest_part);
+  return s;
+}
+
 }  // namespace
 
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
-  const double reach = config.mosaic.stitch_reach * config.change.distance_threshold;
-  const StitchStats s = stitch(merged, {.snap = reach,
-                                        .reach = reach,
-                                        .weld = kWeldInThresholds * config.change.distance_threshold,
-                                        .clip = config.mosaic.clip_overlaps ? config.mosaic.clip_reach * config.change.distance_threshold : 0.0,
-                                        .clip_angle = config.mosaic.clip_angle,
-                                        .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0});
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope) {
+  const StitchParams params = stitch_params(config);
+  BlockStitchStats blocks;
+  const StitchStats s = scope == StitchScope::tile_blocks ? (blocks = stitch_on_tile_grid(config, merged, params)).stitch
+                                                          : stitch(merged, params);
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
       s.triangles_clipped, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added, s.open_boundary_before,
       s.open_boundary_after);
-  return {{"open_boundary_before_m", s.open_boundary_before},
+  nlohmann::json report{{"open_boundary_before_m", s.open_boundary_before},
           {"open_boundary_after_m", s.open_boundary_after},
           {"triangles_clipped", s.triangles_clipped},
           {"triangles_uncovered", s.triangles_uncovered},
@@ -57,6 +84,10 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
           {"vertices_welded", s.vertices_welded},
           {"rejected", s.rejected},
           {"seconds", s.seconds}};
+  if (scope == StitchScope::tile_blocks) {
+    report["by_blocks"] = {{"parts", blocks.parts}, {"largest_part_triangles", blocks.largest_part}};
+  }
+  return report;
 }
 
 namespace {

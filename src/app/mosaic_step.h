@@ -17,9 +17,13 @@ namespace citymesh::app {
 void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
                      const PictureOptions& pictures, nlohmann::json seconds);
 
+/// How the output is stitched: at once, or block by block on the tile grid (a tiled run with
+/// `[run] seam_pass = "blocks"`).
+enum class StitchScope { whole, tile_blocks };
+
 /// Stitches `merged` with the config's reach and weld, prints a line and returns the figures
 /// for the summary.
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged);
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope = StitchScope::whole);
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

@@ -134,7 +134,10 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
   // like seams inside a tile.
   const nlohmann::json stitched = config.mosaic.method == MosaicMethod::energy
-                                      ? stitch_and_report(config, merged)
+                                      ? stitch_and_report(config, merged,
+                                                          config.run.seam_pass == SeamPass::blocks
+                                                              ? StitchScope::tile_blocks
+                                                              : StitchScope::whole)
                                       : nlohmann::json::object();
   stage_done("stitch");
   MosaicStats stats;

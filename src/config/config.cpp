@@ -14,6 +14,8 @@
 
 namespace citymesh {
 
+std::string_view seam_pass_name(SeamPass p) { return p == SeamPass::blocks ? "blocks" : "whole"; }
+
 using namespace config_detail;
 
 namespace {

@@ -284,6 +284,10 @@ std::vector<KeyDef> make_keys() {
         c.run.memory = bytes;
       },
       [](const Config& c) { return toml_string(format_byte_size(c.run.memory)); }});
+  keys.push_back(enum_key(run, "seam_pass",
+      "how a tiled run's final pass stitches the output: whole (at once) or blocks (block by block on the tile "
+      "grid, in parallel; see docs/mosaic.md)",
+      [](auto& c) -> auto& { return c.run.seam_pass; }, {SeamPass::whole, SeamPass::blocks}, seam_pass_name));
 
   keys.push_back(bool_key(output, "tiles_3d", "write a 3D Tiles tileset with Draco-compressed glb tiles",
       [](auto& c) -> auto& { return c.output.tiles_3d; }));

@@ -228,8 +228,7 @@ void gather(std::vector<T>& v, std::span<const std::uint32_t> from) {
 
 /// Replaces each triangle in place by its uncovered part (nothing when covered whole).
 ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& covered,
-                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut,
-                          std::span<const std::uint8_t> roles) {
+                          const std::unordered_map<std::uint64_t, std::uint32_t>& cut, const StitchSurroundings& around) {
   Mesh& m = merged.mesh;
   ClipStats stats;
   std::vector<Triangle> triangles;
@@ -239,7 +238,11 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const Triangle& tri = m.triangles[t];
     const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
-    if (corners_covered == 0 || of_other_parts(tri, roles)) {
+    // A triangle of this part on other parts' vertices cannot be cut (its edges are theirs
+    // too), but covered whole it goes: no later part would take it away.
+    const bool own = around.first_own_triangle && t >= *around.first_own_triangle;
+    const bool stays_whole = of_other_parts(tri, around.vertex_roles) && !(own && corners_covered == 3);
+    if (corners_covered == 0 || stays_whole) {
       triangles.push_back(tri);  // nearly every triangle of a city: no polygon built
       from.push_back(static_cast<std::uint32_t>(t));
     } else if (corners_covered == 3) {
@@ -284,7 +287,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
   const std::size_t before = m.vertex_count();
   const auto vertex_of = add_cut_vertices(m, cuts);
   covered.resize(m.vertex_count(), 0);  // the cuts are where the cover ends: uncovered
-  ClipStats stats = replace_covered(merged, covered, vertex_of, around.vertex_roles);
+  ClipStats stats = replace_covered(merged, covered, vertex_of, around);
   stats.vertices_added = m.vertex_count() - before;
   return stats;
 }

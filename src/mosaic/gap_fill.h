@@ -12,6 +12,9 @@
 
 namespace citymesh::mosaic_detail {
 
+/// The longest gap stitching closes, in gap widths: 2 m around at 10 cm, a crack, not a window.
+constexpr double kGapPerimeterInWidths = 20.0;
+
 struct GapFillParams {
   double max_width = 0.1;       ///< metres: twice the area over the perimeter (a strip's width)
   double max_perimeter = 2.0;   ///< metres

@@ -45,4 +45,14 @@ MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& 
   return out;
 }
 
+std::vector<std::uint64_t> source_sizes(const MergedMesh& m) {
+  std::vector<std::uint64_t> sizes;
+  for (const std::int32_t s : m.source_acq) {
+    if (s < 0) continue;
+    if (sizes.size() <= static_cast<std::size_t>(s)) sizes.resize(static_cast<std::size_t>(s) + 1, 0);
+    ++sizes[static_cast<std::size_t>(s)];
+  }
+  return sizes;
+}
+
 }  // namespace citymesh

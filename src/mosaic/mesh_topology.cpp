@@ -7,9 +7,11 @@
 
 namespace citymesh::mosaic_detail {
 
-MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles)
+MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles,
+                           std::optional<std::size_t> first_own_triangle)
     : merged_(merged),
       roles_(roles),
+      first_own_(first_own_triangle),
       offsets_(merged.mesh.vertex_count() + 1, 0),
       edited_(merged.mesh.vertex_count(), UINT32_MAX) {
   const auto& triangles = merged.mesh.triangles;
@@ -25,9 +27,12 @@ MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> rol
 }
 
 bool MeshTopology::joinable(std::uint32_t v) const {
-  if (role_of(roles_, v) != VertexRole::later) return true;
+  const VertexRole role = role_of(roles_, v);
+  if (role == VertexRole::held) return false;
+  if (role != VertexRole::later) return true;
   const std::span<const std::uint32_t> around = triangles_of(v);
-  return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return !frozen_triangle(t); });
+  return std::any_of(around.begin(), around.end(),
+                     [&](std::uint32_t t) { return (first_own_ && t >= *first_own_) || !frozen_triangle(t); });
 }
 
 std::span<const std::uint32_t> MeshTopology::triangles_of(std::uint32_t v) const {
@@ -81,6 +86,12 @@ bool MeshTopology::edges_free(std::span<const Triangle> tris, std::span<const st
 std::int32_t MeshTopology::source_of_vertex(std::uint32_t v) const {
   const std::span<const std::uint32_t> around = triangles_of(v);
   return around.empty() ? kNoSource : merged_.source_acq[around.front()];
+}
+
+double MeshTopology::boundary_length() const {
+  double total = 0;
+  for (const EdgeUse& e : boundary_edges()) total += norm(position(e.lo) - position(e.hi));
+  return total;
 }
 
 std::vector<EdgeUse> MeshTopology::boundary_edges() const {

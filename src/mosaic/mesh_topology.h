@@ -25,8 +25,9 @@ struct DirectedEdge {
 class MeshTopology {
  public:
   /// `roles`: per vertex, a VertexRole (vertices past its end are free); the caller keeps it
-  /// alive.
-  explicit MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles = {});
+  /// alive. `first_own_triangle`: where the part's own triangles start (StitchSurroundings).
+  explicit MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles = {},
+                        std::optional<std::size_t> first_own_triangle = {});
 
   [[nodiscard]] MergedMesh& merged() const { return merged_; }
   [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
@@ -39,8 +40,9 @@ class MeshTopology {
 
   /// Whether v must stay where and what it is (a vertex of a part stitched before or after).
   [[nodiscard]] bool frozen(std::uint32_t v) const { return role_of(roles_, v) != VertexRole::free; }
-  /// Whether seams may be joined to v: not a vertex of a part stitched afterwards, unless
-  /// this part's triangles use it too (it lies on the border between the two).
+  /// Whether seams may be joined to v: not a held vertex, nor one of a part stitched
+  /// afterwards unless this part's triangles use it too (it lies on the border between the
+  /// two): a triangle with a free corner, or any of the part's own when they are told.
   [[nodiscard]] bool joinable(std::uint32_t v) const;
   /// Whether triangle t must stay as it is: its three corners are frozen. (A free triangle
   /// whose corners all happen to be frozen is kept as it is too: nothing it could become
@@ -69,6 +71,8 @@ class MeshTopology {
   /// The edges used by exactly one triangle, sorted as boundary_edges() sorts them (which
   /// gives the same list, from the lists around each vertex instead of a sort of every edge).
   [[nodiscard]] std::vector<EdgeUse> boundary_edges() const;
+  /// Total length of boundary_edges() (open_boundary_length() without sorting every edge).
+  [[nodiscard]] double boundary_length() const;
   /// The directed edges whose reverse no triangle uses, oriented as their triangle runs
   /// them, in triangle order: the boundary that snapping walks and gap closing follows.
   [[nodiscard]] std::vector<DirectedEdge> boundary_half_edges() const;
@@ -76,6 +80,7 @@ class MeshTopology {
  private:
   MergedMesh& merged_;
   std::span<const std::uint8_t> roles_;
+  std::optional<std::size_t> first_own_;
   std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
   std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
   std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows

@@ -240,8 +240,6 @@ void weld(StitchContext& c) {
 
 namespace {
 
-constexpr double kGapPerimeterInWidths = 20.0;  // 2 m around at 10 cm: a crack, not a window
-
 double length_of(const Mesh& m, std::span<const EdgeUse> edges) {
   double total = 0;
   for (const EdgeUse& e : edges) total += norm(position(m, e.lo) - position(m, e.hi));
@@ -261,8 +259,9 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
-  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around.vertex_roles);
-  const double before = length_of(merged.mesh, unclipped->boundary_edges());
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around.vertex_roles,
+                                                                around.first_own_triangle);
+  const double before = unclipped->boundary_length();
   phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
@@ -270,7 +269,8 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
     clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle}, around);
   }
   phase_done("clipped");
-  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged, around.vertex_roles);
+  mosaic_detail::MeshTopology& topo =
+      unclipped ? *unclipped : unclipped.emplace(merged, around.vertex_roles, around.first_own_triangle);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   phase_done("snapped");
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};
@@ -294,7 +294,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   phase_done("zippered");
   if (params.gap > 0) {
     const mosaic_detail::GapFillStats gaps =
-        mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = kGapPerimeterInWidths * params.gap});
+        mosaic_detail::fill_seam_gaps(topo, {.max_width = params.gap, .max_perimeter = mosaic_detail::kGapPerimeterInWidths * params.gap});
     c.stats.gaps_filled = gaps.gaps_filled + gaps.gaps_split;
     c.stats.triangles_added += gaps.triangles_added;
   }
@@ -304,7 +304,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   // From fresh incidence lists (the weld merged vertices and dropped collapsed triangles, so
   // topo's lists are stale): sorting every edge of a city's output instead took a third of
   // the pass. open_boundary_length() stays the sort-based reference the tests compare with.
-  c.stats.open_boundary_after = length_of(merged.mesh, mosaic_detail::MeshTopology(merged).boundary_edges());
+  c.stats.open_boundary_after = mosaic_detail::MeshTopology(merged).boundary_length();
   c.stats.seconds = clock.seconds();
   return c.stats;
 }

@@ -3,10 +3,13 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <utility>
 
+#include "citymesh/core/geometry.h"
 #include "citymesh/core/mesh.h"
 #include "citymesh/mosaic/merged_mesh.h"
 
@@ -48,6 +51,41 @@ inline std::size_t repeated_directed_edges(const Mesh& m) {
     for (int k = 0; k < 3; ++k) ++uses[{t[k], t[(k + 1) % 3]}];
   }
   return static_cast<std::size_t>(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 1; }));
+}
+
+/// A triangle by its corners' positions, to find it again after indices changed.
+using Corners = std::array<std::array<float, 3>, 3>;
+
+inline Corners corners_of(const MergedMesh& m, std::size_t t) {
+  Corners c{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const Vec3f p = m.mesh.positions[m.mesh.triangles[t][k]];
+    c[k] = {p.x, p.y, p.z};
+  }
+  return c;
+}
+
+template <class Chosen>
+inline std::multiset<Corners> triangles_of(const MergedMesh& m, Chosen chosen) {
+  std::multiset<Corners> out;
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (chosen(t)) out.insert(corners_of(m, t));
+  }
+  return out;
+}
+
+inline bool contains_all(const std::multiset<Corners>& all, const std::multiset<Corners>& part) {
+  return std::includes(all.begin(), all.end(), part.begin(), part.end());
+}
+
+/// Triangles facing down or of no area (every fixture faces +z).
+inline std::size_t flipped_or_flat(const Mesh& m) {
+  std::size_t bad = 0;
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const TriangleCorners c = m.corners(t);
+    bad += cross(c[1] - c[0], c[2] - c[0]).z > 1e-9 ? 0 : 1;
+  }
+  return bad;
 }
 
 }  // namespace citymesh::test

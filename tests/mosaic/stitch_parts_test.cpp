@@ -16,6 +16,11 @@ namespace citymesh {
 namespace {
 
 using test::add_grid;
+using test::contains_all;
+using test::corners_of;
+using test::Corners;
+using test::flipped_or_flat;
+using test::triangles_of;
 using test::non_manifold_edges;
 using test::repeated_directed_edges;
 
@@ -33,16 +38,6 @@ MergedMesh scene() {
 
 const StitchParams kParams{.snap = 0.02, .reach = 0.2, .weld = 0.005, .clip = 0.1, .gap = 0.1};
 
-std::vector<std::uint64_t> source_sizes(const MergedMesh& m) {
-  std::vector<std::uint64_t> sizes;
-  for (const std::int32_t s : m.source_acq) {
-    if (s < 0) continue;
-    if (sizes.size() <= static_cast<std::size_t>(s)) sizes.resize(static_cast<std::size_t>(s) + 1, 0);
-    ++sizes[static_cast<std::size_t>(s)];
-  }
-  return sizes;
-}
-
 constexpr auto kFree = static_cast<std::uint8_t>(VertexRole::free);
 constexpr auto kDone = static_cast<std::uint8_t>(VertexRole::done);
 constexpr auto kLater = static_cast<std::uint8_t>(VertexRole::later);
@@ -57,40 +52,6 @@ std::vector<std::uint8_t> roles_for(const MergedMesh& m, OfPart of_part, std::ui
     for (const std::uint32_t v : m.mesh.triangles[t]) roles[v] = others;
   }
   return roles;
-}
-
-/// A triangle by its corners' positions, to find it again after indices changed.
-using Corners = std::array<std::array<float, 3>, 3>;
-
-Corners corners_of(const MergedMesh& m, std::size_t t) {
-  Corners c{};
-  for (std::size_t k = 0; k < 3; ++k) {
-    const Vec3f p = m.mesh.positions[m.mesh.triangles[t][k]];
-    c[k] = {p.x, p.y, p.z};
-  }
-  return c;
-}
-
-template <class Chosen>
-std::multiset<Corners> triangles_of(const MergedMesh& m, Chosen chosen) {
-  std::multiset<Corners> out;
-  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
-    if (chosen(t)) out.insert(corners_of(m, t));
-  }
-  return out;
-}
-
-bool contains_all(const std::multiset<Corners>& all, const std::multiset<Corners>& part) {
-  return std::includes(all.begin(), all.end(), part.begin(), part.end());
-}
-
-std::size_t flipped_or_flat(const Mesh& m) {
-  std::size_t bad = 0;
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    const TriangleCorners c = m.corners(t);
-    bad += cross(c[1] - c[0], c[2] - c[0]).z > 1e-9 ? 0 : 1;
-  }
-  return bad;
 }
 
 double centroid_y(const MergedMesh& m, std::size_t t) {

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "citymesh/change/change_params.h"
@@ -45,9 +46,19 @@ struct TilingParams {
   std::array<double, 2> origin{0.0, 0.0};
 };
 
+/// How a tiled run's final pass stitches the output.
+enum class SeamPass {
+  whole,   ///< the whole output at once
+  blocks,  ///< block by block on the tile grid, the parts of each level in parallel (stitch_in_blocks)
+};
+
+/// "whole" or "blocks".
+std::string_view seam_pass_name(SeamPass p);
+
 struct RunParams {
   unsigned threads = 0;  ///< 0: all cores
   std::uint64_t memory = 2ull << 30;
+  SeamPass seam_pass = SeamPass::whole;
 };
 
 struct OutputParams {

@@ -61,6 +61,11 @@ struct Box3d {
   [[nodiscard]] bool contains(const Vec3d& p) const {
     return min.x <= p.x && p.x <= max.x && min.y <= p.y && p.y <= max.y && min.z <= p.z && p.z <= max.z;
   }
+  /// Whether the two closed boxes share a point (never for an empty one).
+  [[nodiscard]] bool intersects(const Box3d& b) const {
+    return min.x <= b.max.x && b.min.x <= max.x && min.y <= b.max.y && b.min.y <= max.y && min.z <= b.max.z &&
+           b.min.z <= max.z;
+  }
   /// The box grown by pad on every side; an empty box stays empty.
   [[nodiscard]] Box3d grown(double pad) const {
     if (empty()) return *this;

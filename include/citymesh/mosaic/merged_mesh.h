@@ -26,4 +26,7 @@ struct MergedMesh {
 MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& index,
                            std::span<const std::uint8_t> selected);
 
+/// Per source acquisition, its triangles in `m` (stitch triangles not counted).
+std::vector<std::uint64_t> source_sizes(const MergedMesh& m);
+
 }  // namespace citymesh

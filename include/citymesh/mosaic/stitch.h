@@ -4,7 +4,9 @@
 // them (zippering), and vertices closer than a small tolerance are merged.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 
 #include "citymesh/mosaic/merged_mesh.h"
@@ -46,6 +48,10 @@ enum class VertexRole : std::uint8_t {
   /// around it may be cut back from it; seams are joined to it only where this part's
   /// triangles use it too (on the border between the two parts), the rest is that part's
   later = 2,
+  /// of this part and of a part stitched at the same time, or on the edge of what a part
+  /// sees of the output: stays where it is, no seam joins it (the part stitched after both
+  /// does); the free triangles around it may be cut back from it
+  held = 3,
 };
 
 /// The role of vertex v in `roles` (a StitchSurroundings::vertex_roles): free past its end.
@@ -64,6 +70,11 @@ struct StitchSurroundings {
   /// Per source: its triangles in the whole output, which decide who yields where two
   /// overlap (clipping); empty: counted in the mesh itself.
   std::span<const std::uint64_t> source_sizes = {};
+  /// Where the part's own triangles start, when the mesh holds the other parts' first (done
+  /// or later); unset: the part's triangles are told by their vertices alone. Told, a
+  /// triangle of the part whose corners are all frozen is still removed when a larger
+  /// source covers it whole (no part after it could).
+  std::optional<std::size_t> first_own_triangle = {};
 };
 
 /// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
