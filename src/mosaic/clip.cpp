@@ -51,18 +51,12 @@ VertexFrames vertex_frames(const MergedMesh& merged) {
 /// smaller pieces are cut back to the larger ones), on a tie the earlier acquisition.
 /// `sizes`: per source, its triangles in the whole output when the mesh is only part of it.
 std::vector<std::uint64_t> source_precedence(const MergedMesh& merged, std::span<const std::uint64_t> sizes) {
-  std::vector<std::uint64_t> count(sizes.begin(), sizes.end());
+  const std::vector<std::uint64_t> count = sizes.empty() ? source_sizes(merged)
+                                                         : std::vector<std::uint64_t>(sizes.begin(), sizes.end());
   for (const std::int32_t s : merged.source_acq) {
-    if (s < 0) continue;
-    const auto k = static_cast<std::size_t>(s);
-    if (!sizes.empty()) {
-      if (k >= sizes.size()) {
-        throw ProcessingError(fmt::format("clipping: source {} has no size among the {} given", s, sizes.size()));
-      }
-      continue;
+    if (s >= 0 && static_cast<std::size_t>(s) >= count.size()) {
+      throw ProcessingError(fmt::format("clipping: source {} has no size among the {} given", s, sizes.size()));
     }
-    if (count.size() <= k) count.resize(k + 1, 0);
-    ++count[k];
   }
   std::vector<std::uint64_t> precedence(count.size());
   for (std::size_t k = 0; k < count.size(); ++k) precedence[k] = count[k] * count.size() + k;

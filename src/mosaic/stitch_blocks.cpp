@@ -183,17 +183,6 @@ class PartCutter {
   std::unordered_map<std::uint32_t, Use> vertices_;  ///< per vertex of the whole mesh used
 };
 
-/// Per vertex of `whole`, the triangles of every part using it.
-std::vector<std::uint32_t> vertex_uses(const Mesh& whole, const std::vector<Part>& parts) {
-  std::vector<std::uint32_t> uses(whole.vertex_count(), 0);
-  for (const Part& part : parts) {
-    for (const Triangle& tri : part.triangles) {
-      for (const std::uint32_t v : tri) ++uses[v];
-    }
-  }
-  return uses;
-}
-
 /// Part `index` with every triangle of the other parts within `context` of it: those of done
 /// parts as output stitched before, the others as parts stitched later.
 PartMesh cut_out(const Mesh& whole, std::span<const std::uint32_t> uses, const std::vector<Part>& parts,
@@ -232,10 +221,19 @@ StitchStats stitch_part(PartMesh& cut, const StitchParams& params, std::span<con
   return stats;
 }
 
+/// Adds `step` to the uses of every corner of `triangles`.
+void count_uses(std::span<const Triangle> triangles, int step, std::vector<std::uint32_t>& uses) {
+  for (const Triangle& tri : triangles) {
+    for (const std::uint32_t v : tri) uses[v] += static_cast<std::uint32_t>(step);
+  }
+}
+
 /// Puts a stitched part back: its free vertices where stitching moved them, its new
-/// vertices at the end of the whole mesh, its triangles in place of its input.
-void splice(Mesh& whole, Part& part, const PartMesh& cut) {
+/// vertices at the end of the whole mesh, its triangles in place of its input (`uses`
+/// follows: per vertex of the whole mesh, the triangles of every part using it).
+void splice(Mesh& whole, std::vector<std::uint32_t>& uses, Part& part, const PartMesh& cut) {
   const Mesh& m = cut.merged.mesh;
+  count_uses(part.triangles, -1, uses);
   std::vector<std::uint32_t> to_whole(m.vertex_count());
   for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
     if (v < cut.whole_vertex.size()) {
@@ -244,6 +242,7 @@ void splice(Mesh& whole, Part& part, const PartMesh& cut) {
     } else {
       to_whole[v] = static_cast<std::uint32_t>(whole.vertex_count());
       append_vertex(m, v, whole);
+      uses.push_back(0);
     }
   }
   const PartKey key = part.key;
@@ -254,6 +253,7 @@ void splice(Mesh& whole, Part& part, const PartMesh& cut) {
     for (std::uint32_t& v : tri) v = to_whole[v];
     add_triangle(part, whole, tri, m.triangle_ids[t], cut.merged.source_acq[t], cut.merged.source_triangle[t]);
   }
+  count_uses(part.triangles, +1, uses);
 }
 
 void add_counts(StitchStats& total, const StitchStats& s) {
@@ -268,6 +268,14 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.rejected += s.rejected;
 }
 
+/// What every level works on: the output (its vertices; the parts hold its triangles) and
+/// per vertex, the triangles of every part using it (kept up to date as parts are spliced).
+struct Output {
+  Mesh& whole;
+  std::vector<Part> parts;
+  std::vector<std::uint32_t> uses;
+};
+
 struct LevelRun {
   const StitchParams& params;
   std::span<const std::uint64_t> sizes;
@@ -281,25 +289,25 @@ constexpr std::size_t kPartsInFlight = 8;
 /// spliced back in part order. They are marked done once the whole level is (until then
 /// the parts of the level see each other's vertices as held), so the output is the same
 /// for any thread count.
-void stitch_level(Mesh& whole, std::vector<Part>& parts, int level, const LevelRun& run, BlockStitchStats& stats) {
+void stitch_level(Output& out, int level, const LevelRun& run, BlockStitchStats& stats) {
+  std::vector<Part>& parts = out.parts;
   std::vector<std::size_t> of_level;
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (parts[i].key.level == level) of_level.push_back(i);
   }
   for (std::size_t first = 0; first < of_level.size(); first += kPartsInFlight) {
     const std::size_t count = std::min(kPartsInFlight, of_level.size() - first);
-    const std::vector<std::uint32_t> uses = vertex_uses(whole, parts);
     std::vector<std::optional<PartMesh>> cuts(count);
     std::vector<StitchStats> part_stats(count);
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        cuts[i] = cut_out(whole, uses, parts, of_level[first + i], run.context);
+        cuts[i] = cut_out(out.whole, out.uses, parts, of_level[first + i], run.context);
         part_stats[i] = stitch_part(*cuts[i], run.params, run.sizes);
       }
     });
     for (std::size_t i = 0; i < count; ++i) {
       stats.largest_part = std::max(stats.largest_part, cuts[i]->merged.mesh.triangle_count());
-      splice(whole, parts[of_level[first + i]], *cuts[i]);
+      splice(out.whole, out.uses, parts[of_level[first + i]], *cuts[i]);
       cuts[i].reset();
       add_counts(stats.stitch, part_stats[i]);
     }
@@ -346,7 +354,8 @@ BlockStitchStats stitch_in_blocks(MergedMesh& mesh, const StitchParams& params, 
   BlockStitchStats stats;
   stats.stitch.open_boundary_before = mosaic_detail::MeshTopology(mesh).boundary_length();
   const std::vector<std::uint64_t> sizes = source_sizes(mesh);
-  std::vector<Part> parts = split_into_parts(mesh, blocks);
+  Output out{mesh.mesh, split_into_parts(mesh, blocks), std::vector<std::uint32_t>(mesh.mesh.vertex_count(), 0)};
+  count_uses(mesh.mesh.triangles, +1, out.uses);
   // The parts hold the triangles now (the output is gathered from them at the end).
   mesh.mesh.triangles = {};
   mesh.mesh.triangle_ids = {};
@@ -354,12 +363,12 @@ BlockStitchStats stitch_in_blocks(MergedMesh& mesh, const StitchParams& params, 
   mesh.source_triangle = {};
   const LevelRun run{params, sizes, context};
   for (int level = 0; level < kLevels; ++level) {
-    stitch_level(mesh.mesh, parts, level, run, stats);
+    stitch_level(out, level, run, stats);
     log::debug("stitch by blocks: level {} ({} parts) at {:.2f} s, resident {} MiB (peak {} MiB)", level,
                stats.parts[static_cast<std::size_t>(level)], clock.seconds(), resident_bytes() >> 20,
                peak_resident_bytes() >> 20);
   }
-  gather(mesh, parts);
+  gather(mesh, out.parts);
   stats.stitch.open_boundary_after = mosaic_detail::MeshTopology(mesh).boundary_length();
   stats.stitch.seconds = clock.seconds();
   return stats;
