@@ -44,15 +44,11 @@ StitchParams stitch_params(const Config& config) {
 
 /// Stitches block by block on the tile grid, bands as narrow as the stitching's reach allows.
 BlockStitchStats stitch_on_tile_grid(const Config& config, MergedMesh& merged, const StitchParams& params) {
+  check_seam_pass(config);
   const BlockStitchParams blocks{.origin_x = config.tiling.origin[0] - merged.mesh.origin.x,
                                  .origin_y = config.tiling.origin[1] - merged.mesh.origin.y,
                                  .size = config.tiling.tile_size,
                                  .band = block_context(params)};
-  if (!(4 * blocks.band < blocks.size)) {
-    throw InputError(fmt::format("[run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m "
-                                 "(the stitching's reach); use tiles over {:.0f} m or seam_pass = \"whole\"",
-                                 blocks.size, blocks.band, std::ceil(4 * blocks.band)));
-  }
   const BlockStitchStats s = stitch_in_blocks(merged, params, blocks);
   std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
                            "triangles with its surroundings\n",
@@ -61,6 +57,15 @@ BlockStitchStats stitch_on_tile_grid(const Config& config, MergedMesh& merged, c
 }
 
 }  // namespace
+
+void check_seam_pass(const Config& config) {
+  if (config.run.seam_pass != SeamPass::blocks || config.mosaic.method != MosaicMethod::energy) return;
+  const double band = block_context(stitch_params(config));
+  if (4 * band < config.tiling.tile_size) return;
+  throw ConfigError(fmt::format("{}: [run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m (the "
+                                "stitching's reach): tiling.tile_size must be over {:.2f} m, or use seam_pass = \"whole\"",
+                                config.file.string(), config.tiling.tile_size, band, 4 * band));
+}
 
 nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope) {
   const StitchParams params = stitch_params(config);

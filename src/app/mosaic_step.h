@@ -21,6 +21,10 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
 /// `[run] seam_pass = "blocks"`).
 enum class StitchScope { whole, tile_blocks };
 
+/// Throws InputError when `[run] seam_pass = "blocks"` and the tiles are too small for its bands.
+/// A tiled run checks it first, before hours of tiles, not only when the seam pass starts.
+void check_seam_pass(const Config& config);
+
 /// Stitches `merged` with the config's reach and weld, prints a line and returns the figures
 /// for the summary.
 nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope = StitchScope::whole);

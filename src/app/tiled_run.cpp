@@ -217,6 +217,7 @@ void run_subset(const Config& config, const TileStore& store, std::uint64_t fing
 
 void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cluster) {
   Stopwatch clock;
+  check_seam_pass(config);
   const auto keys = result_keys(config);
   if (cluster.root()) {
     check_run_config(config.project.work, keys, options.force);
@@ -238,6 +239,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
 }
 
 void merge_tiled(const Config& config, const PictureOptions& pictures) {
+  check_seam_pass(config);
   const auto keys = result_keys(config);
   check_run_config(config.project.work, keys, false);
   remove_leftovers_of_ended_runs(config);

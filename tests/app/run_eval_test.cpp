@@ -10,39 +10,13 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
-#include "citymesh/io/ply_reader.h"
+#include "mosaic_ply.h"
 #include "test_support.h"
 
 namespace citymesh {
 namespace {
 
 nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
-
-/// Edges of the PLY's faces used by more than two faces, and the source_acq values seen.
-std::pair<std::size_t, std::map<int, std::size_t>> inspect(const std::filesystem::path& ply) {
-  PlyReadParams params;
-  params.require_sensor_origin = false;
-  params.extra_face_properties = {"source_acq", "source_face"};
-  PlyReader reader(ply, params);
-  PlyVertexChunk vertices;
-  PlyFaceChunk faces;
-  std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;
-  std::map<int, std::size_t> sources;
-  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end; kind = reader.next(vertices, faces)) {
-    if (kind != PlyReader::ChunkKind::faces) continue;
-    for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
-      const Triangle& tri = faces.triangles[t];
-      for (int k = 0; k < 3; ++k) ++uses[{std::min(tri[k], tri[(k + 1) % 3]), std::max(tri[k], tri[(k + 1) % 3])}];
-      ++sources[static_cast<int>(faces.extras[0][t])];
-      if (faces.extras[0][t] < 0) {
-        EXPECT_EQ(faces.extras[1][t], -1.0);  // stitch triangles have no source face
-      }
-    }
-  }
-  const auto non_manifold =
-      static_cast<std::size_t>(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 2; }));
-  return {non_manifold, sources};
-}
 
 TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   test::TempDir dir;
@@ -102,7 +76,7 @@ TEST(RunEval, DefaultStreetMosaicMeetsItsTargetsAndBeatsTheBaseline) {
   EXPECT_GT(s["counts"]["filled"].get<std::uint64_t>(), 0u);
   EXPECT_GT(s["counts"]["seen_through"].get<std::uint64_t>(), 0u);
   EXPECT_GT(s["counts"]["candidates"].get<std::uint64_t>(), s["counts"]["selected"].get<std::uint64_t>());
-  const auto [non_manifold, sources] = inspect(dir / "sim/out/mosaic/mosaic.ply");
+  const auto [non_manifold, sources] = test::inspect_mosaic_ply(dir / "sim/out/mosaic/mosaic.ply");
   EXPECT_EQ(non_manifold, 0u);
   EXPECT_GT(sources.count(-1), 0u);  // stitch triangles
   EXPECT_GE(sources.size(), 3u);     // pieces of several acquisitions
