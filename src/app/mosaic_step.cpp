@@ -72,6 +72,7 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, Stitc
   BlockStitchStats blocks;
   const StitchStats s = scope == StitchScope::tile_blocks ? (blocks = stitch_on_tile_grid(config, merged, params)).stitch
                                                           : stitch(merged, params);
+  shrink_to_fit(merged);  // the outputs and the export that follow peak on top of it
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",

@@ -45,6 +45,19 @@ MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& 
   return out;
 }
 
+void shrink_to_fit(MergedMesh& m) {
+  Mesh& mesh = m.mesh;
+  mesh.positions.shrink_to_fit();
+  mesh.sensor_positions.shrink_to_fit();
+  mesh.times.shrink_to_fit();
+  mesh.intensities.shrink_to_fit();
+  mesh.colors.shrink_to_fit();
+  mesh.triangles.shrink_to_fit();
+  mesh.triangle_ids.shrink_to_fit();
+  m.source_acq.shrink_to_fit();
+  m.source_triangle.shrink_to_fit();
+}
+
 std::vector<std::uint64_t> source_sizes(const MergedMesh& m) {
   std::vector<std::uint64_t> sizes;
   for (const std::int32_t s : m.source_acq) {

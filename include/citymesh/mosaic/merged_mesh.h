@@ -26,6 +26,10 @@ struct MergedMesh {
 MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& index,
                            std::span<const std::uint8_t> selected);
 
+/// Hands back the room `m`'s arrays grew beyond their size (stitching appends to them: up to
+/// twice what they hold), so that later stages do not carry it.
+void shrink_to_fit(MergedMesh& m);
+
 /// Per source acquisition, its triangles in `m` (stitch triangles not counted).
 std::vector<std::uint64_t> source_sizes(const MergedMesh& m);
 
