@@ -8,6 +8,7 @@
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
 #include "command.h"
+#include "mosaic_step.h"
 
 namespace citymesh::app {
 
@@ -37,6 +38,7 @@ class ConfigCommand final : public Command {
     const std::string& file = !check_.empty() ? check_ : print_;
     if (file.empty()) throw UsageError("give --dump-defaults, --check FILE or --print FILE");
     const Config config = load_config(file, {.overrides = overrides_, .check_files = !no_file_check_});
+    check_seam_pass(config);  // what `run` would refuse at its start
     if (!print_.empty()) {
       std::cout << effective_config_toml(config);
       return;

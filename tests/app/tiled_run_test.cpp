@@ -119,6 +119,10 @@ TEST(TiledRun, SeamPassByBlocksScoresLikeWholeOnAnyThreadCount) {
   EXPECT_EQ(small.exit_code, 1);
   EXPECT_NE(small.err.find("tiling.tile_size must be over 15.00 m"), std::string::npos) << small.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "sim/work-s/tiles"));
+  const auto check =
+      test::run_citymesh(fmt::format("config --check {}/config.toml --set tiling.tile_size=8 --set run.seam_pass=blocks", sim));
+  EXPECT_EQ(check.exit_code, 1);
+  EXPECT_NE(check.err.find("tiling.tile_size must be over 15.00 m"), std::string::npos) << check.err;
 
   const std::string tiles = "--set tiling.tile_size=16";
   for (const auto& [name, extra] : {std::pair{"whole", " --threads 2"}, std::pair{"b1", " --set run.seam_pass=blocks --threads 1"},
