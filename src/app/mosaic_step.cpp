@@ -67,11 +67,11 @@ void check_seam_pass(const Config& config) {
                                 config.file.string(), config.tiling.tile_size, band, 4 * band));
 }
 
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope) {
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, SeamPass pass) {
   const StitchParams params = stitch_params(config);
   BlockStitchStats blocks;
-  const StitchStats s = scope == StitchScope::tile_blocks ? (blocks = stitch_on_tile_grid(config, merged, params)).stitch
-                                                          : stitch(merged, params);
+  const StitchStats s = pass == SeamPass::blocks ? (blocks = stitch_on_tile_grid(config, merged, params)).stitch
+                                                 : stitch(merged, params);
   shrink_to_fit(merged);  // the outputs and the export that follow peak on top of it
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
@@ -90,7 +90,7 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, Stitc
           {"vertices_welded", s.vertices_welded},
           {"rejected", s.rejected},
           {"seconds", s.seconds}};
-  if (scope == StitchScope::tile_blocks) {
+  if (pass == SeamPass::blocks) {
     report["by_blocks"] = {{"parts", blocks.parts}, {"largest_part_triangles", blocks.largest_part}};
   }
   return report;

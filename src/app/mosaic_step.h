@@ -17,17 +17,14 @@ namespace citymesh::app {
 void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
                      const PictureOptions& pictures, nlohmann::json seconds);
 
-/// How the output is stitched: at once, or block by block on the tile grid (a tiled run with
-/// `[run] seam_pass = "blocks"`).
-enum class StitchScope { whole, tile_blocks };
-
-/// Throws InputError when `[run] seam_pass = "blocks"` and the tiles are too small for its bands.
+/// Throws ConfigError when `[run] seam_pass = "blocks"` and the tiles are too small for its bands.
 /// A tiled run checks it first, before hours of tiles, not only when the seam pass starts.
 void check_seam_pass(const Config& config);
 
 /// Stitches `merged` with the config's reach and weld, prints a line and returns the figures
-/// for the summary.
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, StitchScope scope = StitchScope::whole);
+/// for the summary. `pass`: at once, or block by block on the tile grid (only a tiled run has
+/// one: it passes `[run] seam_pass`).
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, SeamPass pass = SeamPass::whole);
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

@@ -104,8 +104,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   const auto stage_done = [&](const char* stage) {
     release_freed_memory();
     seconds[stage] = clock.restart();
-    log::debug("final pass: {} done, resident {} MiB (peak {} MiB)", stage, resident_bytes() >> 20,
-               peak_resident_bytes() >> 20);
+    log::debug("final pass: {} done, {}", stage, memory_note());
   };
   // The pairs wait on disk (a city has 0.7 GB of them), in a folder of this process's own.
   TileAssembly assembly(store, config.output.labels ? std::optional(pair_spill_folder(config.project.work))
@@ -134,10 +133,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
   // like seams inside a tile.
   const nlohmann::json stitched = config.mosaic.method == MosaicMethod::energy
-                                      ? stitch_and_report(config, merged,
-                                                          config.run.seam_pass == SeamPass::blocks
-                                                              ? StitchScope::tile_blocks
-                                                              : StitchScope::whole)
+                                      ? stitch_and_report(config, merged, config.run.seam_pass)
                                       : nlohmann::json::object();
   stage_done("stitch");
   MosaicStats stats;

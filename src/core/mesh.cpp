@@ -39,6 +39,16 @@ double doubled_area(const Vec3d& a, const Vec3d& b, const Vec3d& c) {
   return norm(cross(b - a, c - a));
 }
 
+void Mesh::shrink_to_fit() {
+  positions.shrink_to_fit();
+  sensor_positions.shrink_to_fit();
+  times.shrink_to_fit();
+  intensities.shrink_to_fit();
+  colors.shrink_to_fit();
+  triangles.shrink_to_fit();
+  triangle_ids.shrink_to_fit();
+}
+
 void append_vertex(const Mesh& from, std::uint32_t v, Mesh& to) {
   to.positions.push_back(from.positions[v]);
   if (!from.sensor_positions.empty()) to.sensor_positions.push_back(from.sensor_positions[v]);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "citymesh/core/process_memory.h"
 
+#include <fmt/format.h>
+
 #include <fstream>
 #include <limits>
 #include <string>
@@ -30,6 +32,10 @@ std::uint64_t status_kib(const std::string& name) {
 
 std::uint64_t resident_bytes() { return status_kib("VmRSS"); }
 std::uint64_t peak_resident_bytes() { return status_kib("VmHWM"); }
+
+std::string memory_note() {
+  return fmt::format("resident {} MiB (peak {} MiB)", resident_bytes() >> 20, peak_resident_bytes() >> 20);
+}
 
 void keep_freed_memory_for_reuse() {
 #if defined(__GLIBC__)

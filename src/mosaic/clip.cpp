@@ -140,20 +140,13 @@ struct Cut {
   double fraction;
 };
 
-/// Whether every corner of `tri` belongs to another part (VertexRole done or later): such a
-/// triangle stays whole.
-bool of_other_parts(const Triangle& tri, std::span<const std::uint8_t> roles) {
-  const auto other = [&](std::uint32_t v) { return role_of(roles, v) != VertexRole::free; };
-  return other(tri[0]) && other(tri[1]) && other(tri[2]);
-}
-
 /// One cut per edge with one covered end, in edge-key order.
 std::vector<Cut> find_cuts(const Mesh& m, const Cover& cover, const VertexFrames& f,
                            const std::vector<std::uint8_t>& covered, const ClipParams& params,
                            std::span<const std::uint8_t> roles) {
   std::vector<std::uint64_t> keys;
   for (const Triangle& tri : m.triangles) {
-    if (of_other_parts(tri, roles)) continue;
+    if (all_corners_frozen(tri, roles)) continue;
     for (std::size_t k = 0; k < 3; ++k) {
       const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
       if (covered[a] != covered[b]) keys.push_back(edge_key(a, b));
@@ -235,7 +228,7 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
     // A triangle of this part on other parts' vertices cannot be cut (its edges are theirs
     // too), but covered whole it goes: no later part would take it away.
     const bool own = around.first_own_triangle && t >= *around.first_own_triangle;
-    const bool stays_whole = of_other_parts(tri, around.vertex_roles) && !(own && corners_covered == 3);
+    const bool stays_whole = all_corners_frozen(tri, around.vertex_roles) && !(own && corners_covered == 3);
     if (corners_covered == 0 || stays_whole) {
       triangles.push_back(tri);  // nearly every triangle of a city: no polygon built
       from.push_back(static_cast<std::uint32_t>(t));
@@ -270,7 +263,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
       for (std::size_t v = begin; v < end; ++v) {
         // Output stitched before stays: its vertices are never covered. A later part's
         // vertex may be: the free triangles around it are cut now, the later part's own
-        // triangles (whole, of_other_parts) when their turn comes, at the same place.
+        // triangles (whole, all_corners_frozen) when their turn comes, at the same place.
         if (role_of(roles, static_cast<std::uint32_t>(v)) == VertexRole::done) continue;
         covered[v] = cover.over(Vec3d(m.positions[v]), frames.source[v], Vec3d(frames.normal[v])) ? 1 : 0;
       }

@@ -57,4 +57,10 @@ std::vector<EdgeUse> boundary_edges(std::span<const Triangle> triangles) {
   return boundary;
 }
 
+double edges_length(const Mesh& mesh, std::span<const EdgeUse> edges) {
+  double total = 0;
+  for (const EdgeUse& e : edges) total += norm(Vec3d(mesh.positions[e.lo]) - Vec3d(mesh.positions[e.hi]));
+  return total;
+}
+
 }  // namespace citymesh

@@ -199,8 +199,8 @@ GapFillStats fill_seam_gaps(MeshTopology& topo, const GapFillParams& params) {
   for (const DirectedEdge& start : starts) {
     if (used.contains(half_edge_key(start))) continue;
     const Loop loop = trace_loop(topo, next, start, params.max_vertices, used);
-    const auto later = [&](std::uint32_t v) { return !topo.joinable(v); };
-    if (loop.vertices.size() < 3 || std::any_of(loop.vertices.begin(), loop.vertices.end(), later)) continue;
+    const auto unjoinable = [&](std::uint32_t v) { return !topo.joinable(v); };
+    if (loop.vertices.size() < 3 || std::any_of(loop.vertices.begin(), loop.vertices.end(), unjoinable)) continue;
     // Of the fill (the loop reversed), about the first vertex: small loops far from the
     // frame's origin would lose the area to cancellation.
     const Vec3d origin = topo.position(loop.vertices.front());

@@ -46,14 +46,7 @@ MergedMesh merge_selection(std::span<const Mesh> meshes, const GlobalTriangles& 
 }
 
 void shrink_to_fit(MergedMesh& m) {
-  Mesh& mesh = m.mesh;
-  mesh.positions.shrink_to_fit();
-  mesh.sensor_positions.shrink_to_fit();
-  mesh.times.shrink_to_fit();
-  mesh.intensities.shrink_to_fit();
-  mesh.colors.shrink_to_fit();
-  mesh.triangles.shrink_to_fit();
-  mesh.triangle_ids.shrink_to_fit();
+  m.mesh.shrink_to_fit();
   m.source_acq.shrink_to_fit();
   m.source_triangle.shrink_to_fit();
 }

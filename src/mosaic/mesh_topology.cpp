@@ -89,9 +89,7 @@ std::int32_t MeshTopology::source_of_vertex(std::uint32_t v) const {
 }
 
 double MeshTopology::boundary_length() const {
-  double total = 0;
-  for (const EdgeUse& e : boundary_edges()) total += norm(position(e.lo) - position(e.hi));
-  return total;
+  return edges_length(merged_.mesh, boundary_edges());
 }
 
 std::vector<EdgeUse> MeshTopology::boundary_edges() const {

@@ -47,10 +47,7 @@ class MeshTopology {
   /// Whether triangle t must stay as it is: its three corners are frozen. (A free triangle
   /// whose corners all happen to be frozen is kept as it is too: nothing it could become
   /// would leave them in place anyway but a split of its edges.)
-  [[nodiscard]] bool frozen_triangle(std::uint32_t t) const {
-    const Triangle& tri = triangle(t);
-    return frozen(tri[0]) && frozen(tri[1]) && frozen(tri[2]);
-  }
+  [[nodiscard]] bool frozen_triangle(std::uint32_t t) const { return all_corners_frozen(triangle(t), roles_); }
 
   /// The triangles using vertex v, in the order they were added.
   [[nodiscard]] std::span<const std::uint32_t> triangles_of(std::uint32_t v) const;

@@ -238,24 +238,13 @@ void weld(StitchContext& c) {
 
 }  // namespace
 
-namespace {
-
-double length_of(const Mesh& m, std::span<const EdgeUse> edges) {
-  double total = 0;
-  for (const EdgeUse& e : edges) total += norm(position(m, e.lo) - position(m, e.hi));
-  return total;
-}
-
-}  // namespace
-
-double open_boundary_length(const Mesh& m) { return length_of(m, boundary_edges(m.triangles)); }
+double open_boundary_length(const Mesh& m) { return edges_length(m, boundary_edges(m.triangles)); }
 
 StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchSurroundings& around) {
   Stopwatch clock;
   // Where the time goes, at --log-level debug (the seam pass of a city runs mostly serial).
   const auto phase_done = [&clock](std::string_view phase) {
-    log::debug("stitch: {} at {:.2f} s, resident {} MiB (peak {} MiB)", phase, clock.seconds(), resident_bytes() >> 20,
-               peak_resident_bytes() >> 20);
+    log::debug("stitch: {} at {:.2f} s, {}", phase, clock.seconds(), memory_note());
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.

@@ -164,11 +164,9 @@ class PartCutter {
     PartMesh& cut = out_;
     for (const auto& [v, use] : vertices_) cut.whole_vertex.push_back(v);
     std::sort(cut.whole_vertex.begin(), cut.whole_vertex.end());
-    std::unordered_map<std::uint32_t, std::uint32_t> local;
-    local.reserve(cut.whole_vertex.size());
     for (const std::uint32_t v : cut.whole_vertex) {
-      local.emplace(v, static_cast<std::uint32_t>(cut.roles.size()));
-      const Use& use = vertices_.at(v);
+      Use& use = vertices_.at(v);
+      use.local = static_cast<std::uint32_t>(cut.roles.size());
       // On the edge of what was cut out, the output looks open where it is not: no seam may
       // join such a vertex (this part's triangles never use it).
       const bool on_cut_edge = use.triangles < uses_[v];
@@ -176,7 +174,7 @@ class PartCutter {
       append_vertex(whole_, v, cut.merged.mesh);
     }
     for (Triangle& tri : cut.merged.mesh.triangles) {
-      for (std::uint32_t& v : tri) v = local.at(v);
+      for (std::uint32_t& v : tri) v = vertices_.at(v).local;
     }
     return std::move(out_);
   }
@@ -195,6 +193,7 @@ class PartCutter {
   struct Use {
     VertexRole role = VertexRole::free;
     std::uint32_t triangles = 0;
+    std::uint32_t local = 0;  ///< its index in the part mesh, once taken
   };
   const Mesh& whole_;
   std::span<const std::uint32_t> uses_;
@@ -388,14 +387,12 @@ BlockStitchStats stitch_in_blocks(MergedMesh& mesh, const StitchParams& params, 
   mesh.mesh.triangle_ids = {};
   mesh.source_acq = {};
   mesh.source_triangle = {};
-  log::debug("stitch by blocks: {} parts at {:.2f} s, resident {} MiB (peak {} MiB)", out.parts.size(), clock.seconds(),
-             resident_bytes() >> 20, peak_resident_bytes() >> 20);
+  log::debug("stitch by blocks: {} parts at {:.2f} s, {}", out.parts.size(), clock.seconds(), memory_note());
   const LevelRun run{params, sizes, context};
   for (int level = 0; level < kLevels; ++level) {
     stitch_level(out, level, run, stats);
-    log::debug("stitch by blocks: level {} ({} parts) at {:.2f} s, resident {} MiB (peak {} MiB)", level,
-               stats.parts[static_cast<std::size_t>(level)], clock.seconds(), resident_bytes() >> 20,
-               peak_resident_bytes() >> 20);
+    log::debug("stitch by blocks: level {} ({} parts) at {:.2f} s, {}", level,
+               stats.parts[static_cast<std::size_t>(level)], clock.seconds(), memory_note());
   }
   gather(mesh, out.parts);
   stats.stitch.open_boundary_after = mosaic_detail::MeshTopology(mesh).boundary_length();

@@ -81,6 +81,9 @@ struct Mesh {
   }
   /// Throws ProcessingError when attribute sizes disagree or an index is out of range.
   void check_invariants() const;
+  /// Hands back the room every array grew beyond its size (meshes built by appending hold up
+  /// to twice what they need).
+  void shrink_to_fit();
 };
 
 /// Appends vertex v of `from` to `to` with every per-vertex attribute `from` carries; both

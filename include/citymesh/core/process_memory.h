@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 
 namespace citymesh {
 
@@ -11,6 +12,8 @@ namespace citymesh {
 std::uint64_t resident_bytes();
 /// Largest resident set size so far (VmHWM), in bytes.
 std::uint64_t peak_resident_bytes();
+/// "resident N MiB (peak M MiB)": how the debug lines of long stages report memory.
+std::string memory_note();
 
 /// Makes the C allocator keep freed memory for the next allocation instead of returning it to
 /// the system (glibc: no mmap for large blocks, no trimming of the heap's top). Each tile and

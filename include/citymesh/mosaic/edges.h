@@ -36,4 +36,7 @@ void for_each_edge(std::span<const EdgeUse> uses, Fn fn) {
 /// The edges used by exactly one triangle, in edge order.
 std::vector<EdgeUse> boundary_edges(std::span<const Triangle> triangles);
 
+/// Total length of `edges` on `mesh`'s vertices, summed in their order.
+double edges_length(const Mesh& mesh, std::span<const EdgeUse> edges);
+
 }  // namespace citymesh

@@ -59,6 +59,13 @@ inline VertexRole role_of(std::span<const std::uint8_t> roles, std::uint32_t v) 
   return v < roles.size() ? static_cast<VertexRole>(roles[v]) : VertexRole::free;
 }
 
+/// Whether every corner of `tri` belongs to other parts (a role other than free in `roles`):
+/// such a triangle is frozen, it stays as it is.
+inline bool all_corners_frozen(const Triangle& tri, std::span<const std::uint8_t> roles) {
+  const auto frozen = [&](std::uint32_t v) { return role_of(roles, v) != VertexRole::free; };
+  return frozen(tri[0]) && frozen(tri[1]) && frozen(tri[2]);
+}
+
 /// What a seam pass over one part of an output needs to know of the rest.
 struct StitchSurroundings {
   /// Per vertex of the mesh (VertexRole; vertices past its end are free). Triangles whose
