@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 
 #include "citymesh/core/atomic_file.h"
@@ -187,8 +188,6 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   const EnuFrame frame(stats.origin);
   // The positions in the local frame live only while the split copies them.
   const SplitMesh split = split_by_source(mesh, source.source_acq, local_positions(mesh, source.crs, frame));
-  const TileTree tree = build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
-                                        params.tree);
   GlbParams glb{.draco = params.draco, .draco_params = shared_lattice(split.vertices.positions, params),
                 .acquisitions = params.acquisitions};
   const double step = static_cast<double>(glb.draco_params.lattice->range) /
@@ -199,19 +198,20 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   std::filesystem::remove_all(staged, ec);
   std::filesystem::create_directories(staged, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the folder: {}", staged.string(), ec.message()));
-  std::vector<std::uint64_t> bytes(tree.nodes.size(), 0);
-  parallel_for_blocks(tree.nodes.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t n = begin; n < end; ++n) {
-      const TileNode& node = tree.nodes[n];
-      if (node.mesh.triangles.empty()) continue;
-      const TileAttributes a = gather(split.vertices, node.mesh);
-      const std::vector<std::uint8_t> content =
-          write_glb({a.positions, node.mesh.triangles, a.feature_ids, a.intensities, a.colors}, glb);
-      write_file_atomically(staged / (node.name() + ".glb"),
-                            {reinterpret_cast<const char*>(content.data()), content.size()});
-      bytes[n] = content.size();
-    }
-  });
+  // Each tile is written as soon as the tree is done with it, and its mesh freed: holding
+  // every tile until the last was built was the peak of a city's final pass.
+  std::atomic<std::uint64_t> glb_bytes{0};
+  const auto write_tile = [&](const TileNode& node) {
+    if (node.mesh.triangles.empty()) return;
+    const TileAttributes a = gather(split.vertices, node.mesh);
+    const std::vector<std::uint8_t> content =
+        write_glb({a.positions, node.mesh.triangles, a.feature_ids, a.intensities, a.colors}, glb);
+    write_file_atomically(staged / (node.name() + ".glb"),
+                          {reinterpret_cast<const char*>(content.data()), content.size()});
+    glb_bytes += content.size();
+  };
+  const TileTree tree = build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
+                                        params.tree, write_tile);
   const auto files = tileset_json_files(tree, {.transform = frame.to_ecef_matrix(),
                                                .max_tiles_per_file = params.max_tiles_per_file,
                                                .box_margin = step,
@@ -223,13 +223,13 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   stats.json_files = files.size();
   stats.levels = tree_depth(tree);
   for (const TileNode& node : tree.nodes) {
-    stats.all_triangles += node.mesh.triangles.size();
+    stats.all_triangles += node.triangle_count;
     if (node.level == 0) {
       ++stats.leaves;
-      stats.leaf_triangles += node.mesh.triangles.size();
+      stats.leaf_triangles += node.triangle_count;
     }
   }
-  for (const std::uint64_t b : bytes) stats.glb_bytes += b;
+  stats.glb_bytes = glb_bytes.load();
   stats.position_bits = glb.draco_params.position_bits;
   stats.quantization_step = step;
   stats.seconds = clock.seconds();

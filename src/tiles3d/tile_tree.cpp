@@ -4,9 +4,13 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <numeric>
+#include <optional>
+#include <utility>
 
+#include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
 
 namespace citymesh {
@@ -54,16 +58,17 @@ Box3d mesh_box(const TilesetVertices& vertices, const TileMesh& m) {
   return box;
 }
 
-/// Merges the children's meshes and simplifies the result with locked borders.
-void build_parent(const TilesetVertices& vertices, const TileTree& tree, TileNode& parent,
+/// Merges the children's meshes (children index `nodes`) and simplifies the result with
+/// locked borders.
+void build_parent(const TilesetVertices& vertices, std::span<const TileNode> nodes, TileNode& parent,
                   const TileTreeParams& params) {
   std::vector<Triangle> merged;
   double child_error = 0.0;
   for (const std::uint32_t c : parent.children) {
-    const std::vector<Triangle> g = to_global(tree.nodes[c].mesh);
+    const std::vector<Triangle> g = to_global(nodes[c].mesh);
     merged.insert(merged.end(), g.begin(), g.end());
-    child_error = std::max(child_error, tree.nodes[c].geometric_error);
-    parent.box.extend(tree.nodes[c].box);
+    child_error = std::max(child_error, nodes[c].geometric_error);
+    parent.box.extend(nodes[c].box);
   }
   const TileMesh whole = compact(merged, vertices.positions.size());
   std::vector<Vec3f> positions;
@@ -76,6 +81,7 @@ void build_parent(const TilesetVertices& vertices, const TileTree& tree, TileNod
     kept.push_back({whole.vertices[t[0]], whole.vertices[t[1]], whole.vertices[t[2]]});
   }
   parent.mesh = compact(kept, vertices.positions.size());
+  parent.triangle_count = parent.mesh.triangles.size();
   parent.geometric_error = std::max(child_error + simplified.error, params.min_geometric_error);
 }
 
@@ -86,96 +92,232 @@ struct OpenNode {
   bool alone_is_final = false;  ///< simplifying it alone was tried and kept too much
 };
 
+/// The open nodes whose keys one level up are the same, in key order.
+using Group = std::vector<OpenNode>;
+
 /// A parent of one child must keep at most this share of the child's triangles: above it, the
 /// level repeats its child (once locked borders stop the simplifier, every further level of an
 /// isolated street was the same mesh again, encoded again: 18 of a city's 164 tiles).
 constexpr double kMaxSingleChildShare = 0.5;
 
-/// Groups the open nodes by their keys one level up and gives each group a parent at `level`
-/// (built in parallel); returns the nodes open above it. A node alone in its group whose
-/// parent would keep too much of it is carried up instead, marked so that it is not tried
-/// alone again (the same mesh simplifies the same way).
-std::vector<OpenNode> add_level(const TilesetVertices& vertices, TileTree& tree, std::span<const OpenNode> open,
-                                int level, const TileTreeParams& params) {
-  std::map<TileKey, std::vector<const OpenNode*>> groups;
-  for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(&o);
-  // A group of one node already found not to simplify alone gets no parent to try.
-  const auto settled_alone = [](const std::vector<const OpenNode*>& members) {
-    return members.size() == 1 && members[0]->alone_is_final;
-  };
-  std::vector<TileNode> parents;
-  for (const auto& [key, members] : groups) {
-    if (settled_alone(members)) continue;
-    std::vector<std::uint32_t> children;
-    for (const OpenNode* m : members) children.push_back(m->node);
-    parents.push_back({.level = level, .key = key, .mesh = {}, .geometric_error = 0, .box = {},
-                       .children = std::move(children)});
+/// A group of one node already found not to simplify alone gets no parent to try (the same
+/// mesh simplifies the same way).
+bool settled_alone(const Group& g) { return g.size() == 1 && g[0].alone_is_final; }
+
+/// What one build shares: the input grouped by leaf and the caller's settings.
+struct TreeBuild {
+  const TilesetVertices& vertices;
+  std::span<const Triangle> triangles;
+  std::vector<TileKey> leaves;        ///< ascending
+  std::vector<std::uint32_t> start;   ///< per leaf: its first entry in `order`
+  std::vector<std::uint32_t> order;   ///< triangle indices grouped by leaf, input order kept
+  const TileTreeParams& params;
+  const TileNodeSink& sink;
+};
+
+/// What the tree subtracts from the leaf keys. Halving never brings a negative key and a
+/// non-negative one together (-1 stays -1, 0 stays 0), so an axis whose keys have both signs
+/// (a grid origin inside the output) is counted from its smallest key; otherwise the keys are
+/// the grid's own.
+TileKey key_offset(std::span<const TileKey> leaf_keys) {
+  if (leaf_keys.empty()) return {};
+  std::int64_t lo_i = leaf_keys[0].i, hi_i = lo_i, lo_j = leaf_keys[0].j, hi_j = lo_j;
+  for (const TileKey& k : leaf_keys) {
+    lo_i = std::min<std::int64_t>(lo_i, k.i);
+    hi_i = std::max<std::int64_t>(hi_i, k.i);
+    lo_j = std::min<std::int64_t>(lo_j, k.j);
+    hi_j = std::max<std::int64_t>(hi_j, k.j);
   }
-  parallel_for_blocks(parents.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p) build_parent(vertices, tree, parents[p], params);
+  if (hi_i - lo_i > INT32_MAX || hi_j - lo_j > INT32_MAX) {
+    throw ProcessingError(fmt::format("3D Tiles: the output spans more than 2^31 grid tiles ({} x {})",
+                                      hi_i - lo_i + 1, hi_j - lo_j + 1));
+  }
+  const auto from = [](std::int64_t lo, std::int64_t hi) { return lo < 0 && hi >= 0 ? static_cast<std::int32_t>(lo) : 0; };
+  return {from(lo_i, hi_i), from(lo_j, hi_j)};
+}
+
+/// Groups the triangles by leaf as indices (a counting sort), not as copies: a vector of
+/// triangles per leaf, grown by doubling, was the peak of a city's export. Leaf keys are
+/// taken less `offset`.
+void group_by_leaf(TreeBuild& b, std::span<const TileKey> leaf_keys, TileKey offset) {
+  const auto shifted = [&](const TileKey& k) { return TileKey{k.i - offset.i, k.j - offset.j}; };
+  std::map<TileKey, std::uint32_t> leaf_of;
+  for (const TileKey& key : leaf_keys) leaf_of.try_emplace(shifted(key), 0);
+  for (auto& [key, leaf] : leaf_of) {
+    leaf = static_cast<std::uint32_t>(b.leaves.size());
+    b.leaves.push_back(key);
+  }
+  b.start.assign(b.leaves.size() + 1, 0);
+  std::vector<std::uint32_t> leaf_index(leaf_keys.size());
+  for (std::size_t t = 0; t < leaf_keys.size(); ++t) {
+    // Consecutive triangles mostly share a leaf (the output is in input order): look up only
+    // when the key changes.
+    leaf_index[t] = t > 0 && leaf_keys[t] == leaf_keys[t - 1] ? leaf_index[t - 1] : leaf_of.at(shifted(leaf_keys[t]));
+    ++b.start[leaf_index[t] + 1];
+  }
+  for (std::size_t n = 0; n < b.leaves.size(); ++n) b.start[n + 1] += b.start[n];
+  b.order.resize(leaf_keys.size());
+  std::vector<std::uint32_t> at(b.start.begin(), b.start.end() - 1);
+  for (std::size_t t = 0; t < leaf_keys.size(); ++t) b.order[at[leaf_index[t]]++] = static_cast<std::uint32_t>(t);
+}
+
+TileNode make_leaf(const TreeBuild& b, std::uint32_t leaf) {
+  std::vector<Triangle> own;
+  own.reserve(b.start[leaf + 1] - b.start[leaf]);
+  for (std::uint32_t i = b.start[leaf]; i < b.start[leaf + 1]; ++i) own.push_back(b.triangles[b.order[i]]);
+  TileNode node;
+  node.key = b.leaves[leaf];
+  node.mesh = compact(own, b.vertices.positions.size());
+  node.triangle_count = node.mesh.triangles.size();
+  node.box = mesh_box(b.vertices, node.mesh);
+  return node;
+}
+
+/// Hands a node the tree is done with to the sink, then frees its mesh.
+void hand_over(const TreeBuild& b, TileNode& node) {
+  if (!b.sink) return;
+  b.sink(node);
+  node.mesh = TileMesh{};
+}
+
+/// The group's parent at `level`, built from `nodes`; none when it would only repeat the
+/// group's single node, which is then carried up instead. The children of a parent that is
+/// kept are handed over.
+std::optional<TileNode> parent_of(const TreeBuild& b, std::span<TileNode> nodes, const Group& g, int level,
+                                  TileKey key) {
+  TileNode parent;
+  parent.level = level;
+  parent.key = key;
+  for (const OpenNode& o : g) parent.children.push_back(o.node);
+  build_parent(b.vertices, nodes, parent, b.params);
+  const auto child_triangles = static_cast<double>(nodes[g[0].node].triangle_count);
+  if (g.size() == 1 && static_cast<double>(parent.triangle_count) > kMaxSingleChildShare * child_triangles) {
+    return std::nullopt;
+  }
+  for (const std::uint32_t c : parent.children) hand_over(b, nodes[c]);
+  return parent;
+}
+
+/// Settles one group at `level` in `nodes`: appends its parent, or carries its node up.
+OpenNode settle(const TreeBuild& b, std::vector<TileNode>& nodes, const Group& g, int level, TileKey key) {
+  if (!settled_alone(g)) {
+    if (std::optional<TileNode> parent = parent_of(b, nodes, g, level, key)) {
+      nodes.push_back(std::move(*parent));
+      return {static_cast<std::uint32_t>(nodes.size() - 1), key, false};
+    }
+  }
+  return {g[0].node, key, true};
+}
+
+/// The subtree of the cell `key` at `level` holding the leaves `leaves` (ascending), depth
+/// first: each quarter's subtree is finished, and its nodes handed over, before the next one
+/// is read. Appends its nodes to `nodes` (children first) and returns the node left open.
+OpenNode build_cell(const TreeBuild& b, std::span<const std::uint32_t> leaves, int level, TileKey key,
+                    std::vector<TileNode>& nodes) {
+  if (level == 0) {
+    nodes.push_back(make_leaf(b, leaves[0]));
+    return {static_cast<std::uint32_t>(nodes.size() - 1), key, false};
+  }
+  // The quarters in key order: (i, j) ascending, as the level-by-level grouping meets them.
+  std::array<std::vector<std::uint32_t>, 4> quarters;
+  for (const std::uint32_t leaf : leaves) {
+    const TileKey k = b.leaves[leaf];
+    quarters[((k.i >> (level - 1)) & 1) * 2 + ((k.j >> (level - 1)) & 1)].push_back(leaf);
+  }
+  Group members;
+  for (const std::vector<std::uint32_t>& q : quarters) {
+    if (q.empty()) continue;
+    const TileKey leaf = b.leaves[q[0]];
+    members.push_back(build_cell(b, q, level - 1, {leaf.i >> (level - 1), leaf.j >> (level - 1)}, nodes));
+  }
+  return settle(b, nodes, members, level, key);
+}
+
+/// Groups the open nodes by their keys one level up and gives each group a parent at `level`
+/// (built in parallel); returns the nodes open above it.
+std::vector<OpenNode> add_level(const TreeBuild& b, TileTree& tree, std::span<const OpenNode> open, int level) {
+  std::map<TileKey, Group> groups;
+  for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(o);
+  const std::vector<std::pair<TileKey, Group>> listed(groups.begin(), groups.end());
+  std::vector<std::optional<TileNode>> parents(listed.size());
+  parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const auto& [key, members] = listed[p];
+      if (!settled_alone(members)) parents[p] = parent_of(b, tree.nodes, members, level, key);
+    }
   });
   std::vector<OpenNode> above;
-  auto parent = parents.begin();
-  for (const auto& [key, members] : groups) {
-    const OpenNode& first = *members[0];
-    if (settled_alone(members)) {
-      above.push_back({first.node, key, true});
-      continue;
-    }
-    const double child_triangles = static_cast<double>(tree.nodes[first.node].mesh.triangles.size());
-    if (members.size() == 1 &&
-        static_cast<double>(parent->mesh.triangles.size()) > kMaxSingleChildShare * child_triangles) {
-      above.push_back({first.node, key, true});
-    } else {
+  for (std::size_t p = 0; p < listed.size(); ++p) {
+    const auto& [key, members] = listed[p];
+    if (parents[p]) {
       above.push_back({static_cast<std::uint32_t>(tree.nodes.size()), key, false});
-      tree.nodes.push_back(std::move(*parent));
+      tree.nodes.push_back(std::move(*parents[p]));
+    } else {
+      above.push_back({members[0].node, key, true});
     }
-    ++parent;
   }
   return above;
+}
+
+/// The level whose one cell holds every leaf: the tree's top.
+int top_level(std::span<const TileKey> leaves) {
+  int level = 0;
+  const auto one_cell = [&](int l) {
+    return std::all_of(leaves.begin(), leaves.end(), [&](const TileKey& k) {
+      return (k.i >> l) == (leaves[0].i >> l) && (k.j >> l) == (leaves[0].j >> l);
+    });
+  };
+  while (!one_cell(level)) ++level;
+  return level;
+}
+
+/// The leaves (ascending) of every cell at `level` holding any, in key order.
+std::map<TileKey, std::vector<std::uint32_t>> cells_at(std::span<const TileKey> leaves, int level) {
+  std::map<TileKey, std::vector<std::uint32_t>> cells;
+  for (std::uint32_t n = 0; n < leaves.size(); ++n) {
+    cells[{leaves[n].i >> level, leaves[n].j >> level}].push_back(n);
+  }
+  return cells;
+}
+
+/// The highest level up to `top` with at least `count` cells holding leaves; 0 when none has.
+int depth_first_level(std::span<const TileKey> leaves, int top, std::size_t count) {
+  for (int level = top; level > 0; --level) {
+    if (cells_at(leaves, level).size() >= count) return level;
+  }
+  return 0;
 }
 
 }  // namespace
 
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
-                         std::span<const TileKey> leaf_keys, const TileTreeParams& params) {
+                         std::span<const TileKey> leaf_keys, const TileTreeParams& params, const TileNodeSink& sink) {
   TileTree tree;
-  // The triangles grouped by leaf as indices (a counting sort), not as copies: a vector of
-  // triangles per leaf, grown by doubling, was the peak of a city's export.
-  std::map<TileKey, std::uint32_t> leaf_of;
-  for (const TileKey& key : leaf_keys) leaf_of.try_emplace(key, 0);
-  for (auto& [key, leaf] : leaf_of) {
-    leaf = static_cast<std::uint32_t>(tree.nodes.size());
-    tree.nodes.push_back({.level = 0, .key = key, .mesh = {}, .geometric_error = 0, .box = {}, .children = {}});
-  }
-  std::vector<std::uint32_t> start(tree.nodes.size() + 1, 0);
-  std::vector<std::uint32_t> leaf_index(triangles.size());
-  for (std::size_t t = 0; t < triangles.size(); ++t) {
-    // Consecutive triangles mostly share a leaf (the output is in input order): look up only
-    // when the key changes.
-    leaf_index[t] = t > 0 && leaf_keys[t] == leaf_keys[t - 1] ? leaf_index[t - 1] : leaf_of.at(leaf_keys[t]);
-    ++start[leaf_index[t] + 1];
-  }
-  for (std::size_t n = 0; n < tree.nodes.size(); ++n) start[n + 1] += start[n];
-  std::vector<std::uint32_t> order(triangles.size());
-  std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
-  for (std::size_t t = 0; t < triangles.size(); ++t) order[at[leaf_index[t]]++] = static_cast<std::uint32_t>(t);
-  std::vector<std::uint32_t>().swap(leaf_index);
-  parallel_for_blocks(tree.nodes.size(), 1, [&](std::size_t begin, std::size_t end) {
-    std::vector<Triangle> own;
-    for (std::size_t n = begin; n < end; ++n) {
-      own.clear();
-      for (std::uint32_t i = start[n]; i < start[n + 1]; ++i) own.push_back(triangles[order[i]]);
-      TileNode& leaf = tree.nodes[n];
-      leaf.mesh = compact(own, vertices.positions.size());
-      leaf.box = mesh_box(vertices, leaf.mesh);
-    }
+  TreeBuild b{.vertices = vertices, .triangles = triangles, .leaves = {}, .start = {}, .order = {}, .params = params,
+              .sink = sink};
+  group_by_leaf(b, leaf_keys, key_offset(leaf_keys));
+  if (b.leaves.empty()) return tree;
+  const int top = top_level(b.leaves);
+  const int split = depth_first_level(b.leaves, top, std::max<std::size_t>(params.depth_first_cells, 1));
+  // Below `split`, cell by cell in parallel; each cell's nodes are then appended in key order.
+  const auto cells = cells_at(b.leaves, split);
+  const std::vector<std::pair<TileKey, std::vector<std::uint32_t>>> listed(cells.begin(), cells.end());
+  std::vector<std::vector<TileNode>> subtrees(listed.size());
+  std::vector<OpenNode> open(listed.size());
+  parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) open[c] = build_cell(b, listed[c].second, split, listed[c].first, subtrees[c]);
   });
-  std::vector<std::uint32_t>().swap(order);
-  // The nodes still without a parent, with their keys at the level being built.
-  std::vector<OpenNode> open;
-  for (std::uint32_t n = 0; n < tree.nodes.size(); ++n) open.push_back({n, tree.nodes[n].key, false});
-  for (int level = 1; open.size() > 1; ++level) open = add_level(vertices, tree, open, level, params);
+  for (std::size_t c = 0; c < listed.size(); ++c) {
+    const auto offset = static_cast<std::uint32_t>(tree.nodes.size());
+    for (TileNode& node : subtrees[c]) {
+      for (std::uint32_t& child : node.children) child += offset;
+      tree.nodes.push_back(std::move(node));
+    }
+    open[c].node += offset;
+  }
+  // Above it, level by level.
+  for (int level = split + 1; open.size() > 1; ++level) open = add_level(b, tree, open, level);
+  hand_over(b, tree.nodes[open[0].node]);
   return tree;
 }
 

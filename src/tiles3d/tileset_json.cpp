@@ -56,7 +56,7 @@ class Writer {
   nlohmann::json tile_json(std::uint32_t n, std::size_t& room) {
     const TileNode& node = tree_.nodes[n];
     nlohmann::json tile = tile_header(node);
-    if (!node.mesh.triangles.empty()) tile["content"] = {{"uri", node.name() + ".glb"}};
+    if (node.triangle_count > 0) tile["content"] = {{"uri", node.name() + ".glb"}};
     if (node.children.empty()) return tile;
     nlohmann::json children = nlohmann::json::array();
     for (std::size_t k = 0; k < node.children.size(); ++k) {

@@ -3,7 +3,11 @@
 // parent that merely repeats its only child.
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <map>
+#include <mutex>
 #include <set>
+#include <string>
 
 #include "citymesh/tiles3d/tile_tree.h"
 #include "grid_triangles.h"
@@ -113,6 +117,101 @@ TEST(TileTree, NeighbouringLeavesShareParentsLevelByLevel) {
   EXPECT_EQ(tree.nodes.size(), 16u + 4u + 1u);
   EXPECT_EQ(tree.root().level, 2);
   EXPECT_EQ(tree.root().children.size(), 4u);
+}
+
+/// A tile as a reader of the tileset sees it: level, its triangles (global vertices, in
+/// order), error, box and children by name. Node numbers are left out: they follow the order
+/// in which the tree was built.
+struct TileView {
+  std::vector<Triangle> triangles;
+  double geometric_error = 0;
+  Vec3d box_min, box_max;
+  std::vector<std::string> children;
+  bool operator==(const TileView&) const = default;
+};
+
+std::vector<Triangle> global_triangles(const TileMesh& m) {
+  std::vector<Triangle> out;
+  for (const Triangle& t : m.triangles) out.push_back({m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]});
+  return out;
+}
+
+std::map<std::string, TileView> view_of(const TileTree& tree) {
+  std::map<std::string, TileView> tiles;
+  for (const TileNode& node : tree.nodes) {
+    TileView& v = tiles[node.name()];
+    v.triangles = global_triangles(node.mesh);
+    v.geometric_error = node.geometric_error;
+    v.box_min = node.box.min;
+    v.box_max = node.box.max;
+    for (const std::uint32_t c : node.children) v.children.push_back(tree.nodes[c].name());
+  }
+  return tiles;
+}
+
+/// 7 x 5 leaves with two missing, of flat grids (which simplify) and loose triangles (which do
+/// not), plus a leaf far away that meets the others only near the root.
+Input scattered_leaves() {
+  Input in;
+  for (int i = 0; i < 7; ++i) {
+    for (int j = 0; j < 5; ++j) {
+      if ((i == 2 && j == 3) || (i == 5 && j == 0)) continue;
+      const float x0 = 40.0f * float(5 * i + j);
+      if ((i + j) % 3 == 0) {
+        in.add_loose_triangles({i - 3, j - 2}, x0, 12);
+      } else {
+        in.add_flat_grid({i - 3, j - 2}, x0, 8);
+      }
+    }
+  }
+  in.add_flat_grid({90, -40}, 9000, 8);
+  return in;
+}
+
+TEST(TileTree, DepthFirstCellsGiveTheSameTilesAsLevelByLevel) {
+  const Input in = scattered_leaves();
+  TileTreeParams level_by_level;
+  level_by_level.depth_first_cells = std::numeric_limits<std::size_t>::max();
+  const TileTree reference = build_tile_tree(in.vertices, in.triangles, in.keys, level_by_level);
+  expect_well_formed(reference, in);
+  const auto expected = view_of(reference);
+  for (const std::size_t cells : {std::size_t{1}, std::size_t{2}, std::size_t{4}, std::size_t{16}}) {
+    TileTreeParams params;
+    params.depth_first_cells = cells;
+    const TileTree tree = build_tile_tree(in.vertices, in.triangles, in.keys, params);
+    expect_well_formed(tree, in);
+    EXPECT_EQ(view_of(tree), expected) << "depth_first_cells " << cells;
+    EXPECT_EQ(tree.root().name(), reference.root().name());
+  }
+}
+
+TEST(TileTree, TheSinkGetsEveryTileOnceChildrenFirstAndItsMeshIsThenReleased) {
+  const Input in = scattered_leaves();
+  const TileTree kept = build_tile_tree(in.vertices, in.triangles, in.keys, {});
+  std::mutex mutex;
+  std::map<std::string, std::vector<Triangle>> handed;
+  std::set<std::string> order_violations;
+  std::map<std::string, std::vector<std::string>> children_of;
+  for (const TileNode& node : kept.nodes) {
+    for (const std::uint32_t c : node.children) children_of[node.name()].push_back(kept.nodes[c].name());
+  }
+  TileTreeParams params;
+  params.depth_first_cells = 2;
+  const TileTree tree = build_tile_tree(in.vertices, in.triangles, in.keys, params, [&](const TileNode& node) {
+    const std::lock_guard lock(mutex);
+    for (const std::string& child : children_of[node.name()]) {
+      if (!handed.contains(child)) order_violations.insert(node.name());
+    }
+    EXPECT_TRUE(handed.emplace(node.name(), global_triangles(node.mesh)).second) << node.name() << " twice";
+  });
+  EXPECT_TRUE(order_violations.empty());
+  ASSERT_EQ(handed.size(), kept.nodes.size());
+  const auto expected = view_of(kept);
+  for (const TileNode& node : tree.nodes) {
+    EXPECT_TRUE(node.mesh.triangles.empty() && node.mesh.vertices.empty()) << node.name();
+    EXPECT_EQ(handed.at(node.name()), expected.at(node.name()).triangles) << node.name();
+    EXPECT_EQ(node.triangle_count, expected.at(node.name()).triangles.size()) << node.name();
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -31,33 +32,49 @@ struct TileMesh {
 
 struct TileNode {
   int level = 0;  ///< 0: leaves; a level-l tile covers 2^l x 2^l grid tiles
-  TileKey key;    ///< grid key at its level: leaf keys shifted right by `level`
-  TileMesh mesh;
-  double geometric_error = 0.0;  ///< metres; 0 on leaves, > 0 on parents
-  Box3d box;                     ///< local frame: its content and its children's
+  TileKey key;    ///< grid key at its level: leaf keys shifted right by `level` (see build_tile_tree)
+  TileMesh mesh;                   ///< empty once handed to a TileNodeSink
+  std::size_t triangle_count = 0;  ///< of its mesh, kept when the mesh is released
+  double geometric_error = 0.0;    ///< metres; 0 on leaves, > 0 on parents
+  Box3d box;                       ///< local frame: its content and its children's
   std::vector<std::uint32_t> children;
   /// "t<level>_<i>_<j>": the stem of its files.
   [[nodiscard]] std::string name() const;
 };
 
 struct TileTree {
-  std::vector<TileNode> nodes;  ///< leaves first, then level by level; the root is last
+  std::vector<TileNode> nodes;  ///< children before their parents; the root is last
   [[nodiscard]] const TileNode& root() const { return nodes.back(); }
 };
 
 struct TileTreeParams {
   SimplifyParams simplify;
   double min_geometric_error = 0.001;  ///< metres: a parent's error is never below this
+  /// Below the highest level of the grid that still has this many cells holding leaves, each
+  /// cell's subtree is built depth first, its leaves one group of four at a time (the cells
+  /// run in parallel); the levels above are built level by level. Only the memory and the
+  /// order of `TileTree::nodes` depend on it, never the tiles: 1 builds the whole tree depth
+  /// first, SIZE_MAX level by level from every leaf at once.
+  std::size_t depth_first_cells = 16;
 };
+
+/// Called once per node as soon as the tree no longer reads its mesh (its parent is built, or
+/// it is the root), possibly from several threads at once; the mesh is released when it
+/// returns. Lets a caller write each tile while the tree is built instead of holding them all.
+using TileNodeSink = std::function<void(const TileNode&)>;
 
 /// Builds the tree from the triangles (global vertex indices) and each triangle's leaf key.
 /// Level by level, the nodes without a parent are grouped by their keys one level up and each
 /// group gets a parent, except a node alone in its group whose simplification keeps more than
 /// half of it: that node is carried up unchanged (a parent would only repeat it) until it meets
 /// another, so a parent's children may lie several levels below it.
+/// Halving never brings keys of both signs together, so an axis whose leaf keys have both
+/// signs (a grid origin inside the output) is counted from its smallest key; node keys and
+/// names are then relative to it.
 /// The result depends only on the input, never on the thread count. An empty input gives an
-/// empty tree.
+/// empty tree. Without a sink every node keeps its mesh.
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
-                         std::span<const TileKey> leaf_keys, const TileTreeParams& params);
+                         std::span<const TileKey> leaf_keys, const TileTreeParams& params,
+                         const TileNodeSink& sink = {});
 
 }  // namespace citymesh
