@@ -97,6 +97,22 @@ TEST(TilesetExport, EveryTriangleIsInExactlyOneLeafAndTheTilesetChecksOut) {
   EXPECT_LT(stats.all_triangles, 2 * stats.leaf_triangles);
 }
 
+TEST(TilesetExport, AGridOriginInsideTheOutputGivesATreeAndAValidTileset) {
+  // Keys of both signs on both axes (-3..2 by -3..2): halving never joins -1 and 0, so the tree
+  // counts such an axis from its smallest key. This export used to loop forever.
+  test::TempDir tmp;
+  const Scene s = scene();
+  TilesetExportParams p = params(tmp / "tiles");
+  p.grid.origin = {651060.0, 6860660.0};
+  const TilesetExportStats stats = export_tileset({s.mesh, s.source, lambert93()}, p);
+  EXPECT_EQ(stats.leaves, 36u);  // 6 x 6 grid tiles: the square straddles theirs
+  EXPECT_EQ(stats.leaf_triangles, s.mesh.triangle_count());
+  const TilesetCheckReport r = check_tileset(tmp / "tiles");
+  for (const std::string& e : r.errors) ADD_FAILURE() << e;
+  EXPECT_EQ(r.leaf_triangles, s.mesh.triangle_count());
+  EXPECT_EQ(r.glb_files, stats.tiles);
+}
+
 TEST(TilesetExport, NeighbouringLeavesDecodeSharedVerticesBitIdentically) {
   test::TempDir tmp;
   const Scene s = scene();
