@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <iterator>
 #include <map>
 #include <numeric>
 #include <optional>
@@ -238,7 +239,8 @@ OpenNode build_cell(const TreeBuild& b, std::span<const std::uint32_t> leaves, i
 std::vector<OpenNode> add_level(const TreeBuild& b, TileTree& tree, std::span<const OpenNode> open, int level) {
   std::map<TileKey, Group> groups;
   for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(o);
-  const std::vector<std::pair<TileKey, Group>> listed(groups.begin(), groups.end());
+  const std::vector<std::pair<TileKey, Group>> listed(std::make_move_iterator(groups.begin()),
+                                                       std::make_move_iterator(groups.end()));
   std::vector<std::optional<TileNode>> parents(listed.size());
   parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
@@ -280,12 +282,18 @@ std::map<TileKey, std::vector<std::uint32_t>> cells_at(std::span<const TileKey> 
   return cells;
 }
 
-/// The highest level up to `top` with at least `count` cells holding leaves; 0 when none has.
-int depth_first_level(std::span<const TileKey> leaves, int top, std::size_t count) {
-  for (int level = top; level > 0; --level) {
-    if (cells_at(leaves, level).size() >= count) return level;
-  }
-  return 0;
+/// The cells built depth first: those of the highest level up to `top` with at least
+/// `count` cells holding leaves (level 0, the leaves, when none has), listed in key order.
+struct DepthFirstCells {
+  int level = 0;
+  std::vector<std::pair<TileKey, std::vector<std::uint32_t>>> cells;
+};
+
+DepthFirstCells depth_first_cells(std::span<const TileKey> leaves, int top, std::size_t count) {
+  int level = top;
+  auto cells = cells_at(leaves, level);
+  while (level > 0 && cells.size() < count) cells = cells_at(leaves, --level);
+  return {level, {std::make_move_iterator(cells.begin()), std::make_move_iterator(cells.end())}};
 }
 
 }  // namespace
@@ -297,11 +305,9 @@ TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triang
               .sink = sink};
   group_by_leaf(b, leaf_keys, key_offset(leaf_keys));
   if (b.leaves.empty()) return tree;
-  const int top = top_level(b.leaves);
-  const int split = depth_first_level(b.leaves, top, std::max<std::size_t>(params.depth_first_cells, 1));
+  const auto [split, listed] =
+      depth_first_cells(b.leaves, top_level(b.leaves), std::max<std::size_t>(params.depth_first_cells, 1));
   // Below `split`, cell by cell in parallel; each cell's nodes are then appended in key order.
-  const auto cells = cells_at(b.leaves, split);
-  const std::vector<std::pair<TileKey, std::vector<std::uint32_t>>> listed(cells.begin(), cells.end());
   std::vector<std::vector<TileNode>> subtrees(listed.size());
   std::vector<OpenNode> open(listed.size());
   parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
