@@ -126,14 +126,13 @@ bool TileGrid::within_one_tile(const Box3d& box) const {
   return owner(box.min - grow) == owner(box.max + grow);
 }
 
-bool TileGrid::clearly_within(const Box3d& box, TileKey key) const {
+TileInterior TileGrid::interior(TileKey key) const {
   const Vec3d c = corner(key);
-  const double h = params_.halo, s = params_.tile_size;
+  const double s = params_.tile_size;
   // Far enough inside the tile's sides that no rounding of owner()'s division can put a
   // point of the grown box in another tile.
   const double margin = 1e-12 * (std::abs(c.x) + std::abs(c.y) + s) + 1e-9;
-  return box.min.x - h >= c.x + margin && box.max.x + h <= c.x + s - margin && box.min.y - h >= c.y + margin &&
-         box.max.y + h <= c.y + s - margin;
+  return {key, params_.halo, c.x + margin, c.y + margin, c.x + s - margin, c.y + s - margin};
 }
 
 std::vector<TileKey> TileGrid::tiles_crossed(std::span<const Vec3d> points) const {
@@ -152,7 +151,7 @@ void TileGrid::copy_targets(std::span<const Vec3d, 3> corners, const Vec3d& view
   for (const Vec3d& p : corners) box.extend(p);
   Box3d reach = box;
   reach.extend(viewpoint);
-  if (clearly_within(reach, owner_key)) return;
+  if (interior(owner_key).holds(reach)) return;
   // The cells tiles_crossed would visit hold those halo_tiles would: one loop names both.
   const CellRange near_reach = cells_near(reach);
   if (near_reach.i0 == near_reach.i1 && near_reach.j0 == near_reach.j1) return;  // within one tile

@@ -151,10 +151,20 @@ class AcquisitionTiler {
     const Triangle& tri = triangle.corners;
     const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
                                  vertices_.positions[tri[2]]};
-    const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
-    add_copy(owner, t, TileRole::owned);
     const Vec3d viewpoint =
         (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
+    // Most triangles lie, with their viewpoint, inside the previous triangle's owner: that
+    // tile owns them and no other gets a copy (what owner() and copy_targets() would say).
+    Box3d reach;
+    for (const Vec3d& p : c) reach.extend(p);
+    reach.extend(viewpoint);
+    if (last_interior_.holds(reach)) {
+      add_copy(last_interior_.key, t, TileRole::owned);
+      return;
+    }
+    const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
+    last_interior_ = grid_.interior(owner);
+    add_copy(owner, t, TileRole::owned);
     grid_.copy_targets(c, viewpoint, owner, halo_, crossed_);
     for (const TileKey k : halo_) add_copy(k, t, TileRole::halo);
     for (const TileKey k : crossed_) add_copy(k, t, TileRole::empty_space);
@@ -242,6 +252,7 @@ class AcquisitionTiler {
   std::map<TileKey, std::uint32_t> slot_of_;
   std::uint32_t last_slot_ = 0;
   std::vector<TileKey> halo_, crossed_;  ///< the current triangle's other tiles
+  TileInterior last_interior_;           ///< of the last owner owner() found
   std::uint32_t largest_tile_ = 0;  ///< copies of the batch's largest tile
   // Reused by every flush.
   std::vector<std::uint32_t> sorted_;

@@ -134,6 +134,49 @@ TEST(TileGrid, CopyTargetsEqualHaloAndCrossedTilesOnTileSidesAtCityCoordinates) 
   EXPECT_LT(none, 19000u);
 }
 
+TEST(TileGrid, ATriangleInATilesInteriorIsOwnedThereAndCopiedNowhereElse) {
+  // The tiler places a triangle with interior(key).holds() alone, keeping the last owner's
+  // interior: at city coordinates, with grown boxes on a tile side or an ulp either way, a
+  // triangle the interior holds must have that owner and no halo or crossed tile.
+  const TileGrid grid({.tile_size = 50, .halo = 2, .origin = {650000.5, 6860000.25}});
+  EXPECT_FALSE(TileInterior{}.holds(Box3d{{0, 0, 0}, {0, 0, 0}}));  // the tiler's start
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> tile(-3, 3), offset(-2, 2), neighbour(-1, 1);
+  std::uniform_real_distribution<double> u(0, 50), e(0, 5), near(-3, 3);
+  std::size_t held = 0, refused = 0;
+  for (int n = 0; n < 20000; ++n) {
+    const TileKey key{tile(rng), tile(rng)};
+    const Vec3d corner = grid.corner(key);
+    const auto near_side = [&](double side) {
+      double x = side;
+      for (int k = offset(rng); k != 0; k += k > 0 ? -1 : 1) x = std::nextafter(x, k > 0 ? 1e300 : -1e300);
+      return x;
+    };
+    Vec3d a{corner.x + u(rng), corner.y + u(rng), 0};
+    if (n % 2 == 0) a.x = near_side(corner.x + 2);
+    if (n % 3 == 0) a.y = near_side(corner.y + 48);
+    const Vec3d b = a + Vec3d{e(rng), 0, 1}, c = a + Vec3d{0, e(rng), 2};
+    const Vec3d viewpoint = n % 5 == 0 ? a : a + Vec3d{near(rng), near(rng), 2};
+    Box3d box, reach;
+    for (const Vec3d& p : {a, b, c}) box.extend(p);
+    reach = box;
+    reach.extend(viewpoint);
+    // The interior of the triangle's tile or of a neighbour, as the last owner may be.
+    const TileInterior interior = grid.interior({key.i + neighbour(rng) * (n % 7 == 0), key.j});
+    if (!interior.holds(reach)) {
+      ++refused;
+      continue;
+    }
+    ++held;
+    ASSERT_EQ(grid.owner((a + b + c) / 3.0), interior.key) << n;
+    EXPECT_TRUE(grid.halo_tiles(box, interior.key).empty()) << n;
+    const std::array<Vec3d, 4> tetrahedron{a, b, c, viewpoint};
+    EXPECT_EQ(grid.tiles_crossed(tetrahedron), std::vector<TileKey>{interior.key}) << n;
+  }
+  EXPECT_GT(held, 3000u);  // both answers occur
+  EXPECT_GT(refused, 3000u);
+}
+
 /// Brute force: two convex sets in the plane meet when a point of one lies in the other or
 /// two of their segments cross. The hull of four points is the union of the four triangles.
 bool point_in_triangle(double px, double py, const Vec3d& a, const Vec3d& b, const Vec3d& c) {

@@ -7,6 +7,7 @@
 #include <compare>
 #include <span>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -27,6 +28,21 @@ struct TileGridParams {
   double tile_size = 50.0;                 ///< metres, > 0
   double halo = 2.0;                       ///< metres, 0 <= halo < tile_size / 2
   std::array<double, 2> origin{0.0, 0.0};  ///< grid origin in the project CRS
+};
+
+/// The x-y rectangle in which a box, grown by the halo, lies clearly inside one tile (see
+/// TileGrid::interior).
+struct TileInterior {
+  TileKey key;
+  double halo = 0;
+  /// The tile's sides moved inwards by a rounding margin; the default rectangle holds nothing.
+  double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
+
+  /// Whether the x-y extent of `box` grown by the halo lies in the rectangle (false for an
+  /// empty box).
+  [[nodiscard]] bool holds(const Box3d& box) const {
+    return box.min.x - halo >= x0 && box.max.x + halo <= x1 && box.min.y - halo >= y0 && box.max.y + halo <= y1;
+  }
 };
 
 class TileGrid {
@@ -50,6 +66,12 @@ class TileGrid {
   /// tetrahedron (a triangle and its viewpoint) goes to these tiles, so that a conflict is
   /// found even when the sensor stood in another tile.
   [[nodiscard]] std::vector<TileKey> tiles_crossed(std::span<const Vec3d> points) const;
+  /// Where a box, grown by the halo, lies inside tile `key` by more than any rounding of
+  /// owner() can cross: a triangle whose corners and viewpoint lie there is owned by `key`
+  /// (its centroid is inside) and copied nowhere else. The tiler keeps the last owner's, since
+  /// consecutive triangles mostly fall in the same tile, and so places most triangles with
+  /// four comparisons.
+  [[nodiscard]] TileInterior interior(TileKey key) const;
   /// Where a triangle is copied besides its owner `owner` (the tile of its centroid):
   /// `halo` = halo_tiles(box of the corners, owner), `crossed` = tiles_crossed(corners and
   /// viewpoint) less the owner and the halo tiles, both in (i, j) order; both empty when the
@@ -71,9 +93,6 @@ class TileGrid {
     [[nodiscard]] bool holds(TileKey k) const { return k.i >= i0 && k.i <= i1 && k.j >= j0 && k.j <= j1; }
   };
   [[nodiscard]] CellRange cells_near(const Box3d& box) const;
-  /// True when the x-y extent of `box` grown by the halo lies inside tile `key` by more than
-  /// any rounding of owner() can cross (false says nothing).
-  [[nodiscard]] bool clearly_within(const Box3d& box, TileKey key) const;
 
   TileGridParams params_;
   double inverse_size_;  ///< 1 / tile_size, for owner() and cells_near()
