@@ -135,6 +135,13 @@ int main(int argc, char** argv) {
              parallel_m.system, wall_list(tile_parallel));
   fmt::print("ratio     : {:.2f} .. {:.2f} x the read of the same round (tiling as `run`)\n", ratios.front(),
              ratios.back());
+  // The kernel's share swings from run to run with the file system (on an ext4 without a
+  // journal, creating files scans the inodes deleted in the last minute): user CPU alone
+  // compares the tiler's own work across builds on a noisy machine.
+  const double read_user = read_m.cpu - read_m.system, tile_user = tile_m.cpu - tile_m.system;
+  fmt::print("user CPU  : tiler {:.2f} s against the read's {:.2f} s, {:.2f} x (one acquisition at a time, "
+             "without the kernel's share)\n",
+             tile_user, read_user, tile_user / read_user);
   fmt::print("tiles     : {} of {:.0f} m, halo copies {:.2f} M, empty-space copies {:.2f} M, {} blocks, {:.0f} MB "
              "written\n",
              store.tiles.size(), params.grid.tile_size, double(store.stats.halo_copies) / 1e6,

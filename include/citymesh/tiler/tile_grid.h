@@ -35,11 +35,11 @@ struct TileGridParams {
 struct TileInterior {
   TileKey key;
   double halo = 0;
-  /// The tile's sides moved inwards by a rounding margin; the default rectangle holds nothing.
+  /// The tile's sides moved inwards by a rounding margin; the default rectangle holds no box
+  /// that holds a point.
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
 
-  /// Whether the x-y extent of `box` grown by the halo lies in the rectangle (false for an
-  /// empty box).
+  /// Whether the x-y extent of `box` (not empty) grown by the halo lies in the rectangle.
   [[nodiscard]] bool holds(const Box3d& box) const {
     return box.min.x - halo >= x0 && box.max.x + halo <= x1 && box.min.y - halo >= y0 && box.max.y + halo <= y1;
   }
