@@ -227,8 +227,8 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
     const int corners_covered = covered[tri[0]] + covered[tri[1]] + covered[tri[2]];
     // A triangle of this part on other parts' vertices cannot be cut (its edges are theirs
     // too), but covered whole it goes: no later part would take it away.
-    const bool own = around.first_own_triangle && t >= *around.first_own_triangle;
-    const bool stays_whole = all_corners_frozen(tri, around.vertex_roles) && !(own && corners_covered == 3);
+    const bool stays_whole =
+        all_corners_frozen(tri, around.vertex_roles) && !(around.told_own(t) && corners_covered == 3);
     if (corners_covered == 0 || stays_whole) {
       triangles.push_back(tri);  // nearly every triangle of a city: no polygon built
       from.push_back(static_cast<std::uint32_t>(t));

@@ -7,11 +7,9 @@
 
 namespace citymesh::mosaic_detail {
 
-MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles,
-                           std::optional<std::size_t> first_own_triangle)
+MeshTopology::MeshTopology(MergedMesh& merged, const StitchSurroundings& around)
     : merged_(merged),
-      roles_(roles),
-      first_own_(first_own_triangle),
+      around_(around),
       offsets_(merged.mesh.vertex_count() + 1, 0),
       edited_(merged.mesh.vertex_count(), UINT32_MAX) {
   const auto& triangles = merged.mesh.triangles;
@@ -27,12 +25,12 @@ MeshTopology::MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> rol
 }
 
 bool MeshTopology::joinable(std::uint32_t v) const {
-  const VertexRole role = role_of(roles_, v);
+  const VertexRole role = role_of(around_.vertex_roles, v);
   if (role == VertexRole::held) return false;
   if (role != VertexRole::later) return true;
   const std::span<const std::uint32_t> around = triangles_of(v);
   return std::any_of(around.begin(), around.end(),
-                     [&](std::uint32_t t) { return (first_own_ && t >= *first_own_) || !frozen_triangle(t); });
+                     [&](std::uint32_t t) { return around_.told_own(t) || !frozen_triangle(t); });
 }
 
 std::span<const std::uint32_t> MeshTopology::triangles_of(std::uint32_t v) const {

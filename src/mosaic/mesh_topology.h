@@ -24,10 +24,9 @@ struct DirectedEdge {
 
 class MeshTopology {
  public:
-  /// `roles`: per vertex, a VertexRole (vertices past its end are free); the caller keeps it
-  /// alive. `first_own_triangle`: where the part's own triangles start (StitchSurroundings).
-  explicit MeshTopology(MergedMesh& merged, std::span<const std::uint8_t> roles = {},
-                        std::optional<std::size_t> first_own_triangle = {});
+  /// `around`: the vertices' roles and where the part's own triangles start (its source sizes
+  /// are not read); the caller keeps its arrays alive.
+  explicit MeshTopology(MergedMesh& merged, const StitchSurroundings& around = {});
 
   [[nodiscard]] MergedMesh& merged() const { return merged_; }
   [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
@@ -39,7 +38,7 @@ class MeshTopology {
   }
 
   /// Whether v must stay where and what it is (a vertex of a part stitched before or after).
-  [[nodiscard]] bool frozen(std::uint32_t v) const { return role_of(roles_, v) != VertexRole::free; }
+  [[nodiscard]] bool frozen(std::uint32_t v) const { return role_of(around_.vertex_roles, v) != VertexRole::free; }
   /// Whether seams may be joined to v: not a held vertex, nor one of a part stitched
   /// afterwards unless this part's triangles use it too (it lies on the border between the
   /// two): a triangle with a free corner, or any of the part's own when they are told.
@@ -47,7 +46,9 @@ class MeshTopology {
   /// Whether triangle t must stay as it is: its three corners are frozen. (A free triangle
   /// whose corners all happen to be frozen is kept as it is too: nothing it could become
   /// would leave them in place anyway but a split of its edges.)
-  [[nodiscard]] bool frozen_triangle(std::uint32_t t) const { return all_corners_frozen(triangle(t), roles_); }
+  [[nodiscard]] bool frozen_triangle(std::uint32_t t) const {
+    return all_corners_frozen(triangle(t), around_.vertex_roles);
+  }
 
   /// The triangles using vertex v, in the order they were added.
   [[nodiscard]] std::span<const std::uint32_t> triangles_of(std::uint32_t v) const;
@@ -76,8 +77,7 @@ class MeshTopology {
 
  private:
   MergedMesh& merged_;
-  std::span<const std::uint8_t> roles_;
-  std::optional<std::size_t> first_own_;
+  StitchSurroundings around_;
   std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
   std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
   std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows

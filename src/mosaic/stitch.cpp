@@ -248,8 +248,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
-  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around.vertex_roles,
-                                                                around.first_own_triangle);
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around);
   const double before = unclipped->boundary_length();
   phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
@@ -258,8 +257,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
     clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle}, around);
   }
   phase_done("clipped");
-  mosaic_detail::MeshTopology& topo =
-      unclipped ? *unclipped : unclipped.emplace(merged, around.vertex_roles, around.first_own_triangle);
+  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged, around);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   phase_done("snapped");
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};

@@ -46,11 +46,9 @@ TileMesh compact(std::span<const Triangle> global, std::size_t vertex_count) {
   return m;
 }
 
-std::vector<Triangle> to_global(const TileMesh& m) {
-  std::vector<Triangle> out;
-  out.reserve(m.triangles.size());
+/// Appends m's triangles to `out` in global vertex indices.
+void append_global(const TileMesh& m, std::vector<Triangle>& out) {
   for (const Triangle& t : m.triangles) out.push_back({m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]});
-  return out;
 }
 
 Box3d mesh_box(const TilesetVertices& vertices, const TileMesh& m) {
@@ -64,10 +62,12 @@ Box3d mesh_box(const TilesetVertices& vertices, const TileMesh& m) {
 void build_parent(const TilesetVertices& vertices, std::span<const TileNode> nodes, TileNode& parent,
                   const TileTreeParams& params) {
   std::vector<Triangle> merged;
+  std::size_t total = 0;
+  for (const std::uint32_t c : parent.children) total += nodes[c].mesh.triangles.size();
+  merged.reserve(total);
   double child_error = 0.0;
   for (const std::uint32_t c : parent.children) {
-    const std::vector<Triangle> g = to_global(nodes[c].mesh);
-    merged.insert(merged.end(), g.begin(), g.end());
+    append_global(nodes[c].mesh, merged);
     child_error = std::max(child_error, nodes[c].geometric_error);
     parent.box.extend(nodes[c].box);
   }
@@ -199,15 +199,18 @@ std::optional<TileNode> parent_of(const TreeBuild& b, std::span<TileNode> nodes,
   return parent;
 }
 
+/// The group's node open above it under `key`: its parent, appended to `nodes`, or without
+/// one the group's single node, carried up.
+OpenNode open_above(std::vector<TileNode>& nodes, std::optional<TileNode> parent, const Group& g, TileKey key) {
+  if (!parent) return {g[0].node, key, true};
+  nodes.push_back(std::move(*parent));
+  return {static_cast<std::uint32_t>(nodes.size() - 1), key, false};
+}
+
 /// Settles one group at `level` in `nodes`: appends its parent, or carries its node up.
 OpenNode settle(const TreeBuild& b, std::vector<TileNode>& nodes, const Group& g, int level, TileKey key) {
-  if (!settled_alone(g)) {
-    if (std::optional<TileNode> parent = parent_of(b, nodes, g, level, key)) {
-      nodes.push_back(std::move(*parent));
-      return {static_cast<std::uint32_t>(nodes.size() - 1), key, false};
-    }
-  }
-  return {g[0].node, key, true};
+  std::optional<TileNode> parent = settled_alone(g) ? std::nullopt : parent_of(b, nodes, g, level, key);
+  return open_above(nodes, std::move(parent), g, key);
 }
 
 /// The subtree of the cell `key` at `level` holding the leaves `leaves` (ascending), depth
@@ -250,13 +253,7 @@ std::vector<OpenNode> add_level(const TreeBuild& b, TileTree& tree, std::span<co
   });
   std::vector<OpenNode> above;
   for (std::size_t p = 0; p < listed.size(); ++p) {
-    const auto& [key, members] = listed[p];
-    if (parents[p]) {
-      above.push_back({static_cast<std::uint32_t>(tree.nodes.size()), key, false});
-      tree.nodes.push_back(std::move(*parents[p]));
-    } else {
-      above.push_back({members[0].node, key, true});
-    }
+    above.push_back(open_above(tree.nodes, std::move(parents[p]), listed[p].second, listed[p].first));
   }
   return above;
 }

@@ -396,7 +396,7 @@ TEST(GapFill, DoesNotSplitATriangleOfOutputStitchedBefore) {
     if (m.source_acq[t] != 0) continue;
     for (const std::uint32_t v : m.mesh.triangles[t]) roles[v] = static_cast<std::uint8_t>(VertexRole::done);
   }
-  mosaic_detail::MeshTopology topo(m, roles);
+  mosaic_detail::MeshTopology topo(m, {.vertex_roles = roles});
   const mosaic_detail::GapFillStats s = mosaic_detail::fill_seam_gaps(topo, {.max_width = 0.1, .max_perimeter = 2.0});
   EXPECT_EQ(s.gaps_split + s.gaps_filled, 0u);
   EXPECT_EQ(s.gaps_refused, 1u);

@@ -82,6 +82,9 @@ struct StitchSurroundings {
   /// triangle of the part whose corners are all frozen is still removed when a larger
   /// source covers it whole (no part after it could).
   std::optional<std::size_t> first_own_triangle = {};
+
+  /// Whether triangle t is told to be the part's own (at or past first_own_triangle).
+  [[nodiscard]] bool told_own(std::size_t t) const { return first_own_triangle && t >= *first_own_triangle; }
 };
 
 /// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
