@@ -245,13 +245,18 @@ TEST(Tiler, DamagedChunksAreInputErrorsNamingTheFile) {
   expect_error("a truncated header");
 }
 
-/// Moves vertex 3 (used by face 1 only) and its sensor position `dx` metres along x.
-void stretch_face_one(Fixture& f, double dx) {
+/// Moves vertex `v` of acquisition 1 with its sensor position to vertex `from`'s position plus
+/// `d` (face 1 is {0, 1, 3}, and vertex 3 is used by face 1 only).
+void move_vertex(Fixture& f, std::uint32_t v, std::uint32_t from, const Vec3d& d) {
   Mesh& m = f.meshes[1];
-  m.positions[3].x += static_cast<float>(dx);
-  m.sensor_positions[3].x += static_cast<float>(dx);
+  const Vec3f to = Vec3f(Vec3d(m.positions[from]) + d);
+  m.sensor_positions[v] = m.sensor_positions[v] + (to - m.positions[v]);
+  m.positions[v] = to;
   write_mesh_ply(f.acquisitions[1].path, m);
 }
+
+/// Moves vertex 3 (used by face 1 only) and its sensor position `dx` metres along x.
+void stretch_face_one(Fixture& f, double dx) { move_vertex(f, 3, 3, {dx, 0, 0}); }
 
 TEST(Tiler, AFaceLongerThanTheMaximumReachIsAnInputErrorNamingFileAndFace) {
   // Without this check one corrupt vertex had the change step fill voxels between Paris and
@@ -272,6 +277,22 @@ TEST(Tiler, AFaceLongerThanTheMaximumReachIsAnInputErrorNamingFileAndFace) {
   };
   expect_error([&] { (void)tile_acquisitions(f.acquisitions, f.params); });
   expect_error([&] { (void)read_mesh(f.acquisitions[1].path); });
+}
+
+TEST(Tiler, AFaceWhoseBoxDiagonalPassesTheMaximumReachButNoEdgeDoesIsTiled) {
+  // The tiler checks the box of a face's corners first and its edges only when the box's
+  // diagonal passes the limit: a face 0.7 of the reach long along every axis (edges of 0.99,
+  // diagonal 1.21 of it) must pass that second check.
+  Fixture f;
+  const double r = 0.7 * kMaxReach;
+  move_vertex(f, 3, 1, {r, 0, r});
+  move_vertex(f, 0, 1, {0, r, r});
+  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  EXPECT_EQ(store.triangles[1], f.meshes[1].triangle_count());
+  EXPECT_NO_THROW((void)read_mesh(f.acquisitions[1].path));
+  // 30 m more along x take the edges from vertex 3 past the limit (about 1011 m).
+  move_vertex(f, 3, 3, {30, 0, 0});
+  EXPECT_THROW((void)tile_acquisitions(f.acquisitions, f.params), InputError);
 }
 
 /// Every file under `dir` by relative path, with its bytes.

@@ -34,11 +34,15 @@ class VarintWriter {
   }
 
   void put(std::uint64_t v) {
+    // Through a local pointer: a char store may alias any object, `at_` included, so writing
+    // through the member made the compiler load and store it again for every byte.
+    char* at = at_;
     while (v >= 0x80) {
-      *at_++ = static_cast<char>(v | 0x80);
+      *at++ = static_cast<char>(v | 0x80);
       v >>= 7;
     }
-    *at_++ = static_cast<char>(v);
+    *at++ = static_cast<char>(v);
+    at_ = at;
   }
 
   /// `value - running` as a zigzag varint (small either way), then `running = value`: a
