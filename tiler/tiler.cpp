@@ -148,17 +148,16 @@ class AcquisitionTiler {
     const Triangle& tri = triangle.corners;
     const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
                                  vertices_.positions[tri[2]]};
-    Box3d reach;
-    for (const Vec3d& p : c) reach.extend(p);
-    // No edge is longer than the box's diagonal: the exact check only when that could fail.
-    const Vec3d diagonal = reach.max - reach.min;
-    if (!(dot(diagonal, diagonal) <= kMaxReach * kMaxReach)) check_face_extent(file, triangle.face, c[0], c[1], c[2]);
+    Box3d corners;
+    for (const Vec3d& p : c) corners.extend(p);
+    check_face_extent(file, triangle.face, corners, c[0], c[1], c[2]);
     const auto t = static_cast<std::uint32_t>(batch_.size());
     batch_.push_back(triangle);
     const Vec3d viewpoint =
         (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
     // Most triangles lie, with their viewpoint, inside the previous triangle's owner: that
     // tile owns them and no other gets a copy (what owner() and copy_targets() would say).
+    Box3d reach = corners;
     reach.extend(viewpoint);
     if (last_interior_.holds(reach)) {
       add_copy(last_interior_.key, t, TileRole::owned);

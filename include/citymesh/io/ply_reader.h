@@ -66,6 +66,15 @@ constexpr double kMaxReach = 1000.0;
 void check_face_extent(const std::filesystem::path& file, std::uint64_t face, const Vec3d& a, const Vec3d& b,
                        const Vec3d& c);
 
+/// The same check for a caller that already has `corners`, the box of a, b and c: no edge is
+/// longer than the box's diagonal, so the edges are measured only when the diagonal passes
+/// kMaxReach (the tiler builds the box anyway to place the face).
+inline void check_face_extent(const std::filesystem::path& file, std::uint64_t face, const Box3d& corners,
+                              const Vec3d& a, const Vec3d& b, const Vec3d& c) {
+  const Vec3d diagonal = corners.max - corners.min;
+  if (!(dot(diagonal, diagonal) <= kMaxReach * kMaxReach)) check_face_extent(file, face, a, b, c);
+}
+
 /// Triangles from consecutive faces; polygons are fan-triangulated, faces that repeat a vertex
 /// are dropped (and counted). Each triangle keeps its face index and fan number.
 struct PlyFaceChunk {
