@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Reading the tile store's blocks: version 3 (varints) and version 2 (fixed-size arrays), each
-// checked against its own bytes before anything is allocated.
+// Reading the tile store's blocks: versions 4 and 3 (varints) and version 2 (fixed-size
+// arrays), each checked against its own bytes before anything is allocated.
 #include <fmt/format.h>
 
 #include <array>
@@ -95,8 +95,18 @@ Unsigned next(VarintReader& in, Unsigned& running, const BlockPlace& place) {
   return running;
 }
 
-/// The varint part of a version-3 payload (see encode_varints).
-void read_varints(VarintReader& in, std::size_t nv, std::size_t nt, const BlockPlace& place, BlockArrays& b) {
+/// Where a triangle's fan and role go, from the varint `fan_role` that holds them above
+/// `low_bits` other bits.
+void set_fan_role(std::uint64_t fan_role, unsigned low_bits, std::size_t t, const BlockPlace& place,
+                  BlockArrays& b) {
+  if (fan_role >> low_bits > UINT32_MAX) throw place.fail(fmt::format("triangle {}: fan out of range", t));
+  b.fans[t] = static_cast<std::uint32_t>(fan_role >> low_bits);
+  b.roles[t] = static_cast<TileRole>(fan_role & 3);
+}
+
+/// The varint part of a version-4 or version-3 payload (see TileBlockWriter).
+void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::size_t nt, const BlockPlace& place,
+                  BlockArrays& b) {
   b.ids.resize(nv);
   b.sensors.resize(nv);
   std::uint32_t id = 0;
@@ -113,18 +123,34 @@ void read_varints(VarintReader& in, std::size_t nv, std::size_t nt, const BlockP
   b.roles.resize(nt);
   std::uint32_t corner = 0, index = 0;
   std::uint64_t face = 0, fan_role = 0;
+  const auto take_fan_role = [&] {
+    if (!in.get(fan_role)) throw place.fail("a varint is truncated or out of range");
+  };
   for (std::size_t t = 0; t < nt; ++t) {
     for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
-    b.faces[t] = next(in, face, place);
-    b.indices[t] = next(in, index, place);
-    if (!in.get(fan_role)) throw place.fail("a varint is truncated or out of range");
-    if (fan_role >> 2 > UINT32_MAX) throw place.fail(fmt::format("triangle {}: fan out of range", t));
-    b.fans[t] = static_cast<std::uint32_t>(fan_role >> 2);
-    b.roles[t] = static_cast<TileRole>(fan_role & 3);
+    if (version == kVersion) {
+      take_fan_role();
+      set_fan_role(fan_role, 3, t, place, b);
+      if ((fan_role & kSteps) != 0) {
+        ++face;
+        ++index;
+      } else {
+        next(in, face, place);
+        next(in, index, place);
+      }
+    } else {
+      next(in, face, place);
+      next(in, index, place);
+      take_fan_role();
+      set_fan_role(fan_role, 2, t, place, b);
+    }
+    b.faces[t] = face;
+    b.indices[t] = index;
   }
 }
 
-/// Reads the version-3 block at the start of `bytes` into `b`; returns its size in bytes.
+/// Reads the version-4 or version-3 block at the start of `bytes` into `b`; returns its size
+/// in bytes.
 std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, BlockArrays& b) {
   BlockHeader h{};
   if (bytes.size() < sizeof h) throw place.fail("truncated header");
@@ -132,8 +158,9 @@ std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, B
   if (h.payload_bytes > bytes.size() - sizeof h) throw place.fail("payload larger than the file (truncated?)");
   // Counts are checked against the payload before anything is allocated.
   const std::uint64_t size = h.payload_bytes, per_vertex = raw_vertex_bytes(h.start.flags) + kMinVarintsPerVertex;
-  if (h.vertices > size / per_vertex || h.triangles > size / kMinVarintsPerTriangle ||
-      h.vertices * per_vertex + h.triangles * kMinVarintsPerTriangle > size) {
+  const std::uint64_t per_triangle = min_varints_per_triangle(h.start.version);
+  if (h.vertices > size / per_vertex || h.triangles > size / per_triangle ||
+      h.vertices * per_vertex + h.triangles * per_triangle > size) {
     throw place.fail("counts larger than the block");
   }
   const char* payload = bytes.data() + sizeof h;
@@ -145,7 +172,7 @@ std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, B
   if ((b.flags & kHasIntensity) != 0) r.take(b.intensities, nv);
   if ((b.flags & kHasColor) != 0) r.take(b.colors, nv);
   VarintReader in(r.at(), payload + size);
-  read_varints(in, nv, nt, place, b);
+  read_varints(in, h.start.version, nv, nt, place, b);
   if (!in.at_end()) throw place.fail("bytes left after the triangles");
   return sizeof h + size;
 }
@@ -209,12 +236,12 @@ TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::u
     if (rest.size() < sizeof start) throw place.fail("truncated header");
     std::memcpy(&start, rest.data(), sizeof start);
     if (std::memcmp(start.magic, kMagic, sizeof kMagic) != 0) throw place.fail("not a citymesh tile block");
-    if (start.version == kVersion) {
+    if (start.version == kVersion || start.version == kFullIdsVersion) {
       place.at += read_varint_block(rest, place, block);
     } else if (start.version == kFixedVersion) {
       place.at += read_fixed_block(rest, place, block);
     } else {
-      throw place.fail(fmt::format("version {} (this build reads {} and {})", start.version, kFixedVersion, kVersion));
+      throw place.fail(fmt::format("version {} (this build reads {} to {})", start.version, kFixedVersion, kVersion));
     }
     merge_block(block, place, acquisition, local, piece);
   }

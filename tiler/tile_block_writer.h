@@ -16,7 +16,7 @@
 
 namespace citymesh::tiler_detail {
 
-/// One version-3 block (see encode_tile_block), built vertex by vertex and triangle by
+/// One version-4 block (see encode_tile_block), built vertex by vertex and triangle by
 /// triangle with no TilePiece in between: building a piece and then encoding it was two passes
 /// over every copy, a fifth of the tiler's time. Vertices must all come before the triangles
 /// only in the bytes, not in the calls: the two varint sequences are kept apart. The buffers
@@ -45,9 +45,16 @@ class TileBlockWriter {
   void add_triangle(const Triangle& corners, std::uint64_t face, std::uint32_t index, std::uint32_t fan,
                     TileRole role) {
     for (const std::uint32_t c : corners) triangle_varints_.put_next(c, corner_);
-    triangle_varints_.put_next(face, face_);
-    triangle_varints_.put_next(index, index_);
-    triangle_varints_.put(std::uint64_t{fan} << 2 | static_cast<std::uint8_t>(role));
+    // Unsigned wrap-around on both sides, as the reader steps.
+    const bool steps = face == face_ + 1 && index == static_cast<std::uint32_t>(index_ + 1);
+    triangle_varints_.put(std::uint64_t{fan} << 3 | (steps ? kSteps : 0) | static_cast<std::uint8_t>(role));
+    if (steps) {
+      face_ = face;
+      index_ = index;
+    } else {
+      triangle_varints_.put_next(face, face_);
+      triangle_varints_.put_next(index, index_);
+    }
     ++triangles_;
   }
 

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Writing the tile store's blocks (version 3) and its files; reading is in
+// Writing the tile store's blocks (version 4) and its files; reading is in
 // tile_block_decode.cpp.
 #include "citymesh/tiler/tile_store.h"
 
@@ -49,10 +49,10 @@ std::vector<std::string_view> write_piece(const TilePiece& piece, TileBlockWrite
 namespace tiler_detail {
 
 void TileBlockWriter::start(std::uint32_t flags, std::size_t max_vertices, std::size_t max_triangles) {
-  // Per vertex four 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 2
-  // | role (34 bits).
+  // Per vertex four 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 3
+  // | step | role (35 bits).
   constexpr std::size_t per_vertex = 4 * max_varint_bytes(32);
-  constexpr std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(34);
+  constexpr std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(35);
   flags_ = flags;
   positions_.clear();
   intensities_.clear();

@@ -1,14 +1,19 @@
 // SPDX-License-Identifier: MIT
-// The tile store's block codec: version 3 (varint deltas) round-trips any values, is under
-// half the size of version 2 on scan-ordered data, still reads version-2 blocks, and turns
-// damage that a checksum cannot see (re-checksummed garbage) into input errors.
+// The tile store's block codec: version 4 (varint deltas, faces and indices that step by one
+// left out) round-trips any values, is under half the size of version 2 and two bytes a
+// triangle smaller than version 3 on scan-ordered data, still reads version-3 and version-2
+// blocks, and turns damage that a checksum cannot see (re-checksummed garbage) into input
+// errors.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <bit>
 #include <cstring>
 #include <random>
 
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/varint.h"
 #include "citymesh/tiler/tile_store.h"
 
 namespace citymesh {
@@ -63,11 +68,40 @@ void expect_same(const TilePiece& a, const TilePiece& b) {
   EXPECT_EQ(a.roles, b.roles);
 }
 
+/// `p` with breaks in its steps: some faces repeat (a polygon's fan), some jump, some indices
+/// jump (a halo copy after a gap), at random places, and the last face and index wrap around.
+TilePiece with_broken_steps(TilePiece p, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uint64_t face_shift = 0;
+  std::uint32_t index_shift = 0;
+  for (std::size_t t = 0; t < p.triangle_count(); ++t) {
+    TriangleId& id = p.mesh.triangle_ids[t];
+    const unsigned kind = rng() % 8;
+    if (kind == 0 && t > 0) {
+      id.fan = p.mesh.triangle_ids[t - 1].fan + 1;
+      face_shift -= 1;
+    }
+    if (kind == 1) face_shift += rng() % 1000;
+    if (kind == 2) index_shift += static_cast<std::uint32_t>(rng() % 1000);
+    id.face += face_shift;
+    p.triangle_index[t] += index_shift;
+  }
+  p.mesh.triangle_ids.back().face = UINT64_MAX;
+  p.triangle_index.back() = UINT32_MAX;
+  p.mesh.triangle_ids.push_back({kAcquisition, 0, 0});  // both wrap to 0 from their maximum
+  p.triangle_index.push_back(0);
+  p.mesh.triangles.push_back(p.mesh.triangles.back());
+  p.roles.push_back(TileRole::halo);
+  return p;
+}
+
 TEST(TileBlock, AnyValuesRoundTrip) {
   for (const bool scan_order : {false, true}) {
     const TilePiece piece = make_piece(3, 500, 900, scan_order);
     expect_same(piece, decode_tile_blocks(encode_tile_block(piece), kOrigin, kAcquisition, "test"));
   }
+  const TilePiece broken = with_broken_steps(make_piece(3, 500, 900, true), 11);
+  expect_same(broken, decode_tile_blocks(encode_tile_block(broken), kOrigin, kAcquisition, "test"));
 }
 
 TEST(TileBlock, ScanOrderedBlocksTakeUnderHalfOfTheFixedLayout) {
@@ -111,11 +145,57 @@ std::string fixed_layout_block(const TilePiece& p) {
   return block + payload;
 }
 
-TEST(TileBlock, VersionTwoBlocksStillRead) {
-  const TilePiece a = make_piece(5, 300, 400, false), b = make_piece(6, 200, 100, true);
-  // A chunk of old blocks followed by a new one (a resumed run appending): both read.
-  const TilePiece back =
-      decode_tile_blocks(fixed_layout_block(a) + encode_tile_block(b), kOrigin, kAcquisition, "test");
+/// `p` in version 3's layout (version 4's header; positions, intensities, colours; per vertex
+/// the varint deltas of id and sensor bits; per triangle those of the corners, face and index,
+/// then fan << 2 | role), as builds before version 4 wrote it.
+std::string version_three_block(const TilePiece& p) {
+  std::string payload;
+  const auto add = [&](const auto& values) {
+    payload.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(values[0]));
+  };
+  add(p.mesh.positions);
+  add(p.mesh.intensities);
+  add(p.mesh.colors);
+  VarintWriter vertices(p.vertex_ids.size() * 4 * max_varint_bytes(32));
+  std::uint32_t id = 0;
+  std::array<std::uint32_t, 3> sensor{};
+  for (std::size_t v = 0; v < p.vertex_ids.size(); ++v) {
+    vertices.put_next(p.vertex_ids[v], id);
+    const Vec3f& s = p.mesh.sensor_positions[v];
+    vertices.put_next(std::bit_cast<std::uint32_t>(s.x), sensor[0]);
+    vertices.put_next(std::bit_cast<std::uint32_t>(s.y), sensor[1]);
+    vertices.put_next(std::bit_cast<std::uint32_t>(s.z), sensor[2]);
+  }
+  VarintWriter triangles(p.triangle_count() * 6 * max_varint_bytes(64));
+  std::uint32_t corner = 0, index = 0;
+  std::uint64_t face = 0;
+  for (std::size_t t = 0; t < p.triangle_count(); ++t) {
+    for (const std::uint32_t c : p.mesh.triangles[t]) triangles.put_next(c, corner);
+    triangles.put_next(p.mesh.triangle_ids[t].face, face);
+    triangles.put_next(p.triangle_index[t], index);
+    triangles.put(std::uint64_t{p.mesh.triangle_ids[t].fan} << 2 | static_cast<std::uint8_t>(p.roles[t]));
+  }
+  payload += vertices.bytes();
+  payload += triangles.bytes();
+  std::string block("CMTILE01");
+  const std::uint32_t version = 3, flags = 3;
+  const std::uint64_t header[4] = {p.vertex_ids.size(), p.triangle_index.size(), payload.size(),
+                                   bulk_checksum(payload.data(), payload.size())};
+  block.append(reinterpret_cast<const char*>(&version), 4);
+  block.append(reinterpret_cast<const char*>(&flags), 4);
+  block.append(reinterpret_cast<const char*>(header), sizeof header);
+  return block + payload;
+}
+
+TEST(TileBlock, VersionFourTakesTwoBytesATriangleLessThanVersionThreeOnScanOrderedData) {
+  const TilePiece piece = make_piece(4, 4000, 8000, true);
+  // Every triangle but the first (whose face and index start from 0) steps.
+  EXPECT_EQ(version_three_block(piece).size() - encode_tile_block(piece).size(), 2 * (8000 - 1));
+}
+
+/// Checks that `back` is `a`'s triangles, then `b`'s, with their vertices (ids are distinct
+/// between the two).
+void expect_concatenation(const TilePiece& back, const TilePiece& a, const TilePiece& b) {
   ASSERT_EQ(back.triangle_count(), a.triangle_count() + b.triangle_count());
   ASSERT_EQ(back.vertex_ids.size(), a.vertex_ids.size() + b.vertex_ids.size());
   for (std::size_t t = 0; t < back.triangle_count(); ++t) {
@@ -132,7 +212,22 @@ TEST(TileBlock, VersionTwoBlocksStillRead) {
   }
 }
 
-/// Re-checksums a version-3 block after its payload was changed, so that only the decoder's
+TEST(TileBlock, OlderVersionsStillRead) {
+  const TilePiece a = make_piece(5, 300, 400, false), b = make_piece(6, 200, 100, true);
+  // A chunk of old blocks followed by a new one (a resumed run appending): both read.
+  SCOPED_TRACE("version 2");
+  expect_concatenation(decode_tile_blocks(fixed_layout_block(a) + encode_tile_block(b), kOrigin, kAcquisition, "2"),
+                       a, b);
+  TilePiece c = with_broken_steps(make_piece(7, 200, 300, true), 12);
+  for (std::uint32_t& id : c.vertex_ids) id += 100000;  // apart from b's
+  SCOPED_TRACE("version 3");
+  expect_concatenation(decode_tile_blocks(version_three_block(a) + encode_tile_block(b), kOrigin, kAcquisition, "3"),
+                       a, b);
+  expect_concatenation(decode_tile_blocks(version_three_block(c) + encode_tile_block(b), kOrigin, kAcquisition, "3"),
+                       c, b);
+}
+
+/// Re-checksums a version-4 block after its payload was changed, so that only the decoder's
 /// own checks stand between the damage and the piece.
 void recompute_checksum(std::string& block) {
   std::uint64_t payload = 0;
