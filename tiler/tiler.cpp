@@ -90,7 +90,9 @@ class AcquisitionTiler {
         acquisition_(acquisition),
         buffer_bytes_(std::min(buffer_bytes, kMaxBatchBytes)) {}
 
-  void run(const std::filesystem::path& file, const PlyReadParams& ply) {
+  void run(const std::filesystem::path& file, PlyReadParams ply) {
+    // The tile store carries no per-vertex times, so they are not parsed.
+    ply.time_names.clear();
     PlyReader reader(file, ply);
     if (reader.vertex_count() > std::uint64_t{UINT32_MAX}) {
       throw InputError(fmt::format("{}: {} vertices; the tile store numbers them in 32 bits (split the file)",
