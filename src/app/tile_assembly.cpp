@@ -49,6 +49,7 @@ void TileAssembly::add(TileResult result) {
     }
     return static_cast<std::uint32_t>(index_.offsets[a] + t);
   };
+  change_.add(result.change);
   for (const OwnedLabel& l : result.labels) {
     const std::uint32_t g = global(l.acquisition, l.index);
     ++owned_;

@@ -45,6 +45,9 @@ class TileAssembly {
   [[nodiscard]] std::uint64_t seen_through() const { return seen_through_; }
   [[nodiscard]] std::uint64_t filled() const { return filled_; }
   [[nodiscard]] std::uint64_t fill_left_out() const { return fill_left_out_; }
+  /// The change step's figures summed over the tiles: a triangle copied into several tiles
+  /// (halo, empty space) counts in each, and the seconds are each tile's, added up.
+  [[nodiscard]] const ChangeStats& change_stats() const { return change_; }
 
  private:
   /// The index of a label's first_seen or last_seen among the dates met so far.
@@ -62,6 +65,7 @@ class TileAssembly {
   std::vector<std::int64_t> dates_ms_;
   std::optional<PairSpill> pairs_;
   std::uint64_t owned_ = 0, candidates_ = 0, seen_through_ = 0, filled_ = 0, fill_left_out_ = 0;
+  ChangeStats change_;
 };
 
 }  // namespace citymesh::app

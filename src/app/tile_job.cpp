@@ -93,6 +93,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   r.seconds_read = clock.restart();
   ChangeResult change = detect_changes({meshes, dates}, config.change);
   r.seconds_detect = clock.restart();
+  r.change = change.stats;
   std::vector<std::uint8_t> forced(change.index.size(), 0);
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
     for (std::size_t t = 0; t < pieces[a].roles.size(); ++t) {

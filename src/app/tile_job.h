@@ -61,6 +61,7 @@ struct TileResult {
   std::vector<TilePiece> selected;
   double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
   std::uint64_t triangles_in_tile = 0;  ///< owned, halo and empty space
+  ChangeStats change;                   ///< the change step's figures on the whole tile
 };
 
 /// The phase of a tile: tiles of one phase never touch (no shared border or corner), so they

@@ -22,7 +22,38 @@ namespace {
 // fill) in what was padding; older results would read as "nothing noted".
 // Version 05: labels and pairs as varint deltas (about 7 and 6 bytes instead of 32 and 16: the
 // results of a city took more than the tile store); older results are processed again.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '5'};
+// Version 06: the change step's figures (ChangeFigures), which the detect summary of a tiled
+// run sums; older results would leave it zeros.
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '6'};
+
+/// ChangeStats as stored, field by field (a change to ChangeStats must not move them).
+struct ChangeFigures {
+  std::uint64_t triangles, consistent_pairs, conflict_candidates, prefilter_skipped, exact_tests, marked_voxels;
+  double seconds_prepare, seconds_consistency, seconds_grids, seconds_conflicts, seconds_time_series;
+};
+static_assert(sizeof(ChangeFigures) == 88);
+
+ChangeFigures figures_of(const ChangeStats& s) {
+  return {s.triangles,       s.consistent_pairs,    s.conflict_candidates, s.prefilter_skipped,
+          s.exact_tests,     s.marked_voxels,       s.seconds_prepare,     s.seconds_consistency,
+          s.seconds_grids,   s.seconds_conflicts,   s.seconds_time_series};
+}
+
+ChangeStats stats_of(const ChangeFigures& f) {
+  ChangeStats s;
+  s.triangles = f.triangles;
+  s.consistent_pairs = f.consistent_pairs;
+  s.conflict_candidates = f.conflict_candidates;
+  s.prefilter_skipped = f.prefilter_skipped;
+  s.exact_tests = f.exact_tests;
+  s.marked_voxels = f.marked_voxels;
+  s.seconds_prepare = f.seconds_prepare;
+  s.seconds_consistency = f.seconds_consistency;
+  s.seconds_grids = f.seconds_grids;
+  s.seconds_conflicts = f.seconds_conflicts;
+  s.seconds_time_series = f.seconds_time_series;
+  return s;
+}
 
 struct ResultHeader {
   char magic[8];
@@ -31,8 +62,9 @@ struct ResultHeader {
   std::uint64_t labels, pairs, acquisitions, triangles_in_tile;
   double seconds_read, seconds_detect, seconds_mosaic;
   std::uint64_t label_bytes, pair_bytes;  ///< the two varint sections that follow the header
+  ChangeFigures change;
 };
-static_assert(sizeof(ResultHeader) == 96);
+static_assert(sizeof(ResultHeader) == 184);
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
 std::uint64_t label_bits(const OwnedLabel& l) {
@@ -152,6 +184,7 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
   h.seconds_mosaic = r.seconds_mosaic;
   h.label_bytes = labels.bytes().size();
   h.pair_bytes = pairs.bytes().size();
+  h.change = figures_of(r.change);
   std::string bytes;
   append_raw(bytes, h);
   bytes += labels.bytes();
@@ -218,6 +251,7 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   r.seconds_read = h.seconds_read;
   r.seconds_detect = h.seconds_detect;
   r.seconds_mosaic = h.seconds_mosaic;
+  r.change = stats_of(h.change);
   std::size_t at = sizeof h;
   if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;

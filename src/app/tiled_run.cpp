@@ -59,7 +59,7 @@ class TiledDetectOutput final : public DetectOutputSource {
     labels_ = ChangeResult{};
     return assembly_.write_pairs(path, kPairsMagic);
   }
-  [[nodiscard]] ChangeStats stats() const override { return {}; }
+  [[nodiscard]] ChangeStats stats() const override { return assembly_.change_stats(); }
 
  private:
   const Config& config_;

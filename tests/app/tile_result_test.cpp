@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Tile result files: labels and pairs of any values round-trip; damage under a valid checksum
+// Tile result files: labels, pairs and the change step's figures of any values round-trip; damage under a valid checksum
 // makes the tile "processed again", never a crash or a wrong result.
 #include <gtest/gtest.h>
 
@@ -35,6 +35,12 @@ TileResult random_result(std::uint32_t seed, bool scan_order) {
   r.key = {13020, -7};
   r.triangles_in_tile = 4321;
   r.seconds_detect = 0.25;
+  r.change.consistent_pairs = rng();
+  r.change.conflict_candidates = rng();
+  r.change.exact_tests = rng();
+  r.change.marked_voxels = 77;
+  r.change.seconds_grids = 0.125;
+  r.change.seconds_time_series = 1e-3;
   for (std::uint32_t k = 0; k < 700; ++k) {
     OwnedLabel l{.acquisition = scan_order ? k / 400 : static_cast<std::uint32_t>(rng()),
                  .index = scan_order ? 10 + k : static_cast<std::uint32_t>(rng()),
@@ -76,6 +82,12 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
     EXPECT_EQ(back->key, r.key);
     EXPECT_EQ(back->triangles_in_tile, r.triangles_in_tile);
     EXPECT_EQ(back->seconds_detect, r.seconds_detect);
+    EXPECT_EQ(back->change.consistent_pairs, r.change.consistent_pairs);
+    EXPECT_EQ(back->change.conflict_candidates, r.change.conflict_candidates);
+    EXPECT_EQ(back->change.exact_tests, r.change.exact_tests);
+    EXPECT_EQ(back->change.marked_voxels, r.change.marked_voxels);
+    EXPECT_EQ(back->change.seconds_grids, r.change.seconds_grids);
+    EXPECT_EQ(back->change.seconds_time_series, r.change.seconds_time_series);
     expect_same_labels(back->labels, r.labels);
     ASSERT_EQ(back->pairs.size(), r.pairs.size());
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {

@@ -68,6 +68,23 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   EXPECT_NEAR(tiles["seen_through"].get<double>(), whole["seen_through"].get<double>(),
               0.02 * whole["seen_through"].get<double>());
   EXPECT_GT(tiles["filled"].get<std::uint64_t>(), 0u);
+
+  // The detect summary's pre-filter figures are the tiles' summed: one tile finds what the
+  // untiled step finds, many tiles more (their halo and empty-space copies are tested in each
+  // tile that holds them). Up to the tile frame's rounding; the voxels lie on a grid anchored
+  // at the tile's corner instead of the first mesh's origin, so the grid's figures differ more.
+  const nlohmann::json untiled = read_json(dir / "sim/out/detect/summary.json")["prefilter"];
+  const nlohmann::json in_one = read_json(dir / "sim/one/detect/summary.json")["prefilter"];
+  const nlohmann::json in_many = detect["prefilter"];
+  for (const auto& [key, tolerance] : {std::pair{"candidates", 0.01}, std::pair{"exact_tests", 0.01},
+                                       std::pair{"skipped", 0.05}, std::pair{"marked_voxels", 0.05}}) {
+    const auto expected = untiled[key].get<double>();
+    EXPECT_GT(expected, 0.0) << key;
+    EXPECT_NEAR(in_one[key].get<double>(), expected, tolerance * expected) << key;
+    EXPECT_GT(in_many[key].get<double>(), in_one[key].get<double>()) << key;
+  }
+  EXPECT_GT(detect["seconds"]["consistency"].get<double>(), 0.0);
+  EXPECT_GT(detect["seconds"]["detect_total"].get<double>(), detect["seconds"]["conflicts"].get<double>());
 }
 
 TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {

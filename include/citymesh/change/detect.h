@@ -52,6 +52,20 @@ struct ChangeStats {
   [[nodiscard]] double seconds_total() const {
     return seconds_prepare + seconds_consistency + seconds_grids + seconds_conflicts + seconds_time_series;
   }
+  /// Adds another run's figures (a tiled run sums its tiles').
+  void add(const ChangeStats& o) {
+    triangles += o.triangles;
+    consistent_pairs += o.consistent_pairs;
+    conflict_candidates += o.conflict_candidates;
+    prefilter_skipped += o.prefilter_skipped;
+    exact_tests += o.exact_tests;
+    marked_voxels += o.marked_voxels;
+    seconds_prepare += o.seconds_prepare;
+    seconds_consistency += o.seconds_consistency;
+    seconds_grids += o.seconds_grids;
+    seconds_conflicts += o.seconds_conflicts;
+    seconds_time_series += o.seconds_time_series;
+  }
 };
 
 struct ChangeResult {
