@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Tile result files: the labels, consistent pairs and selected triangles of one finished tile.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cstring>
 
@@ -26,32 +27,24 @@ namespace {
 // run sums; older results would leave it zeros.
 constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '6'};
 
-/// ChangeStats as stored, field by field (a change to ChangeStats must not move them).
+/// ChangeStats as stored, in the order of kChangeCounts and kChangeSeconds.
 struct ChangeFigures {
-  std::uint64_t triangles, consistent_pairs, conflict_candidates, prefilter_skipped, exact_tests, marked_voxels;
-  double seconds_prepare, seconds_consistency, seconds_grids, seconds_conflicts, seconds_time_series;
+  std::array<std::uint64_t, kChangeCounts.size()> counts;
+  std::array<double, kChangeSeconds.size()> seconds;
 };
 static_assert(sizeof(ChangeFigures) == 88);
 
 ChangeFigures figures_of(const ChangeStats& s) {
-  return {s.triangles,       s.consistent_pairs,    s.conflict_candidates, s.prefilter_skipped,
-          s.exact_tests,     s.marked_voxels,       s.seconds_prepare,     s.seconds_consistency,
-          s.seconds_grids,   s.seconds_conflicts,   s.seconds_time_series};
+  ChangeFigures f{};
+  for (std::size_t k = 0; k < kChangeCounts.size(); ++k) f.counts[k] = s.*kChangeCounts[k];
+  for (std::size_t k = 0; k < kChangeSeconds.size(); ++k) f.seconds[k] = s.*kChangeSeconds[k];
+  return f;
 }
 
 ChangeStats stats_of(const ChangeFigures& f) {
   ChangeStats s;
-  s.triangles = f.triangles;
-  s.consistent_pairs = f.consistent_pairs;
-  s.conflict_candidates = f.conflict_candidates;
-  s.prefilter_skipped = f.prefilter_skipped;
-  s.exact_tests = f.exact_tests;
-  s.marked_voxels = f.marked_voxels;
-  s.seconds_prepare = f.seconds_prepare;
-  s.seconds_consistency = f.seconds_consistency;
-  s.seconds_grids = f.seconds_grids;
-  s.seconds_conflicts = f.seconds_conflicts;
-  s.seconds_time_series = f.seconds_time_series;
+  for (std::size_t k = 0; k < kChangeCounts.size(); ++k) s.*kChangeCounts[k] = f.counts[k];
+  for (std::size_t k = 0; k < kChangeSeconds.size(); ++k) s.*kChangeSeconds[k] = f.seconds[k];
   return s;
 }
 

@@ -53,20 +53,22 @@ struct ChangeStats {
     return seconds_prepare + seconds_consistency + seconds_grids + seconds_conflicts + seconds_time_series;
   }
   /// Adds another run's figures (a tiled run sums its tiles').
-  void add(const ChangeStats& o) {
-    triangles += o.triangles;
-    consistent_pairs += o.consistent_pairs;
-    conflict_candidates += o.conflict_candidates;
-    prefilter_skipped += o.prefilter_skipped;
-    exact_tests += o.exact_tests;
-    marked_voxels += o.marked_voxels;
-    seconds_prepare += o.seconds_prepare;
-    seconds_consistency += o.seconds_consistency;
-    seconds_grids += o.seconds_grids;
-    seconds_conflicts += o.seconds_conflicts;
-    seconds_time_series += o.seconds_time_series;
-  }
+  void add(const ChangeStats& other);
 };
+
+/// ChangeStats' counts and seconds, for code that treats every figure alike (sums, files).
+/// Tile result files store them in this order: append, never reorder.
+inline constexpr std::array kChangeCounts{&ChangeStats::triangles,           &ChangeStats::consistent_pairs,
+                                          &ChangeStats::conflict_candidates, &ChangeStats::prefilter_skipped,
+                                          &ChangeStats::exact_tests,         &ChangeStats::marked_voxels};
+inline constexpr std::array kChangeSeconds{&ChangeStats::seconds_prepare, &ChangeStats::seconds_consistency,
+                                           &ChangeStats::seconds_grids, &ChangeStats::seconds_conflicts,
+                                           &ChangeStats::seconds_time_series};
+
+inline void ChangeStats::add(const ChangeStats& other) {
+  for (const auto field : kChangeCounts) this->*field += other.*field;
+  for (const auto field : kChangeSeconds) this->*field += other.*field;
+}
 
 struct ChangeResult {
   GlobalTriangles index;
