@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Reading the tile store's blocks: versions 4 and 3 (varints) and version 2 (fixed-size
+// Reading the tile store's blocks: versions 5, 4 and 3 (varints) and version 2 (fixed-size
 // arrays), each checked against its own bytes before anything is allocated.
 #include <fmt/format.h>
 
@@ -104,17 +104,24 @@ void set_fan_role(std::uint64_t fan_role, unsigned low_bits, std::size_t t, cons
   b.roles[t] = static_cast<TileRole>(fan_role & 3);
 }
 
-/// The varint part of a version-4 or version-3 payload (see TileBlockWriter).
+/// The next point of a sequence of points stored as varint deltas of their floats' bits.
+Vec3f next_point(VarintReader& in, std::array<std::uint32_t, 3>& bits, const BlockPlace& place) {
+  for (std::uint32_t& b : bits) next(in, b, place);
+  return {std::bit_cast<float>(bits[0]), std::bit_cast<float>(bits[1]), std::bit_cast<float>(bits[2])};
+}
+
+/// The varint part of a version-5, 4 or 3 payload (see TileBlockWriter).
 void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::size_t nt, const BlockPlace& place,
                   BlockArrays& b) {
   b.ids.resize(nv);
   b.sensors.resize(nv);
+  if (version >= kVersion) b.positions.resize(nv);  // versions 4 and 3 had them raw, read already
   std::uint32_t id = 0;
-  std::array<std::uint32_t, 3> sensor{};
+  std::array<std::uint32_t, 3> position{}, sensor{};
   for (std::size_t v = 0; v < nv; ++v) {
     b.ids[v] = next(in, id, place);
-    for (std::uint32_t& bits : sensor) next(in, bits, place);
-    b.sensors[v] = {std::bit_cast<float>(sensor[0]), std::bit_cast<float>(sensor[1]), std::bit_cast<float>(sensor[2])};
+    if (version >= kVersion) b.positions[v] = next_point(in, position, place);
+    b.sensors[v] = next_point(in, sensor, place);
   }
   b.triangles.resize(nt);
   b.faces.resize(nt);
@@ -128,7 +135,7 @@ void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::
   };
   for (std::size_t t = 0; t < nt; ++t) {
     for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
-    if (version == kVersion) {
+    if (version >= kRawPositionsVersion) {
       take_fan_role();
       set_fan_role(fan_role, 3, t, place, b);
       if ((fan_role & kSteps) != 0) {
@@ -149,16 +156,18 @@ void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::
   }
 }
 
-/// Reads the version-4 or version-3 block at the start of `bytes` into `b`; returns its size
-/// in bytes.
+/// Reads the version-5, 4 or 3 block at the start of `bytes` into `b`; returns its size in
+/// bytes.
 std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, BlockArrays& b) {
   BlockHeader h{};
   if (bytes.size() < sizeof h) throw place.fail("truncated header");
   std::memcpy(&h, bytes.data(), sizeof h);
   if (h.payload_bytes > bytes.size() - sizeof h) throw place.fail("payload larger than the file (truncated?)");
   // Counts are checked against the payload before anything is allocated.
-  const std::uint64_t size = h.payload_bytes, per_vertex = raw_vertex_bytes(h.start.flags) + kMinVarintsPerVertex;
-  const std::uint64_t per_triangle = min_varints_per_triangle(h.start.version);
+  const std::uint32_t version = h.start.version;
+  const std::uint64_t size = h.payload_bytes;
+  const std::uint64_t per_vertex = raw_vertex_bytes(h.start.flags, version) + min_varints_per_vertex(version);
+  const std::uint64_t per_triangle = min_varints_per_triangle(version);
   if (h.vertices > size / per_vertex || h.triangles > size / per_triangle ||
       h.vertices * per_vertex + h.triangles * per_triangle > size) {
     throw place.fail("counts larger than the block");
@@ -168,11 +177,11 @@ std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, B
   b.flags = h.start.flags;
   const std::size_t nv = h.vertices, nt = h.triangles;
   PayloadReader r(payload);
-  r.take(b.positions, nv);
+  if (version < kVersion) r.take(b.positions, nv);
   if ((b.flags & kHasIntensity) != 0) r.take(b.intensities, nv);
   if ((b.flags & kHasColor) != 0) r.take(b.colors, nv);
   VarintReader in(r.at(), payload + size);
-  read_varints(in, h.start.version, nv, nt, place, b);
+  read_varints(in, version, nv, nt, place, b);
   if (!in.at_end()) throw place.fail("bytes left after the triangles");
   return sizeof h + size;
 }
@@ -236,7 +245,7 @@ TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::u
     if (rest.size() < sizeof start) throw place.fail("truncated header");
     std::memcpy(&start, rest.data(), sizeof start);
     if (std::memcmp(start.magic, kMagic, sizeof kMagic) != 0) throw place.fail("not a citymesh tile block");
-    if (start.version == kVersion || start.version == kFullIdsVersion) {
+    if (start.version >= kFullIdsVersion && start.version <= kVersion) {
       place.at += read_varint_block(rest, place, block);
     } else if (start.version == kFixedVersion) {
       place.at += read_fixed_block(rest, place, block);

@@ -11,28 +11,32 @@
 namespace citymesh::tiler_detail {
 
 inline constexpr char kMagic[8] = {'C', 'M', 'T', 'I', 'L', 'E', '0', '1'};
-// Version 4: vertex ids, sensor positions, corners, faces, fans, roles and triangle indices
-// as varint deltas, which mostly take a byte each (version 3, still read, had the same), and a
-// triangle whose face and index are each the previous triangle's plus one (most of a tile's
-// owned triangles) stores neither: a bit beside its fan and role says so. That is two bytes
-// of the six a triangle took, 12 % of a city's tile store. Version 3 was under half the size
-// of version 2's fixed-size arrays, and the tiler's time went mostly into writing them.
-// Versions 3 and 2 are still read, so that work folders and tile results made before stay
-// usable. (Version 1 had an FNV-1a checksum, a tenth of the tiler's time on a city; no
-// longer read.)
-inline constexpr std::uint32_t kVersion = 4;
+// Version 5: per vertex its id, position and sensor position, each coordinate as the varint
+// delta of its float's bits against the previous vertex's: a block's vertices come in scan
+// order, so neighbours are centimetres apart and a coordinate mostly takes two or three
+// bytes instead of four (a fifth of a city's tile store). Per triangle its corners, then
+// fan << 3 | steps << 2 | role, and its face and index only when they are not the previous
+// triangle's plus one (the steps bit).
+// Version 4 (still read) stored the positions as raw floats before the varints. Version 3
+// (still read) always stored the face and index, two bytes of the six a triangle took; it was
+// under half the size of version 2's fixed-size arrays, and the tiler's time went mostly into
+// writing those. Versions 4, 3 and 2 are still read, so that work folders and tile results
+// made before stay usable. (Version 1 had an FNV-1a checksum, a tenth of the tiler's time on a
+// city; no longer read.)
+inline constexpr std::uint32_t kVersion = 5;
+inline constexpr std::uint32_t kRawPositionsVersion = 4;
 inline constexpr std::uint32_t kFullIdsVersion = 3;
 inline constexpr std::uint32_t kFixedVersion = 2;
 inline constexpr std::uint32_t kHasIntensity = 1, kHasColor = 2;
 
-/// What both versions begin with.
+/// What every version begins with.
 struct BlockStart {
   char magic[8];
   std::uint32_t version;
   std::uint32_t flags;
 };
 
-/// Versions 3 and 4's header.
+/// Versions 3 to 5's header.
 struct BlockHeader {
   BlockStart start;
   std::uint64_t vertices;
@@ -51,21 +55,27 @@ struct FixedBlockHeader {
 };
 static_assert(sizeof(FixedBlockHeader) == 40);
 
-/// Bytes per vertex of the attributes stored as they are (versions 3 and 4: positions,
-/// intensities, colours).
-inline std::uint64_t raw_vertex_bytes(std::uint32_t flags) {
-  return 12 + ((flags & kHasIntensity) != 0 ? 4 : 0) + ((flags & kHasColor) != 0 ? 3 : 0);
+/// Bytes per vertex of the optional attributes, stored as they are (intensities, colours).
+inline std::uint64_t attribute_bytes(std::uint32_t flags) {
+  return ((flags & kHasIntensity) != 0 ? 4 : 0) + ((flags & kHasColor) != 0 ? 3 : 0);
 }
-/// Varints take at least a byte each: 4 per vertex (id, sensor x, y, z) and per triangle 4 in
-/// version 4 (3 corners; fan, step and role) and 6 in version 3 (3 corners, face, index; fan
-/// and role).
-inline constexpr std::uint64_t kMinVarintsPerVertex = 4;
-inline std::uint64_t min_varints_per_triangle(std::uint32_t version) { return version == kVersion ? 4 : 6; }
-/// Version 4's last varint of a triangle: fan << 3 | kSteps | role. With kSteps set, its face
-/// and index are the previous triangle's plus one and are not stored.
+/// Bytes per vertex stored as they are in a varint block: versions 3 and 4 also had the
+/// position's three floats there.
+inline std::uint64_t raw_vertex_bytes(std::uint32_t flags, std::uint32_t version) {
+  return (version >= kVersion ? 0 : 12) + attribute_bytes(flags);
+}
+/// Varints take at least a byte each: per vertex 7 in version 5 (id, position, sensor) and 4
+/// before (id, sensor); per triangle 4 from version 4 on (3 corners; fan, step and role) and 6
+/// in version 3 (3 corners, face, index; fan and role).
+inline std::uint64_t min_varints_per_vertex(std::uint32_t version) { return version >= kVersion ? 7 : 4; }
+inline std::uint64_t min_varints_per_triangle(std::uint32_t version) {
+  return version >= kRawPositionsVersion ? 4 : 6;
+}
+/// The last varint of a triangle from version 4 on: fan << 3 | kSteps | role. With kSteps set,
+/// its face and index are the previous triangle's plus one and are not stored.
 inline constexpr std::uint64_t kSteps = 4;
 /// Version 2's fixed sizes.
-inline std::uint64_t fixed_vertex_bytes(std::uint32_t flags) { return 4 + 12 + raw_vertex_bytes(flags); }
+inline std::uint64_t fixed_vertex_bytes(std::uint32_t flags) { return 4 + 12 + 12 + attribute_bytes(flags); }
 inline constexpr std::uint64_t kFixedTriangleBytes = 12 + 8 + 4 + 4 + 1;
 
 /// The block flags of the per-vertex attributes present.

@@ -16,7 +16,7 @@
 
 namespace citymesh::tiler_detail {
 
-/// One version-4 block (see encode_tile_block), built vertex by vertex and triangle by
+/// One version-5 block (see encode_tile_block), built vertex by vertex and triangle by
 /// triangle with no TilePiece in between: building a piece and then encoding it was two passes
 /// over every copy, a fifth of the tiler's time. Vertices must all come before the triangles
 /// only in the bytes, not in the calls: the two varint sequences are kept apart. The buffers
@@ -31,13 +31,16 @@ class TileBlockWriter {
   /// Adds a vertex: `id` in the acquisition, position and sensor position in the tile's frame.
   /// `intensity` and `color` are kept only when the block's flags ask for them.
   void add_vertex(std::uint32_t id, const Vec3f& position, const Vec3f& sensor, float intensity, Rgb8 color) {
-    positions_.push_back(position);
     if ((flags_ & kHasIntensity) != 0) intensities_.push_back(intensity);
     if ((flags_ & kHasColor) != 0) colors_.push_back(color);
     vertex_varints_.put_next(id, id_);
+    vertex_varints_.put_next(float_bits(position.x), position_[0]);
+    vertex_varints_.put_next(float_bits(position.y), position_[1]);
+    vertex_varints_.put_next(float_bits(position.z), position_[2]);
     vertex_varints_.put_next(float_bits(sensor.x), sensor_[0]);
     vertex_varints_.put_next(float_bits(sensor.y), sensor_[1]);
     vertex_varints_.put_next(float_bits(sensor.z), sensor_[2]);
+    ++vertices_;
   }
 
   /// Adds a triangle: corners are indices of this block's vertices; `face`, `fan` and
@@ -58,7 +61,7 @@ class TileBlockWriter {
     ++triangles_;
   }
 
-  [[nodiscard]] std::uint32_t vertex_count() const { return static_cast<std::uint32_t>(positions_.size()); }
+  [[nodiscard]] std::uint32_t vertex_count() const { return vertices_; }
   [[nodiscard]] std::uint64_t triangle_count() const { return triangles_; }
 
   /// The finished block as consecutive byte ranges, header first; valid until start().
@@ -67,13 +70,13 @@ class TileBlockWriter {
  private:
   BlockHeader header_{};
   std::uint32_t flags_ = 0;
-  std::vector<Vec3f> positions_;
+  std::uint32_t vertices_ = 0;
   std::vector<float> intensities_;
   std::vector<Rgb8> colors_;
   VarintWriter vertex_varints_, triangle_varints_;
   // The running values the varints are deltas against.
   std::uint32_t id_ = 0, corner_ = 0, index_ = 0;
-  std::array<std::uint32_t, 3> sensor_{};
+  std::array<std::uint32_t, 3> position_{}, sensor_{};
   std::uint64_t face_ = 0;
   std::uint64_t triangles_ = 0;
 };

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Writing the tile store's blocks (version 4) and its files; reading is in
+// Writing the tile store's blocks (version 5) and its files; reading is in
 // tile_block_decode.cpp.
 #include "citymesh/tiler/tile_store.h"
 
@@ -49,18 +49,18 @@ std::vector<std::string_view> write_piece(const TilePiece& piece, TileBlockWrite
 namespace tiler_detail {
 
 void TileBlockWriter::start(std::uint32_t flags, std::size_t max_vertices, std::size_t max_triangles) {
-  // Per vertex four 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 3
+  // Per vertex seven 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 3
   // | step | role (35 bits).
-  constexpr std::size_t per_vertex = 4 * max_varint_bytes(32);
+  constexpr std::size_t per_vertex = 7 * max_varint_bytes(32);
   constexpr std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(35);
   flags_ = flags;
-  positions_.clear();
+  vertices_ = 0;
   intensities_.clear();
   colors_.clear();
   vertex_varints_.reset(max_vertices * per_vertex);
   triangle_varints_.reset(max_triangles * per_triangle);
   id_ = corner_ = index_ = 0;
-  sensor_ = {};
+  position_ = sensor_ = {};
   face_ = 0;
   triangles_ = 0;
 }
@@ -70,9 +70,9 @@ std::vector<std::string_view> TileBlockWriter::finish() {
   std::memcpy(header_.start.magic, kMagic, sizeof kMagic);
   header_.start.version = kVersion;
   header_.start.flags = flags_;
-  header_.vertices = positions_.size();
+  header_.vertices = vertices_;
   header_.triangles = triangles_;
-  std::vector<std::string_view> parts{bytes_of(positions_)};
+  std::vector<std::string_view> parts;
   if ((flags_ & kHasIntensity) != 0) parts.push_back(bytes_of(intensities_));
   if ((flags_ & kHasColor) != 0) parts.push_back(bytes_of(colors_));
   parts.push_back(vertex_varints_.bytes());
