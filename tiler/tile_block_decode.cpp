@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Reading the tile store's blocks: versions 5, 4 and 3 (varints) and version 2 (fixed-size
+// Reading the tile store's blocks: versions 6 to 3 (varints) and version 2 (fixed-size
 // arrays), each checked against its own bytes before anything is allocated.
 #include <fmt/format.h>
 
@@ -110,17 +110,41 @@ Vec3f next_point(VarintReader& in, std::array<std::uint32_t, 3>& bits, const Blo
   return {std::bit_cast<float>(bits[0]), std::bit_cast<float>(bits[1]), std::bit_cast<float>(bits[2])};
 }
 
-/// The varint part of a version-5, 4 or 3 payload (see TileBlockWriter).
+/// A version-6 triangle's corners: the codes in the low bits of `shape` and the varints of the
+/// corners coded kOther (see CornerWindow).
+Triangle read_coded_corners(VarintReader& in, std::uint64_t shape, std::size_t t, const BlockPlace& place,
+                            CornerWindow& window) {
+  Triangle corners{};
+  for (std::size_t k = 0; k < 3; ++k) {
+    const auto code = static_cast<std::uint32_t>(shape >> (CornerWindow::kCodeBits * (2 - k)) & 7u);
+    std::optional<std::uint64_t> corner;
+    if (code == CornerWindow::kOther) {
+      std::uint64_t distance = 0;
+      if (!in.get(distance)) throw place.fail("a varint is truncated or out of range");
+      corner = window.next_new() - unzigzag(distance);
+    } else {
+      corner = window.corner_of(code);
+    }
+    if (!corner || *corner > UINT32_MAX) throw place.fail(fmt::format("triangle {}: corner {} stands for no vertex", t, k));
+    corners[k] = static_cast<std::uint32_t>(*corner);
+    window.saw(*corner);
+  }
+  window.shift(corners);
+  return corners;
+}
+
+/// The varint part of a version-6 to 3 payload (see TileBlockWriter).
 void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::size_t nt, const BlockPlace& place,
                   BlockArrays& b) {
   b.ids.resize(nv);
   b.sensors.resize(nv);
-  if (version >= kVersion) b.positions.resize(nv);  // versions 4 and 3 had them raw, read already
+  const bool has_positions = version >= kCornerDeltasVersion;  // versions 4 and 3 had them raw
+  if (has_positions) b.positions.resize(nv);
   std::uint32_t id = 0;
   std::array<std::uint32_t, 3> position{}, sensor{};
   for (std::size_t v = 0; v < nv; ++v) {
     b.ids[v] = next(in, id, place);
-    if (version >= kVersion) b.positions[v] = next_point(in, position, place);
+    if (has_positions) b.positions[v] = next_point(in, position, place);
     b.sensors[v] = next_point(in, sensor, place);
   }
   b.triangles.resize(nt);
@@ -130,13 +154,20 @@ void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::
   b.roles.resize(nt);
   std::uint32_t corner = 0, index = 0;
   std::uint64_t face = 0, fan_role = 0;
+  CornerWindow window;
   const auto take_fan_role = [&] {
     if (!in.get(fan_role)) throw place.fail("a varint is truncated or out of range");
   };
   for (std::size_t t = 0; t < nt; ++t) {
-    for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
-    if (version >= kRawPositionsVersion) {
+    if (version >= kVersion) {
       take_fan_role();
+      b.triangles[t] = read_coded_corners(in, fan_role, t, place, window);
+      fan_role >>= 3 * CornerWindow::kCodeBits;
+    } else {
+      for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
+      if (version >= kRawPositionsVersion) take_fan_role();
+    }
+    if (version >= kRawPositionsVersion) {
       set_fan_role(fan_role, 3, t, place, b);
       if ((fan_role & kSteps) != 0) {
         ++face;
@@ -156,8 +187,7 @@ void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::
   }
 }
 
-/// Reads the version-5, 4 or 3 block at the start of `bytes` into `b`; returns its size in
-/// bytes.
+/// Reads the version-6 to 3 block at the start of `bytes` into `b`; returns its size in bytes.
 std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, BlockArrays& b) {
   BlockHeader h{};
   if (bytes.size() < sizeof h) throw place.fail("truncated header");
@@ -177,7 +207,7 @@ std::size_t read_varint_block(std::string_view bytes, const BlockPlace& place, B
   b.flags = h.start.flags;
   const std::size_t nv = h.vertices, nt = h.triangles;
   PayloadReader r(payload);
-  if (version < kVersion) r.take(b.positions, nv);
+  if (version < kCornerDeltasVersion) r.take(b.positions, nv);
   if ((b.flags & kHasIntensity) != 0) r.take(b.intensities, nv);
   if ((b.flags & kHasColor) != 0) r.take(b.colors, nv);
   VarintReader in(r.at(), payload + size);

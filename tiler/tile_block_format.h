@@ -3,27 +3,34 @@
 // and the reader (tile_block_decode.cpp).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <bit>
 #include <cstdint>
+#include <optional>
 
 #include "citymesh/core/mesh.h"
 
 namespace citymesh::tiler_detail {
 
 inline constexpr char kMagic[8] = {'C', 'M', 'T', 'I', 'L', 'E', '0', '1'};
-// Version 5: per vertex its id, position and sensor position, each coordinate as the varint
+// Version 6: per vertex its id, position and sensor position, each coordinate as the varint
 // delta of its float's bits against the previous vertex's: a block's vertices come in scan
 // order, so neighbours are centimetres apart and a coordinate mostly takes two or three
-// bytes instead of four (a fifth of a city's tile store). Per triangle its corners, then
-// fan << 3 | steps << 2 | role, and its face and index only when they are not the previous
-// triangle's plus one (the steps bit).
-// Version 4 (still read) stored the positions as raw floats before the varints. Version 3
-// (still read) always stored the face and index, two bytes of the six a triangle took; it was
-// under half the size of version 2's fixed-size arrays, and the tiler's time went mostly into
-// writing those. Versions 4, 3 and 2 are still read, so that work folders and tile results
-// made before stay usable. (Version 1 had an FNV-1a checksum, a tenth of the tiler's time on a
-// city; no longer read.)
-inline constexpr std::uint32_t kVersion = 5;
+// bytes instead of four. Per triangle one varint holds fan, steps bit, role and a 3-bit code
+// per corner (see CornerWindow: most corners are a corner of one of the two previous
+// triangles, or the block's next new vertex, and need nothing more); the other corners
+// follow as varints, then the face and index only when they are not the previous triangle's
+// plus one (the steps bit). A triangle mostly takes two bytes.
+// Version 5 (still read) stored the corners as varint deltas against the previous corner,
+// about five bytes a triangle, and the fan and role in a varint of their own. Version 4 also
+// stored the positions as raw floats before the varints. Version 3 always stored the face and
+// index; it was under half the size of version 2's fixed-size arrays, and the tiler's time
+// went mostly into writing those. Versions 5 to 2 are still read, so that work folders and
+// tile results made before stay usable. (Version 1 had an FNV-1a checksum, a tenth of the
+// tiler's time on a city; no longer read.)
+inline constexpr std::uint32_t kVersion = 6;
+inline constexpr std::uint32_t kCornerDeltasVersion = 5;
 inline constexpr std::uint32_t kRawPositionsVersion = 4;
 inline constexpr std::uint32_t kFullIdsVersion = 3;
 inline constexpr std::uint32_t kFixedVersion = 2;
@@ -62,18 +69,61 @@ inline std::uint64_t attribute_bytes(std::uint32_t flags) {
 /// Bytes per vertex stored as they are in a varint block: versions 3 and 4 also had the
 /// position's three floats there.
 inline std::uint64_t raw_vertex_bytes(std::uint32_t flags, std::uint32_t version) {
-  return (version >= kVersion ? 0 : 12) + attribute_bytes(flags);
+  return (version >= kCornerDeltasVersion ? 0 : 12) + attribute_bytes(flags);
 }
-/// Varints take at least a byte each: per vertex 7 in version 5 (id, position, sensor) and 4
-/// before (id, sensor); per triangle 4 from version 4 on (3 corners; fan, step and role) and 6
-/// in version 3 (3 corners, face, index; fan and role).
-inline std::uint64_t min_varints_per_vertex(std::uint32_t version) { return version >= kVersion ? 7 : 4; }
+/// Varints take at least a byte each: per vertex 7 from version 5 on (id, position, sensor)
+/// and 4 before (id, sensor); per triangle 1 in version 6 (fan, step, role and corner codes),
+/// 4 in versions 5 and 4 (3 corners; fan, step and role) and 6 in version 3 (3 corners, face,
+/// index; fan and role).
+inline std::uint64_t min_varints_per_vertex(std::uint32_t version) {
+  return version >= kCornerDeltasVersion ? 7 : 4;
+}
 inline std::uint64_t min_varints_per_triangle(std::uint32_t version) {
-  return version >= kRawPositionsVersion ? 4 : 6;
+  return version >= kVersion ? 1 : version >= kRawPositionsVersion ? 4 : 6;
 }
-/// The last varint of a triangle from version 4 on: fan << 3 | kSteps | role. With kSteps set,
-/// its face and index are the previous triangle's plus one and are not stored.
+/// fan << 3 | kSteps | role, from version 4 on. With kSteps set, the triangle's face and index
+/// are the previous triangle's plus one and are not stored.
 inline constexpr std::uint64_t kSteps = 4;
+
+/// Version 6's corner codes, the same state kept by the writer and the reader: a corner is
+/// coded 0 to 5 when it is corner k of the previous triangle (0 to 2) or of the one before
+/// (3 to 5), 6 when it is the block's next new vertex (one past the largest corner so far:
+/// the tiler numbers a block's vertices in order of first use), and 7 otherwise, followed by
+/// a varint of its zigzag distance below the next new vertex. Strips of triangles between two
+/// scan lines share two corners with one of the two triangles before and bring one new
+/// vertex, so that most triangles need no corner varint at all.
+class CornerWindow {
+ public:
+  static constexpr std::uint32_t kNew = 6, kOther = 7, kCodeBits = 3;
+
+  /// The code of `corner` (kOther: see other_distance).
+  [[nodiscard]] std::uint32_t code(std::uint32_t corner) const {
+    for (std::uint32_t slot = 0; slot < recent_.size(); ++slot) {
+      if (recent_[slot] == corner) return slot;
+    }
+    return corner == next_new_ ? kNew : kOther;
+  }
+  /// The corner that codes 0 to 6 stand for; nullopt for a slot no triangle has filled yet.
+  [[nodiscard]] std::optional<std::uint64_t> corner_of(std::uint32_t code) const {
+    if (code == kNew) return next_new_;
+    if (recent_[code] == kEmpty) return std::nullopt;
+    return recent_[code];
+  }
+  [[nodiscard]] std::uint64_t next_new() const { return next_new_; }
+  /// After each corner, coded or decoded.
+  void saw(std::uint64_t corner) { next_new_ = std::max(next_new_, corner + 1); }
+  /// After each triangle.
+  void shift(const Triangle& corners) {
+    std::copy(recent_.begin(), recent_.begin() + 3, recent_.begin() + 3);
+    std::copy(corners.begin(), corners.end(), recent_.begin());
+  }
+
+ private:
+  static constexpr std::uint64_t kEmpty = UINT64_MAX;  ///< no 32-bit corner equals it
+  std::array<std::uint64_t, 6> recent_{kEmpty, kEmpty, kEmpty, kEmpty, kEmpty, kEmpty};
+  std::uint64_t next_new_ = 0;
+};
+
 /// Version 2's fixed sizes.
 inline std::uint64_t fixed_vertex_bytes(std::uint32_t flags) { return 4 + 12 + 12 + attribute_bytes(flags); }
 inline constexpr std::uint64_t kFixedTriangleBytes = 12 + 8 + 4 + 4 + 1;

@@ -16,7 +16,7 @@
 
 namespace citymesh::tiler_detail {
 
-/// One version-5 block (see encode_tile_block), built vertex by vertex and triangle by
+/// One version-6 block (see encode_tile_block), built vertex by vertex and triangle by
 /// triangle with no TilePiece in between: building a piece and then encoding it was two passes
 /// over every copy, a fifth of the tiler's time. Vertices must all come before the triangles
 /// only in the bytes, not in the calls: the two varint sequences are kept apart. The buffers
@@ -47,10 +47,21 @@ class TileBlockWriter {
   /// `index` (in the acquisition) as in the triangle's global id and TilePiece.
   void add_triangle(const Triangle& corners, std::uint64_t face, std::uint32_t index, std::uint32_t fan,
                     TileRole role) {
-    for (const std::uint32_t c : corners) triangle_varints_.put_next(c, corner_);
+    std::uint64_t codes = 0;
+    std::array<std::uint64_t, 3> others{};  // zigzag distances of the corners coded kOther
+    std::size_t other_count = 0;
+    for (const std::uint32_t c : corners) {
+      const std::uint32_t code = window_.code(c);
+      if (code == CornerWindow::kOther) others[other_count++] = zigzag(window_.next_new() - c);
+      codes = codes << CornerWindow::kCodeBits | code;
+      window_.saw(c);
+    }
+    window_.shift(corners);
     // Unsigned wrap-around on both sides, as the reader steps.
     const bool steps = face == face_ + 1 && index == static_cast<std::uint32_t>(index_ + 1);
-    triangle_varints_.put(std::uint64_t{fan} << 3 | (steps ? kSteps : 0) | static_cast<std::uint8_t>(role));
+    const std::uint64_t fan_role = std::uint64_t{fan} << 3 | (steps ? kSteps : 0) | static_cast<std::uint8_t>(role);
+    triangle_varints_.put(fan_role << (3 * CornerWindow::kCodeBits) | codes);
+    for (std::size_t k = 0; k < other_count; ++k) triangle_varints_.put(others[k]);
     if (steps) {
       face_ = face;
       index_ = index;
@@ -75,7 +86,8 @@ class TileBlockWriter {
   std::vector<Rgb8> colors_;
   VarintWriter vertex_varints_, triangle_varints_;
   // The running values the varints are deltas against.
-  std::uint32_t id_ = 0, corner_ = 0, index_ = 0;
+  std::uint32_t id_ = 0, index_ = 0;
+  CornerWindow window_;
   std::array<std::uint32_t, 3> position_{}, sensor_{};
   std::uint64_t face_ = 0;
   std::uint64_t triangles_ = 0;

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Writing the tile store's blocks (version 5) and its files; reading is in
+// Writing the tile store's blocks (version 6) and its files; reading is in
 // tile_block_decode.cpp.
 #include "citymesh/tiler/tile_store.h"
 
@@ -49,17 +49,18 @@ std::vector<std::string_view> write_piece(const TilePiece& piece, TileBlockWrite
 namespace tiler_detail {
 
 void TileBlockWriter::start(std::uint32_t flags, std::size_t max_vertices, std::size_t max_triangles) {
-  // Per vertex seven 32-bit deltas; per triangle four 32-bit deltas, a 64-bit one and fan << 3
-  // | step | role (35 bits).
+  // Per vertex seven 32-bit deltas; per triangle fan << 3 | step | role with the corner codes
+  // (44 bits), up to three corner distances and the face (64-bit deltas), and the index.
   constexpr std::size_t per_vertex = 7 * max_varint_bytes(32);
-  constexpr std::size_t per_triangle = 4 * max_varint_bytes(32) + max_varint_bytes(64) + max_varint_bytes(35);
+  constexpr std::size_t per_triangle = max_varint_bytes(44) + 4 * max_varint_bytes(64) + max_varint_bytes(32);
   flags_ = flags;
   vertices_ = 0;
   intensities_.clear();
   colors_.clear();
   vertex_varints_.reset(max_vertices * per_vertex);
   triangle_varints_.reset(max_triangles * per_triangle);
-  id_ = corner_ = index_ = 0;
+  id_ = index_ = 0;
+  window_ = {};
   position_ = sensor_ = {};
   face_ = 0;
   triangles_ = 0;

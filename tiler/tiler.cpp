@@ -64,7 +64,7 @@ struct BatchTile {
 std::string chunk_name(TileKey key);
 
 /// Memory one copy takes in the block of its tile while that tile is written: its varints up
-/// to 35 bytes and a new vertex up to 42 more (a tile's copies bring fewer new vertices than
+/// to 52 bytes and a new vertex up to 42 more (a tile's copies bring fewer new vertices than
 /// that on average: a mesh has about half as many vertices as triangles). Only the largest
 /// tile of a batch is ever built at once.
 constexpr std::uint64_t kBlockBytesPerCopy = 96;

@@ -16,6 +16,13 @@ namespace citymesh {
 /// needs one bit more).
 constexpr std::size_t max_varint_bytes(unsigned bits) { return (bits + 1 + 6) / 7; }
 
+/// `d`, a difference modulo 2^64 read as signed, with its sign in the low bit: small either way.
+constexpr std::uint64_t zigzag(std::uint64_t d) {
+  return d << 1 ^ static_cast<std::uint64_t>(static_cast<std::int64_t>(d) >> 63);
+}
+/// The inverse of zigzag.
+constexpr std::uint64_t unzigzag(std::uint64_t z) { return (z >> 1) ^ (~(z & 1) + 1); }
+
 /// Writes varints into a buffer sized beforehand: `room` must be at least the bytes every
 /// value to come can take (see max_varint_bytes), so that no write checks the capacity. The
 /// buffer is not zeroed: only the bytes written are ever touched.
@@ -51,8 +58,7 @@ class VarintWriter {
   template <class Unsigned>
   void put_next(Unsigned value, Unsigned& running) {
     static_assert(std::is_unsigned_v<Unsigned>);
-    const auto d = static_cast<std::int64_t>(std::uint64_t{value} - std::uint64_t{running});
-    put((static_cast<std::uint64_t>(d) << 1) ^ static_cast<std::uint64_t>(d >> 63));
+    put(zigzag(std::uint64_t{value} - std::uint64_t{running}));
     running = value;
   }
 
@@ -87,7 +93,7 @@ class VarintReader {
   [[nodiscard]] bool get_next(std::uint64_t& running) {
     std::uint64_t z = 0;
     if (!get(z)) return false;
-    running += (z >> 1) ^ (~(z & 1) + 1);
+    running += unzigzag(z);
     return true;
   }
 
