@@ -125,7 +125,9 @@ Triangle read_coded_corners(VarintReader& in, std::uint64_t shape, std::size_t t
     } else {
       corner = window.corner_of(code);
     }
-    if (!corner || *corner > UINT32_MAX) throw place.fail(fmt::format("triangle {}: corner {} stands for no vertex", t, k));
+    if (!corner || *corner > UINT32_MAX) {
+      throw place.fail(fmt::format("triangle {}: corner {} stands for no vertex", t, k));
+    }
     corners[k] = static_cast<std::uint32_t>(*corner);
     window.saw(*corner);
   }
