@@ -116,7 +116,8 @@ Triangle read_coded_corners(VarintReader& in, std::uint64_t shape, std::size_t t
                             CornerWindow& window) {
   Triangle corners{};
   for (std::size_t k = 0; k < 3; ++k) {
-    const auto code = static_cast<std::uint32_t>(shape >> (CornerWindow::kCodeBits * (2 - k)) & 7u);
+    const std::uint64_t code_at = shape >> (CornerWindow::kCodeBits * (2 - k));
+    const auto code = static_cast<std::uint32_t>(code_at & CornerWindow::kCodeMask);
     std::optional<std::uint64_t> corner;
     if (code == CornerWindow::kOther) {
       std::uint64_t distance = 0;
@@ -164,7 +165,7 @@ void read_varints(VarintReader& in, std::uint32_t version, std::size_t nv, std::
     if (version >= kVersion) {
       take_fan_role();
       b.triangles[t] = read_coded_corners(in, fan_role, t, place, window);
-      fan_role >>= 3 * CornerWindow::kCodeBits;
+      fan_role >>= CornerWindow::kTriangleCodeBits;
     } else {
       for (std::uint32_t& c : b.triangles[t]) c = next(in, corner, place);
       if (version >= kRawPositionsVersion) take_fan_role();

@@ -43,7 +43,7 @@ struct BlockStart {
   std::uint32_t flags;
 };
 
-/// Versions 3 to 5's header.
+/// Versions 3 to 6's header.
 struct BlockHeader {
   BlockStart start;
   std::uint64_t vertices;
@@ -94,9 +94,11 @@ inline constexpr std::uint64_t kSteps = 4;
 /// vertex, so that most triangles need no corner varint at all.
 class CornerWindow {
  public:
-  static constexpr std::uint32_t kNew = 6, kOther = 7, kCodeBits = 3;
+  static constexpr std::uint32_t kNew = 6, kOther = 7, kCodeBits = 3, kCodeMask = (1u << kCodeBits) - 1;
+  /// A triangle's three codes, first corner highest, in the low bits of its varint.
+  static constexpr std::uint32_t kTriangleCodeBits = 3 * kCodeBits;
 
-  /// The code of `corner` (kOther: see other_distance).
+  /// The code of `corner` (kOther: its distance below next_new() follows, zigzagged).
   [[nodiscard]] std::uint32_t code(std::uint32_t corner) const {
     for (std::uint32_t slot = 0; slot < recent_.size(); ++slot) {
       if (recent_[slot] == corner) return slot;

@@ -34,12 +34,8 @@ class TileBlockWriter {
     if ((flags_ & kHasIntensity) != 0) intensities_.push_back(intensity);
     if ((flags_ & kHasColor) != 0) colors_.push_back(color);
     vertex_varints_.put_next(id, id_);
-    vertex_varints_.put_next(float_bits(position.x), position_[0]);
-    vertex_varints_.put_next(float_bits(position.y), position_[1]);
-    vertex_varints_.put_next(float_bits(position.z), position_[2]);
-    vertex_varints_.put_next(float_bits(sensor.x), sensor_[0]);
-    vertex_varints_.put_next(float_bits(sensor.y), sensor_[1]);
-    vertex_varints_.put_next(float_bits(sensor.z), sensor_[2]);
+    put_point(position, position_);
+    put_point(sensor, sensor_);
     ++vertices_;
   }
 
@@ -60,7 +56,7 @@ class TileBlockWriter {
     // Unsigned wrap-around on both sides, as the reader steps.
     const bool steps = face == face_ + 1 && index == static_cast<std::uint32_t>(index_ + 1);
     const std::uint64_t fan_role = std::uint64_t{fan} << 3 | (steps ? kSteps : 0) | static_cast<std::uint8_t>(role);
-    triangle_varints_.put(fan_role << (3 * CornerWindow::kCodeBits) | codes);
+    triangle_varints_.put(fan_role << CornerWindow::kTriangleCodeBits | codes);
     for (std::size_t k = 0; k < other_count; ++k) triangle_varints_.put(others[k]);
     if (steps) {
       face_ = face;
@@ -79,6 +75,13 @@ class TileBlockWriter {
   [[nodiscard]] std::vector<std::string_view> finish();
 
  private:
+  /// A point's coordinates as varint deltas of their floats' bits against `running`'s.
+  void put_point(const Vec3f& p, std::array<std::uint32_t, 3>& running) {
+    vertex_varints_.put_next(float_bits(p.x), running[0]);
+    vertex_varints_.put_next(float_bits(p.y), running[1]);
+    vertex_varints_.put_next(float_bits(p.z), running[2]);
+  }
+
   BlockHeader header_{};
   std::uint32_t flags_ = 0;
   std::uint32_t vertices_ = 0;

@@ -164,18 +164,15 @@ std::string varint_block(const TilePiece& p, std::uint32_t version) {
   VarintWriter vertices(p.vertex_ids.size() * 7 * max_varint_bytes(32));
   std::uint32_t id = 0;
   std::array<std::uint32_t, 3> position{}, sensor{};
+  const auto put_point = [&](const Vec3f& x, std::array<std::uint32_t, 3>& running) {
+    vertices.put_next(std::bit_cast<std::uint32_t>(x.x), running[0]);
+    vertices.put_next(std::bit_cast<std::uint32_t>(x.y), running[1]);
+    vertices.put_next(std::bit_cast<std::uint32_t>(x.z), running[2]);
+  };
   for (std::size_t v = 0; v < p.vertex_ids.size(); ++v) {
     vertices.put_next(p.vertex_ids[v], id);
-    const Vec3f& x = p.mesh.positions[v];
-    if (version == 5) {
-      vertices.put_next(std::bit_cast<std::uint32_t>(x.x), position[0]);
-      vertices.put_next(std::bit_cast<std::uint32_t>(x.y), position[1]);
-      vertices.put_next(std::bit_cast<std::uint32_t>(x.z), position[2]);
-    }
-    const Vec3f& s = p.mesh.sensor_positions[v];
-    vertices.put_next(std::bit_cast<std::uint32_t>(s.x), sensor[0]);
-    vertices.put_next(std::bit_cast<std::uint32_t>(s.y), sensor[1]);
-    vertices.put_next(std::bit_cast<std::uint32_t>(s.z), sensor[2]);
+    if (version == 5) put_point(p.mesh.positions[v], position);
+    put_point(p.mesh.sensor_positions[v], sensor);
   }
   VarintWriter triangles(p.triangle_count() * 6 * max_varint_bytes(64));
   std::uint32_t corner = 0, index = 0;
