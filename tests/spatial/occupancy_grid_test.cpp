@@ -57,6 +57,45 @@ TEST(OccupancyGrid, MarksAndQueriesLikeAVoxelSet) {
   }
 }
 
+/// Marks the voxels of [lo, hi] in the reference set.
+void mark_reference(const Vec3f& lo, const Vec3f& hi, double s, std::set<Voxel>& reference) {
+  const auto [i0, j0, k0] = voxel(lo, s);
+  const auto [i1, j1, k1] = voxel(hi, s);
+  for (int a = i0; a <= i1; ++a)
+    for (int b = j0; b <= j1; ++b)
+      for (int c = k0; c <= k1; ++c) reference.insert({a, b, c});
+}
+
+TEST(OccupancyGrid, SmallBoxesAcrossLeavesAndInsideFilledRegionsMarkExactlyTheirVoxels) {
+  // Voxels of 1 m: leaves of 8 voxels start at multiples of 8, so boxes of 1 to 4 voxels
+  // around +-8 and +-16 straddle leaves on every axis, on both sides of zero. Large boxes go
+  // through the sparse fill first, which may leave whole active tiles under later small boxes.
+  const double s = 1.0;
+  OccupancyGrid grid(s);
+  std::set<Voxel> reference;
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<float> corner(-18.f, 18.f), extent(0.f, 3.5f);
+  for (int i = 0; i < 4; ++i) {
+    const Vec3f lo{corner(rng), corner(rng), corner(rng)};
+    const Vec3f hi = lo + Vec3f{9.f, 17.f, 8.5f};  // > 64 voxels: the fill
+    grid.mark_box(lo, hi);
+    mark_reference(lo, hi, s, reference);
+  }
+  for (int i = 0; i < 3000; ++i) {
+    const Vec3f lo{corner(rng), corner(rng), corner(rng)};
+    const Vec3f hi = lo + Vec3f{extent(rng), extent(rng), extent(rng)};
+    grid.mark_box(lo, hi);
+    mark_reference(lo, hi, s, reference);
+  }
+  EXPECT_EQ(grid.marked_voxels(), reference.size());
+  for (int a = -20; a <= 24; ++a)
+    for (int b = -20; b <= 24; ++b)
+      for (int c = -20; c <= 24; ++c) {
+        const Vec3f centre{float(a) + 0.5f, float(b) + 0.5f, float(c) + 0.5f};
+        ASSERT_EQ(grid.occupied(centre), reference.count({a, b, c}) == 1) << a << " " << b << " " << c;
+      }
+}
+
 TEST(OccupancyGrid, MergeIsTheUnionAndRepeatedBoxesStayMarked) {
   OccupancyGrid a(0.5), b(0.5);
   a.mark_box({0, 0, 0}, {0.9f, 0.4f, 0.4f});  // 2 voxels
