@@ -1,18 +1,25 @@
 // SPDX-License-Identifier: MIT
 // Stitching an output block by block: each part of it once, with what lies around it as
 // frozen surroundings (StitchSurroundings), so that a part needs memory of its own size and
-// the parts of one level run in parallel.
+// the parts of one level run in parallel. The parts live in a PartStore between levels: in
+// memory (stitch_in_blocks) or in files (a tiled run's bounded final pass).
 #pragma once
 
 #include <array>
+#include <compare>
 #include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
 
 #include "citymesh/mosaic/stitch.h"
 
 namespace citymesh {
 
-/// A square grid of blocks over the output, in the mesh's frame, and the bands along the
-/// block sides.
+/// A square grid of blocks over the output, in the frame of the positions it is given, and
+/// the bands along the block sides.
 struct BlockStitchParams {
   double origin_x = 0, origin_y = 0;  ///< metres: a corner of the grid
   double size = 50;                   ///< metres: a block's side
@@ -40,11 +47,95 @@ double block_context(const StitchParams& params);
 /// interior, with the bands along its sides as surroundings stitched later; then each band
 /// without its ends, those along x = const before those along y = const, with what was
 /// stitched before as done and the rest later; then the corner squares, with everything
-/// else done. Each triangle belongs to the
-/// part holding its centroid. A part sees only the triangles within the context of it; the
-/// parts of a level run in parallel and the output (parts in level and grid order) is the
-/// same whatever the thread count. Throws std::invalid_argument on a layout that breaks
-/// the rules above.
+/// else done. Each triangle belongs to the part holding its centroid. A part sees only the
+/// triangles within the context of it, the parts of its own level as they were before the
+/// level; the parts of a level run in parallel and the output (parts in level and grid order,
+/// the mesh's vertices first and in place, new ones after) is the same whatever the thread
+/// count. `blocks` is in the mesh's frame. Throws std::invalid_argument on a layout that
+/// breaks the rules above.
 BlockStitchStats stitch_in_blocks(MergedMesh& mesh, const StitchParams& params, const BlockStitchParams& blocks);
+
+// ----- The parts, and stitching them wherever they are kept ------------------------------
+
+/// Which part a triangle belongs to. Level 0: a block interior (x, y: the block). Level 1: a
+/// band along the grid line x, without its ends (y: the block row). Level 2: the same along
+/// the grid line y (x: the block column). Level 3: the corner square at grid point (x, y).
+/// The parts of one level lie apart: the bands along x are held apart by the corner squares,
+/// and so on (the two kinds of band touch at the corner squares' inner corners).
+struct BlockPartKey {
+  int level = 0;
+  std::int64_t x = 0, y = 0;
+  friend auto operator<=>(const BlockPartKey&, const BlockPartKey&) = default;
+  /// "<level>_<x>_<y>": a file name.
+  [[nodiscard]] std::string name() const;
+};
+
+/// The part of a triangle whose centroid is `centroid` (same frame as `blocks`).
+BlockPartKey block_part_of(const Vec3d& centroid, const BlockStitchParams& blocks);
+
+/// Throws std::invalid_argument when `blocks` breaks the rules of BlockStitchParams for
+/// surroundings of `context` metres.
+void check_block_layout(const BlockStitchParams& blocks, double context);
+
+/// Keys of the vertices stitching makes: kNewVertexKey | part << 32 | k for the k-th vertex
+/// part `part` (its index in the run's part list) made. Other keys are the caller's own, below.
+inline constexpr std::uint64_t kNewVertexKey = std::uint64_t{1} << 63;
+
+/// Some triangles of an output, on vertices named by 64-bit keys (one key, one vertex of the
+/// whole output, wherever it is stored), positions in the project CRS as doubles: what
+/// block stitching keeps of a part between levels.
+struct KeyedPiece {
+  std::vector<std::uint64_t> keys;        ///< per vertex, ascending
+  std::vector<Vec3d> positions, sensors;  ///< per vertex; sensors empty when the output has none
+  std::vector<double> times;              ///< per vertex, or empty
+  std::vector<float> intensities;         ///< per vertex, or empty
+  std::vector<Rgb8> colors;               ///< per vertex, or empty
+  std::vector<Triangle> triangles;        ///< on the vertices above
+  std::vector<TriangleId> ids;
+  std::vector<std::int32_t> source_acq, source_triangle;
+
+  [[nodiscard]] std::size_t vertex_count() const { return keys.size(); }
+  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
+  /// The box of the triangles' corners.
+  [[nodiscard]] Box3d box() const;
+  /// The box of triangle t's corners.
+  [[nodiscard]] Box3d box(std::size_t t) const;
+  /// Throws ProcessingError naming `what` when the arrays disagree, keys are not ascending
+  /// or a corner is out of range.
+  void check(std::string_view what) const;
+};
+
+/// Where block stitching keeps the parts between levels.
+class PartStore {
+ public:
+  virtual ~PartStore() = default;
+  /// Part `part` (its index in the run's list) as it was before stitching, or once stitched
+  /// (only after save_stitched). Called from several threads at once.
+  [[nodiscard]] virtual std::shared_ptr<const KeyedPiece> load(std::size_t part, bool stitched) const = 0;
+  /// Keeps the stitched triangles of part `part`: once per part, from several threads at once
+  /// (never for the same part).
+  virtual void save_stitched(std::size_t part, KeyedPiece stitched) = 0;
+};
+
+/// A part of a run: its key and the box of its triangles before and after stitching.
+struct BlockPart {
+  BlockPartKey key;
+  Box3d box, stitched_box;
+};
+
+struct PartStitchRun {
+  StitchParams params;
+  BlockStitchParams blocks;  ///< in the frame of the pieces' positions, context set
+  /// Per source: its triangles in the whole output (clipping's precedence).
+  std::vector<std::uint64_t> source_sizes;
+  /// The frame every part is stitched in; unset: each part's own, the lowest corner of its
+  /// box in whole metres (floats relative to it keep their precision anywhere in a city).
+  std::optional<Vec3d> frame;
+};
+
+/// Stitches every part of `parts` (sorted by key, boxes set) level by level as
+/// stitch_in_blocks describes, reading them from `store` and saving each one stitched there;
+/// sets their stitched boxes. The open boundary figures are left to the caller.
+BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run);
 
 }  // namespace citymesh
