@@ -215,31 +215,6 @@ double block_context(const StitchParams& params) {
   return 1.25 * farthest;  // a margin: what is looked for near a vertex may lie a little farther
 }
 
-Box3d KeyedPiece::box(std::size_t t) const {
-  Box3d b;
-  for (const std::uint32_t v : triangles[t]) b.extend(positions[v]);
-  return b;
-}
-
-Box3d KeyedPiece::box() const {
-  Box3d b;
-  for (std::size_t t = 0; t < triangle_count(); ++t) b.extend(box(t));
-  return b;
-}
-
-void KeyedPiece::check(std::string_view what) const {
-  const std::size_t n = keys.size(), tris = triangles.size();
-  const auto optional_size = [&](std::size_t size) { return size == 0 || size == n; };
-  bool ok = positions.size() == n && optional_size(sensors.size()) && optional_size(times.size()) &&
-            optional_size(intensities.size()) && optional_size(colors.size()) && ids.size() == tris &&
-            source_acq.size() == tris && source_triangle.size() == tris &&
-            std::adjacent_find(keys.begin(), keys.end(), std::greater_equal<>()) == keys.end();
-  for (std::size_t t = 0; ok && t < tris; ++t) {
-    ok = triangles[t][0] < n && triangles[t][1] < n && triangles[t][2] < n;
-  }
-  if (!ok) throw ProcessingError(fmt::format("{}: the part's arrays disagree or its vertices are out of order", what));
-}
-
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run) {
   const double context = run.blocks.context > 0 ? run.blocks.context : block_context(run.params);
   check_block_layout(run.blocks, context);

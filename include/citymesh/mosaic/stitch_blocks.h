@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "citymesh/mosaic/keyed_piece.h"
 #include "citymesh/mosaic/stitch.h"
 
 namespace citymesh {
@@ -80,30 +81,6 @@ void check_block_layout(const BlockStitchParams& blocks, double context);
 /// Keys of the vertices stitching makes: kNewVertexKey | part << 32 | k for the k-th vertex
 /// part `part` (its index in the run's part list) made. Other keys are the caller's own, below.
 inline constexpr std::uint64_t kNewVertexKey = std::uint64_t{1} << 63;
-
-/// Some triangles of an output, on vertices named by 64-bit keys (one key, one vertex of the
-/// whole output, wherever it is stored), positions in the project CRS as doubles: what
-/// block stitching keeps of a part between levels.
-struct KeyedPiece {
-  std::vector<std::uint64_t> keys;        ///< per vertex, ascending
-  std::vector<Vec3d> positions, sensors;  ///< per vertex; sensors empty when the output has none
-  std::vector<double> times;              ///< per vertex, or empty
-  std::vector<float> intensities;         ///< per vertex, or empty
-  std::vector<Rgb8> colors;               ///< per vertex, or empty
-  std::vector<Triangle> triangles;        ///< on the vertices above
-  std::vector<TriangleId> ids;
-  std::vector<std::int32_t> source_acq, source_triangle;
-
-  [[nodiscard]] std::size_t vertex_count() const { return keys.size(); }
-  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
-  /// The box of the triangles' corners.
-  [[nodiscard]] Box3d box() const;
-  /// The box of triangle t's corners.
-  [[nodiscard]] Box3d box(std::size_t t) const;
-  /// Throws ProcessingError naming `what` when the arrays disagree, keys are not ascending
-  /// or a corner is out of range.
-  void check(std::string_view what) const;
-};
 
 /// Where block stitching keeps the parts between levels.
 class PartStore {

@@ -1,0 +1,50 @@
+// SPDX-License-Identifier: MIT
+// Pieces of an output on vertices named by keys: what a seam pass keeps apart from the whole
+// output (in memory or in files) and puts back together.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "citymesh/core/mesh.h"
+
+namespace citymesh {
+
+/// Some triangles of an output, on vertices named by 64-bit keys (one key, one vertex of the
+/// whole output, wherever it is stored), positions in the project CRS as doubles: what
+/// block stitching keeps of a part between levels.
+struct KeyedPiece {
+  std::vector<std::uint64_t> keys;        ///< per vertex, ascending
+  std::vector<Vec3d> positions, sensors;  ///< per vertex; sensors empty when the output has none
+  std::vector<double> times;              ///< per vertex, or empty
+  std::vector<float> intensities;         ///< per vertex, or empty
+  std::vector<Rgb8> colors;               ///< per vertex, or empty
+  std::vector<Triangle> triangles;        ///< on the vertices above
+  std::vector<TriangleId> ids;
+  std::vector<std::int32_t> source_acq, source_triangle;
+
+  [[nodiscard]] std::size_t vertex_count() const { return keys.size(); }
+  [[nodiscard]] std::size_t triangle_count() const { return triangles.size(); }
+  /// The box of the triangles' corners.
+  [[nodiscard]] Box3d box() const;
+  /// The box of triangle t's corners.
+  [[nodiscard]] Box3d box(std::size_t t) const;
+  /// Appends vertex v of `from` (same attributes) with `key`, which must pass every key so far.
+  void append_vertex(const KeyedPiece& from, std::uint32_t v, std::uint64_t key);
+  /// Appends triangle t of `from` on the vertices `corners` of this piece.
+  void append_triangle(const KeyedPiece& from, std::size_t t, const Triangle& corners);
+  /// Throws ProcessingError naming `what` when the arrays disagree, keys are not ascending
+  /// or a corner is out of range.
+  void check(std::string_view what) const;
+};
+
+/// The triangles `triangles` of `piece` (in that order) on the vertices they use.
+KeyedPiece subset(const KeyedPiece& piece, std::span<const std::uint32_t> triangles);
+
+/// The pieces as one: each key's vertex once (the first piece's copy), the triangles of each
+/// piece in turn. Throws ProcessingError when the pieces carry different attributes.
+KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces);
+
+}  // namespace citymesh
