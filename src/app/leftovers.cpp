@@ -9,6 +9,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/tiler/tiler.h"
 #include "pair_spill.h"
+#include "seam_parts.h"
 
 namespace citymesh::app {
 
@@ -16,7 +17,9 @@ std::string_view process_tag_in_name(std::string_view name, std::string_view par
   if (const std::size_t at = name.rfind(kTemporaryInfix); at != std::string_view::npos && at > 0) {
     return name.substr(at + kTemporaryInfix.size());
   }
-  if (name.starts_with(kPairSpillPrefix)) return name.substr(kPairSpillPrefix.size());
+  for (const std::string_view prefix : {kPairSpillPrefix, kSeamPartsPrefix}) {
+    if (name.starts_with(prefix)) return name.substr(prefix.size());
+  }
   if (parent == kStagingFolder && name.size() > 1 && name[0] == 'a') {
     const std::size_t dot = name.find('.');
     const std::string_view index = name.substr(1, dot == std::string_view::npos ? 0 : dot - 1);

@@ -42,20 +42,6 @@ StitchParams stitch_params(const Config& config) {
           .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0};
 }
 
-/// Stitches block by block on the tile grid, bands as narrow as the stitching's reach allows.
-BlockStitchStats stitch_on_tile_grid(const Config& config, MergedMesh& merged, const StitchParams& params) {
-  check_seam_pass(config);
-  const BlockStitchParams blocks{.origin_x = config.tiling.origin[0] - merged.mesh.origin.x,
-                                 .origin_y = config.tiling.origin[1] - merged.mesh.origin.y,
-                                 .size = config.tiling.tile_size,
-                                 .band = block_context(params)};
-  const BlockStitchStats s = stitch_in_blocks(merged, params, blocks);
-  std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
-                           "triangles with its surroundings\n",
-                           s.parts[0], s.parts[1], s.parts[2], s.parts[3], s.largest_part);
-  return s;
-}
-
 }  // namespace
 
 void check_seam_pass(const Config& config) {
@@ -67,12 +53,8 @@ void check_seam_pass(const Config& config) {
                                 config.file.string(), config.tiling.tile_size, band, 4 * band));
 }
 
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, SeamPass pass) {
-  const StitchParams params = stitch_params(config);
-  BlockStitchStats blocks;
-  const StitchStats s = pass == SeamPass::blocks ? (blocks = stitch_on_tile_grid(config, merged, params)).stitch
-                                                 : stitch(merged, params);
-  shrink_to_fit(merged);  // the outputs and the export that follow peak on top of it
+/// Prints the stitching's line and returns its figures for the summary.
+nlohmann::json report_stitching(const StitchStats& s, const BlockStitchStats* blocks) {
   std::cout << fmt::format(
       "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
@@ -90,10 +72,42 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, SeamP
           {"vertices_welded", s.vertices_welded},
           {"rejected", s.rejected},
           {"seconds", s.seconds}};
-  if (pass == SeamPass::blocks) {
-    report["by_blocks"] = {{"parts", blocks.parts}, {"largest_part_triangles", blocks.largest_part}};
+  if (blocks != nullptr) {
+    report["by_blocks"] = {{"parts", blocks->parts}, {"largest_part_triangles", blocks->largest_part}};
   }
   return report;
+}
+
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged) {
+  const StitchStats s = stitch(merged, stitch_params(config));
+  shrink_to_fit(merged);  // the outputs and the export that follow peak on top of it
+  return report_stitching(s, nullptr);
+}
+
+BlockStitchParams tile_grid_blocks(const Config& config) {
+  return {.origin_x = config.tiling.origin[0],
+          .origin_y = config.tiling.origin[1],
+          .size = config.tiling.tile_size,
+          .band = block_context(stitch_params(config))};
+}
+
+nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
+                                       std::span<const std::uint64_t> source_sizes) {
+  check_seam_pass(config);
+  Stopwatch clock;
+  const PartStitchRun run{.params = stitch_params(config),
+                          .blocks = tile_grid_blocks(config),
+                          .source_sizes = {source_sizes.begin(), source_sizes.end()},
+                          .frame = std::nullopt};
+  const double before = parts_open_boundary(parts, store, false, run.blocks);
+  BlockStitchStats s = stitch_parts(parts, store, run);
+  s.stitch.open_boundary_before = before;
+  s.stitch.open_boundary_after = parts_open_boundary(parts, store, true, run.blocks);
+  s.stitch.seconds = clock.seconds();
+  std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
+                           "triangles with its surroundings\n",
+                           s.parts[0], s.parts[1], s.parts[2], s.parts[3], s.largest_part);
+  return report_stitching(s.stitch, &s);
 }
 
 namespace {

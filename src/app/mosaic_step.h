@@ -8,6 +8,7 @@
 #include "acquisitions.h"
 #include "citymesh/change/detect.h"
 #include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/stitch_blocks.h"
 #include "pipeline.h"
 
 namespace citymesh::app {
@@ -21,10 +22,19 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
 /// A tiled run checks it first, before hours of tiles, not only when the seam pass starts.
 void check_seam_pass(const Config& config);
 
-/// Stitches `merged` with the config's reach and weld, prints a line and returns the figures
-/// for the summary. `pass`: at once, or block by block on the tile grid (only a tiled run has
-/// one: it passes `[run] seam_pass`).
-nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged, SeamPass pass = SeamPass::whole);
+/// Stitches `merged` at once with the config's reach and weld, prints a line and returns the
+/// figures for the summary.
+nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged);
+
+/// The tile grid as blocks of block stitching, in the project CRS, bands as narrow as the
+/// stitching's reach allows.
+BlockStitchParams tile_grid_blocks(const Config& config);
+
+/// Stitches the parts in `store` block by block on the tile grid (`[run] seam_pass =
+/// "blocks"`), `source_sizes` the output's triangles per source; prints and returns the
+/// figures as stitch_and_report does.
+nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
+                                       std::span<const std::uint64_t> source_sizes);
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

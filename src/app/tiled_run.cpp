@@ -21,6 +21,7 @@
 #include "run_state.h"
 #include "tile_assembly.h"
 #include "run_stages.h"
+#include "seam_parts.h"
 #include "tile_job.h"
 #include "tileset_output.h"
 
@@ -109,6 +110,12 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // The pairs wait on disk (a city has 0.7 GB of them), in a folder of this process's own.
   TileAssembly assembly(store, config.output.labels ? std::optional(pair_spill_folder(config.project.work))
                                                     : std::nullopt);
+  // Block by block, the selected triangles go to files under their parts as the results are
+  // read: the seam pass then holds only the parts around the one it stitches.
+  std::optional<SeamPartFiles> seams;
+  if (config.run.seam_pass == SeamPass::blocks && config.mosaic.method == MosaicMethod::energy) {
+    seams.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
+  }
   std::vector<nlohmann::json> per_tile;
   // Results are read (and checked) a few at a time in parallel, then added in tile order; a
   // read result is several times the piece the assembly keeps of it, so not all at once.
@@ -122,19 +129,38 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                                     {.pairs = config.output.labels});
       }
     });
-    for (std::size_t i = 0; i < count; ++i) add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0,
-                                                            std::move(batch[i]), assembly, per_tile);
+    for (std::size_t i = 0; i < count; ++i) {
+      if (seams && batch[i]) {
+        seams->add_tile(store.tiles[first + i].key, batch[i]->selected);
+        batch[i]->selected.clear();
+      }
+      add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0, std::move(batch[i]), assembly,
+                      per_tile);
+    }
   }
-  MergedMesh merged = assembly.take_merged();
-  const std::uint64_t selected = merged.mesh.triangle_count();
+  std::vector<BlockPart> parts;
+  MergedMesh merged;
+  std::uint64_t selected = 0;
+  if (seams) {
+    parts = seams->finish();
+    for (const std::uint64_t n : seams->source_sizes()) selected += n;
+  } else {
+    merged = assembly.take_merged();
+    selected = merged.mesh.triangle_count();
+  }
   stage_done("assembly");
   if (config.output.labels) write_labels(config, assembly, pictures);
   stage_done("labels");
-  // The seam pass: stitching runs on the assembled mesh, so seams between tiles are joined
-  // like seams inside a tile.
-  const nlohmann::json stitched = config.mosaic.method == MosaicMethod::energy
-                                      ? stitch_and_report(config, merged, config.run.seam_pass)
-                                      : nlohmann::json::object();
+  // The seam pass: stitching runs on the assembled mesh (or its parts), so seams between tiles
+  // are joined like seams inside a tile.
+  nlohmann::json stitched = nlohmann::json::object();
+  if (seams) {
+    stitched = stitch_parts_and_report(config, parts, *seams, seams->source_sizes());
+    merged = gather_stitched_parts(parts, *seams);
+    seams.reset();
+  } else if (config.mosaic.method == MosaicMethod::energy) {
+    stitched = stitch_and_report(config, merged);
+  }
   stage_done("stitch");
   MosaicStats stats;
   stats.candidates = assembly.candidates();

@@ -185,7 +185,53 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   stats.parts[static_cast<std::size_t>(level)] = of_level.size();
 }
 
+/// The length of the edges of `own`'s triangles used by exactly one triangle of `own` and
+/// `around` (every triangle sharing an edge with `own` is in one of them).
+double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<const KeyedPiece>> around) {
+  const auto edge = [](std::uint64_t a, std::uint64_t b) { return a < b ? std::pair{a, b} : std::pair{b, a}; };
+  std::map<std::pair<std::uint64_t, std::uint64_t>, std::uint32_t> uses;
+  for (const Triangle& tri : own.triangles) {
+    for (int k = 0; k < 3; ++k) ++uses[edge(own.keys[tri[k]], own.keys[tri[(k + 1) % 3]])];
+  }
+  for (const auto& piece : around) {
+    for (const Triangle& tri : piece->triangles) {
+      for (int k = 0; k < 3; ++k) {
+        const auto it = uses.find(edge(piece->keys[tri[k]], piece->keys[tri[(k + 1) % 3]]));
+        if (it != uses.end()) ++it->second;
+      }
+    }
+  }
+  double length = 0;
+  for (const Triangle& tri : own.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+      if (uses.at(edge(own.keys[a], own.keys[b])) == 1) length += norm(own.positions[a] - own.positions[b]);
+    }
+  }
+  return length;
+}
+
 }  // namespace
+
+double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
+                           const BlockStitchParams& blocks) {
+  // As the last level sees them (all stitched) or as the first does (none).
+  const int view = stitched ? kLevels : -1;
+  const PartFinder finder(parts, blocks, view);
+  std::vector<double> lengths(parts.size(), 0.0);
+  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const Box3d& box = box_for_level(parts[p], view);
+      if (box.empty()) continue;
+      std::vector<std::shared_ptr<const KeyedPiece>> around;
+      for (const std::uint32_t q : finder.meeting(box, p)) around.push_back(store.load(q, stitched));
+      lengths[p] = own_open_boundary(*store.load(p, stitched), around);
+    }
+  });
+  double total = 0;
+  for (const double l : lengths) total += l;  // in part order: the same sum on any thread count
+  return total;
+}
 
 std::string BlockPartKey::name() const { return fmt::format("{}_{}_{}", level, x, y); }
 

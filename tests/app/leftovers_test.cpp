@@ -22,6 +22,7 @@ TEST(Leftovers, TagsAreFoundInTheNamesRunsGiveTheirOwnFiles) {
   EXPECT_EQ(process_tag_in_name("0_1.bin.tmp.vm.42", "results"), "vm.42");
   EXPECT_EQ(process_tag_in_name("run.json.tmp.host.example.org.7", "out"), "host.example.org.7");
   EXPECT_EQ(process_tag_in_name("pairs.vm.42", "work"), "vm.42");
+  EXPECT_EQ(process_tag_in_name("seams.vm.42", "work"), "vm.42");
   EXPECT_EQ(process_tag_in_name("a12.vm.42", "staging"), "vm.42");
   EXPECT_EQ(process_tag_in_name("a12.vm.42", "tiles"), "");  // only the tiler's staging folders
   EXPECT_EQ(process_tag_in_name("ab.vm.42", "staging"), "");
@@ -38,12 +39,14 @@ TEST(Leftovers, OnlyWhatEndedProcessesOfThisMachineLeftIsRemoved) {
   const std::string elsewhere = fmt::format("other-{}", ended);
   const std::vector<std::filesystem::path> gone{
       dir / ("work/pairs." + ended + "/range0.bin"),
+      dir / ("work/seams." + ended + "/0_1_1.input.part"),
       dir / ("work/results/0_1.bin.tmp." + ended),
       dir / ("work/tiles/staging/a3." + ended + "/0_0.bin"),
       dir / ("out/mosaic/mosaic.ply.tmp." + ended),
   };
   const std::vector<std::filesystem::path> kept{
       dir / ("work/pairs." + running + "/range0.bin"),
+      dir / ("work/seams." + running + "/0_1_1.input.part"),
       dir / ("work/pairs." + elsewhere + "/range0.bin"),
       dir / ("work/results/0_2.bin.tmp." + running),
       dir / ("work/results/0_3.bin.tmp." + elsewhere),

@@ -21,17 +21,7 @@ using test::non_manifold_edges;
 using test::repeated_directed_edges;
 using test::triangles_of;
 
-/// Four sources, each kind of seam crossing both axes: source 0 (3 x 3 m) with, 4 cm beyond
-/// its side x = 3, a coarser source 1 (zippered); 1.5 cm beyond its side y = 3, source 2
-/// (snapped); a small piece of source 3 lying 5 cm over source 0 (clipped).
-MergedMesh scene() {
-  MergedMesh m;
-  add_grid(m, 0, 0, 30, 30, 0.1f, 0, 0);
-  add_grid(m, 3.04f, 0.013f, 22, 27, 0.11f, 1, 0.01f);
-  add_grid(m, 0, 3.015f, 30, 12, 0.1f, 2, 0.01f);
-  add_grid(m, 1.25f, 1.3f, 8, 6, 0.1f, 3, 0.05f);
-  return m;
-}
+MergedMesh scene() { return test::four_source_scene(); }
 
 const StitchParams kParams{.snap = 0.02, .reach = 0.2, .weld = 0.005, .clip = 0.1, .gap = 0.025};
 

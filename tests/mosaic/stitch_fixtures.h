@@ -35,6 +35,18 @@ inline void add_grid(MergedMesh& out, float x0, float y0, int nx, int ny, float 
   }
 }
 
+/// Four sources, each kind of seam crossing both axes: source 0 (3 x 3 m) with, 4 cm beyond
+/// its side x = 3, a coarser source 1 (zippered); 1.5 cm beyond its side y = 3, source 2
+/// (snapped); a small piece of source 3 lying 5 cm over source 0 (clipped).
+inline MergedMesh four_source_scene() {
+  MergedMesh m;
+  add_grid(m, 0, 0, 30, 30, 0.1f, 0, 0);
+  add_grid(m, 3.04f, 0.013f, 22, 27, 0.11f, 1, 0.01f);
+  add_grid(m, 0, 3.015f, 30, 12, 0.1f, 2, 0.01f);
+  add_grid(m, 1.25f, 1.3f, 8, 6, 0.1f, 3, 0.05f);
+  return m;
+}
+
 /// Edges used by more than two triangles.
 inline std::size_t non_manifold_edges(const Mesh& m) {
   std::map<std::pair<std::uint32_t, std::uint32_t>, int> uses;

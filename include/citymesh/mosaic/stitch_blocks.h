@@ -115,4 +115,10 @@ struct PartStitchRun {
 /// sets their stitched boxes. The open boundary figures are left to the caller.
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run);
 
+/// The open boundary of the whole output the parts hold, before stitching or once stitched:
+/// the length of the edges used by exactly one triangle, each part's counted with the parts
+/// around it loaded (`blocks`: the grid of the parts).
+double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
+                           const BlockStitchParams& blocks);
+
 }  // namespace citymesh

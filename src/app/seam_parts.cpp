@@ -1,0 +1,308 @@
+// SPDX-License-Identifier: MIT
+#include "seam_parts.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <numeric>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/read_file.h"
+
+namespace citymesh::app {
+
+namespace {
+
+constexpr std::string_view kPieceMagic = "CMPART01";
+constexpr std::uint32_t kSensors = 1, kTimes = 2, kIntensities = 4, kColors = 8;
+
+/// What precedes a piece's arrays.
+struct PieceHeader {
+  char magic[8];
+  std::uint32_t flags;
+  std::uint32_t reserved;
+  std::uint64_t vertices, triangles, checksum;
+};
+static_assert(sizeof(PieceHeader) == 40 && sizeof(Vec3d) == 24 && sizeof(Rgb8) == 3 && sizeof(Triangle) == 12 &&
+              sizeof(TriangleId) == 16);
+
+std::uint32_t flags_of(const KeyedPiece& p) {
+  return (p.sensors.empty() ? 0u : kSensors) | (p.times.empty() ? 0u : kTimes) |
+         (p.intensities.empty() ? 0u : kIntensities) | (p.colors.empty() ? 0u : kColors);
+}
+
+/// The payload's size for these counts and flags: each array in turn.
+std::uint64_t payload_size(std::uint32_t flags, std::uint64_t n, std::uint64_t t) {
+  std::uint64_t per_vertex = sizeof(std::uint64_t) + sizeof(Vec3d);
+  if ((flags & kSensors) != 0) per_vertex += sizeof(Vec3d);
+  if ((flags & kTimes) != 0) per_vertex += sizeof(double);
+  if ((flags & kIntensities) != 0) per_vertex += sizeof(float);
+  if ((flags & kColors) != 0) per_vertex += sizeof(Rgb8);
+  const std::uint64_t per_triangle = sizeof(Triangle) + sizeof(TriangleId) + 2 * sizeof(std::int32_t);
+  return n * per_vertex + t * per_triangle;
+}
+
+template <class T>
+void put(std::string& out, const std::vector<T>& values) {
+  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
+}
+
+template <class T>
+void take(std::string_view& in, std::vector<T>& values, std::size_t count) {
+  values.resize(count);
+  std::memcpy(values.data(), in.data(), count * sizeof(T));
+  in.remove_prefix(count * sizeof(T));
+}
+
+void write_scratch_file(const std::filesystem::path& path, const std::string& bytes) {
+  // Scratch for this pass only: the folder is this process's and is never reused, so no
+  // fsync (hundreds of them would cost seconds); a killed run's folder is removed whole.
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  if (!out.flush()) throw OutputError(fmt::format("{}: cannot write a part of the seam pass", path.string()));
+}
+
+KeyedPiece read_piece(const std::filesystem::path& path) {
+  const std::optional<std::string> bytes = read_file_bytes(path);
+  if (!bytes) throw ProcessingError(fmt::format("{}: a part of the seam pass vanished", path.string()));
+  return decode_keyed_piece(*bytes, path.string());
+}
+
+/// The triangles of `piece` in input order (acquisition, then its triangle).
+KeyedPiece in_input_order(const KeyedPiece& piece) {
+  std::vector<std::uint32_t> order(piece.triangle_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+    return std::pair{piece.source_acq[a], piece.source_triangle[a]} < std::pair{piece.source_acq[b], piece.source_triangle[b]};
+  });
+  return subset(piece, order);
+}
+
+}  // namespace
+
+std::filesystem::path seam_parts_folder(const std::filesystem::path& work) {
+  return work / (std::string(kSeamPartsPrefix) + process_tag());
+}
+
+std::string encode_keyed_piece(const KeyedPiece& p) {
+  PieceHeader h{};
+  std::memcpy(h.magic, kPieceMagic.data(), sizeof(h.magic));
+  h.flags = flags_of(p);
+  h.vertices = p.vertex_count();
+  h.triangles = p.triangle_count();
+  std::string payload;
+  payload.reserve(payload_size(h.flags, h.vertices, h.triangles));
+  put(payload, p.keys);
+  put(payload, p.positions);
+  put(payload, p.sensors);
+  put(payload, p.times);
+  put(payload, p.intensities);
+  put(payload, p.colors);
+  put(payload, p.triangles);
+  put(payload, p.ids);
+  put(payload, p.source_acq);
+  put(payload, p.source_triangle);
+  h.checksum = bulk_checksum(payload.data(), payload.size());
+  std::string out(reinterpret_cast<const char*>(&h), sizeof(h));
+  return out + payload;
+}
+
+KeyedPiece decode_keyed_piece(std::string_view bytes, std::string_view source) {
+  PieceHeader h{};
+  const auto refuse = [&](std::string_view why) {
+    return ProcessingError(fmt::format("{}: not a part of the seam pass ({})", source, why));
+  };
+  if (bytes.size() < sizeof(h)) throw refuse("too short");
+  std::memcpy(&h, bytes.data(), sizeof(h));
+  if (std::string_view(h.magic, sizeof(h.magic)) != kPieceMagic) throw refuse("another magic");
+  std::string_view in = bytes.substr(sizeof(h));
+  // Counts are checked against the size before anything is allocated from them.
+  const std::uint64_t limit = in.size();
+  if (h.vertices > limit || h.triangles > limit || payload_size(h.flags, h.vertices, h.triangles) != in.size()) {
+    throw refuse("its counts disagree with its size");
+  }
+  if (bulk_checksum(in.data(), in.size()) != h.checksum) throw refuse("its checksum does not match");
+  const auto n = static_cast<std::size_t>(h.vertices), t = static_cast<std::size_t>(h.triangles);
+  const auto optional = [&](std::uint32_t flag) { return (h.flags & flag) != 0 ? n : 0; };
+  KeyedPiece p;
+  take(in, p.keys, n);
+  take(in, p.positions, n);
+  take(in, p.sensors, optional(kSensors));
+  take(in, p.times, optional(kTimes));
+  take(in, p.intensities, optional(kIntensities));
+  take(in, p.colors, optional(kColors));
+  take(in, p.triangles, t);
+  take(in, p.ids, t);
+  take(in, p.source_acq, t);
+  take(in, p.source_triangle, t);
+  p.check(source);
+  return p;
+}
+
+KeyedPiece keyed_piece(const TilePiece& piece) {
+  const Mesh& m = piece.mesh;
+  // A piece holds one acquisition's triangles, whose vertex ids are that acquisition's.
+  const std::uint32_t acquisition = m.triangle_ids.empty() ? 0 : m.triangle_ids.front().acquisition;
+  KeyedPiece raw;
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+    raw.keys.push_back(input_vertex_key(acquisition, piece.vertex_ids[v]));
+    raw.positions.push_back(m.world_position(v));
+    if (m.has_sensor_positions()) raw.sensors.push_back(m.world_sensor_position(v));
+    if (!m.times.empty()) raw.times.push_back(m.times[v]);
+    if (!m.intensities.empty()) raw.intensities.push_back(m.intensities[v]);
+    if (!m.colors.empty()) raw.colors.push_back(m.colors[v]);
+  }
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    raw.triangles.push_back(m.triangles[t]);
+    raw.ids.push_back(m.triangle_ids[t]);
+    raw.source_acq.push_back(static_cast<std::int32_t>(m.triangle_ids[t].acquisition));
+    raw.source_triangle.push_back(static_cast<std::int32_t>(piece.triangle_index[t]));
+  }
+  // Vertices into key order.
+  std::vector<std::uint32_t> order(raw.vertex_count());
+  std::iota(order.begin(), order.end(), 0u);
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return raw.keys[a] < raw.keys[b]; });
+  std::vector<std::uint32_t> rank(order.size());
+  KeyedPiece out;
+  for (std::uint32_t i = 0; i < order.size(); ++i) {
+    rank[order[i]] = i;
+    out.append_vertex(raw, order[i], raw.keys[order[i]]);
+  }
+  for (std::size_t t = 0; t < raw.triangle_count(); ++t) {
+    const Triangle& tri = raw.triangles[t];
+    out.append_triangle(raw, t, {rank[tri[0]], rank[tri[1]], rank[tri[2]]});
+  }
+  return out;
+}
+
+SeamPartFiles::SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks)
+    : dir_(std::move(dir)), blocks_(blocks) {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create a folder for the seam pass: {}", dir_.string(), ec.message()));
+}
+
+SeamPartFiles::~SeamPartFiles() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);  // best effort: a leftover holds no finished output
+}
+
+std::filesystem::path SeamPartFiles::part_file(const BlockPartKey& key, bool stitched) const {
+  return dir_ / fmt::format("{}.{}.part", key.name(), stitched ? "stitched" : "input");
+}
+
+void SeamPartFiles::add_tile(TileKey key, const std::vector<TilePiece>& selected) {
+  std::map<BlockPartKey, std::vector<KeyedPiece>> by_part;
+  for (const TilePiece& tile_piece : selected) {
+    if (tile_piece.triangle_count() == 0) continue;
+    const KeyedPiece piece = keyed_piece(tile_piece);
+    std::map<BlockPartKey, std::vector<std::uint32_t>> triangles;
+    for (std::uint32_t t = 0; t < piece.triangle_count(); ++t) {
+      const Triangle& tri = piece.triangles[t];
+      const Vec3d centroid = (piece.positions[tri[0]] + piece.positions[tri[1]] + piece.positions[tri[2]]) / 3.0;
+      triangles[block_part_of(centroid, blocks_)].push_back(t);
+      const auto a = static_cast<std::size_t>(piece.source_acq[t]);
+      if (source_sizes_.size() <= a) source_sizes_.resize(a + 1, 0);
+      ++source_sizes_[a];
+    }
+    for (const auto& [part, ts] : triangles) by_part[part].push_back(subset(piece, ts));
+  }
+  for (const auto& [part, pieces] : by_part) {
+    std::vector<const KeyedPiece*> all;
+    for (const KeyedPiece& p : pieces) all.push_back(&p);
+    const KeyedPiece fragment = merge_pieces(all);
+    boxes_[part].extend(fragment.box());
+    const std::filesystem::path file = dir_ / fmt::format("{}.{}.tile", part.name(), key.name());
+    write_scratch_file(file, encode_keyed_piece(fragment));
+    fragments_[part].push_back(file);
+  }
+}
+
+std::vector<BlockPart> SeamPartFiles::finish() {
+  std::vector<BlockPart> parts;
+  for (const auto& [key, box] : boxes_) parts.push_back({key, box, {}});
+  keys_.clear();
+  for (const BlockPart& p : parts) keys_.push_back(p.key);
+  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::vector<std::filesystem::path>& files = fragments_.at(keys_[i]);
+      std::vector<KeyedPiece> fragments;
+      for (const std::filesystem::path& f : files) fragments.push_back(read_piece(f));
+      std::vector<const KeyedPiece*> all;
+      for (const KeyedPiece& f : fragments) all.push_back(&f);
+      write_scratch_file(part_file(keys_[i], false), encode_keyed_piece(in_input_order(merge_pieces(all))));
+      for (const std::filesystem::path& f : files) {
+        std::error_code ec;
+        std::filesystem::remove(f, ec);
+      }
+    }
+  });
+  fragments_.clear();
+  return parts;
+}
+
+std::shared_ptr<const KeyedPiece> SeamPartFiles::load(std::size_t part, bool stitched) const {
+  return std::make_shared<const KeyedPiece>(read_piece(part_file(keys_.at(part), stitched)));
+}
+
+void SeamPartFiles::save_stitched(std::size_t part, KeyedPiece stitched) {
+  write_scratch_file(part_file(keys_.at(part), true), encode_keyed_piece(stitched));
+}
+
+MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store) {
+  // First every key, then each part's vertices and triangles in place: the output and one
+  // part in memory, never every part at once.
+  std::vector<std::uint64_t> keys;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
+    keys.insert(keys.end(), piece->keys.begin(), piece->keys.end());
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  MergedMesh out;
+  Mesh& m = out.mesh;
+  bool first = true;
+  std::vector<std::uint8_t> placed(keys.size(), 0);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
+    if (piece->vertex_count() == 0) continue;
+    if (first) {
+      m.origin = whole_metre_origin(piece->positions.front());
+      m.positions.resize(keys.size());
+      if (!piece->sensors.empty()) m.sensor_positions.resize(keys.size());
+      if (!piece->times.empty()) m.times.resize(keys.size());
+      if (!piece->intensities.empty()) m.intensities.resize(keys.size());
+      if (!piece->colors.empty()) m.colors.resize(keys.size());
+      first = false;
+    }
+    std::vector<std::uint32_t> index(piece->vertex_count());
+    std::size_t at = 0;
+    for (std::size_t v = 0; v < index.size(); ++v) {
+      while (keys[at] != piece->keys[v]) ++at;  // both ascend
+      index[v] = static_cast<std::uint32_t>(at);
+      if (placed[at] != 0) continue;
+      placed[at] = 1;
+      m.positions[at] = to_local(piece->positions[v], m.origin);
+      if (!m.sensor_positions.empty()) m.sensor_positions[at] = to_local(piece->sensors[v], m.origin);
+      if (!m.times.empty()) m.times[at] = piece->times[v];
+      if (!m.intensities.empty()) m.intensities[at] = piece->intensities[v];
+      if (!m.colors.empty()) m.colors[at] = piece->colors[v];
+    }
+    for (std::size_t t = 0; t < piece->triangle_count(); ++t) {
+      const Triangle& tri = piece->triangles[t];
+      m.triangles.push_back({index[tri[0]], index[tri[1]], index[tri[2]]});
+      m.triangle_ids.push_back(piece->ids[t]);
+      out.source_acq.push_back(piece->source_acq[t]);
+      out.source_triangle.push_back(piece->source_triangle[t]);
+    }
+  }
+  return out;
+}
+
+}  // namespace citymesh::app

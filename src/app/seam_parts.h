@@ -1,0 +1,78 @@
+// SPDX-License-Identifier: MIT
+// The seam pass of a tiled run block by block in files (`[run] seam_pass = "blocks"`): every
+// tile's selected triangles filed under the block-stitching part holding their centroid, in
+// a folder of this process's own, then stitched level by level with only the parts around
+// each one in memory (stitch_parts).
+#pragma once
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "citymesh/mosaic/merged_mesh.h"
+#include "citymesh/mosaic/stitch_blocks.h"
+#include "citymesh/tiler/tile_grid.h"
+#include "citymesh/tiler/tile_store.h"
+
+namespace citymesh::app {
+
+/// What the folder of a run's seam parts is named after: "seams.<host>.<pid>".
+inline constexpr std::string_view kSeamPartsPrefix = "seams.";
+
+/// <work>/seams.<process tag>: this process's own (a killed run's is removed by the next run).
+std::filesystem::path seam_parts_folder(const std::filesystem::path& work);
+
+/// A keyed piece as bytes: magic, attribute flags, counts, XXH3 of the payload, the arrays.
+std::string encode_keyed_piece(const KeyedPiece& piece);
+/// The piece in `bytes`; throws ProcessingError naming `source` when they are not one
+/// (another magic, counts that disagree with the size, a checksum that does not match).
+KeyedPiece decode_keyed_piece(std::string_view bytes, std::string_view source);
+
+/// The key of vertex `id` of acquisition `acquisition` (below kNewVertexKey).
+inline std::uint64_t input_vertex_key(std::uint32_t acquisition, std::uint32_t id) {
+  return std::uint64_t{acquisition} << 32 | id;
+}
+
+/// A tile's selected triangles of one acquisition (as a tile result holds them) as a keyed
+/// piece: vertices keyed by input_vertex_key, positions in the project CRS.
+KeyedPiece keyed_piece(const TilePiece& piece);
+
+/// The parts of a seam pass, in files under one folder (created empty, removed with this).
+class SeamPartFiles final : public PartStore {
+ public:
+  /// `blocks`: the grid, in the project CRS.
+  SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks);
+  ~SeamPartFiles() override;
+  SeamPartFiles(const SeamPartFiles&) = delete;
+  SeamPartFiles& operator=(const SeamPartFiles&) = delete;
+
+  /// Files the selected triangles of tile `key` under their parts. Tiles come one at a time.
+  void add_tile(TileKey key, const std::vector<TilePiece>& selected);
+  /// Puts each part's tiles together, its triangles in input order (acquisition, then
+  /// triangle); the parts in key order with their boxes. Called once, after the last tile.
+  [[nodiscard]] std::vector<BlockPart> finish();
+  /// Per source acquisition: its triangles in the output (clipping's precedence).
+  [[nodiscard]] const std::vector<std::uint64_t>& source_sizes() const { return source_sizes_; }
+
+  [[nodiscard]] std::shared_ptr<const KeyedPiece> load(std::size_t part, bool stitched) const override;
+  void save_stitched(std::size_t part, KeyedPiece stitched) override;
+
+ private:
+  [[nodiscard]] std::filesystem::path part_file(const BlockPartKey& key, bool stitched) const;
+
+  std::filesystem::path dir_;
+  BlockStitchParams blocks_;
+  std::map<BlockPartKey, std::vector<std::filesystem::path>> fragments_;  ///< per part, its tiles' files in order
+  std::map<BlockPartKey, Box3d> boxes_;
+  std::vector<BlockPartKey> keys_;  ///< the parts, once finished
+  std::vector<std::uint64_t> source_sizes_;
+};
+
+/// The stitched parts as one output mesh: vertices in key order, floats relative to the
+/// first one in whole metres, triangles part by part. Holds the output; reads each part twice.
+MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store);
+
+}  // namespace citymesh::app

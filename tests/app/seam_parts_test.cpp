@@ -1,0 +1,176 @@
+// SPDX-License-Identifier: MIT
+// The seam pass in files: parts written and read back whole (damaged ones refused), tiles
+// filed under their parts whatever the tiling, and stitching from files giving what
+// stitching in memory gives.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+
+#include "../mosaic/stitch_fixtures.h"
+#include "citymesh/core/error.h"
+#include "seam_parts.h"
+#include "test_support.h"
+
+namespace citymesh::app {
+namespace {
+
+const StitchParams kParams{.snap = 0.02, .reach = 0.2, .weld = 0.005, .clip = 0.1, .gap = 0.025};
+
+/// Blocks of 1.6 m with bands of 0.35 m, the grid's corner at (0.7, 0.7): every kind of part
+/// holds seams of the four-source scene.
+BlockStitchParams blocks() { return {.origin_x = 0.7, .origin_y = 0.7, .size = 1.6, .band = 0.35}; }
+
+/// The triangles of `m` chosen by `keep` as a tile's selected pieces, one per source: vertex
+/// ids are the mesh's vertex indices, triangle indices its source_triangle.
+template <class Keep>
+std::vector<TilePiece> tile_pieces(const MergedMesh& m, Keep keep) {
+  std::map<std::int32_t, TilePiece> by_source;
+  std::map<std::int32_t, std::map<std::uint32_t, std::uint32_t>> local;
+  for (std::uint32_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (!keep(t)) continue;
+    const std::int32_t s = m.source_acq[t];
+    TilePiece& p = by_source[s];
+    p.mesh.origin = m.mesh.origin;
+    Triangle tri{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const std::uint32_t v = m.mesh.triangles[t][k];
+      const auto [it, added] = local[s].try_emplace(v, static_cast<std::uint32_t>(p.vertex_ids.size()));
+      if (added) {
+        p.vertex_ids.push_back(v);
+        append_vertex(m.mesh, v, p.mesh);
+      }
+      tri[k] = it->second;
+    }
+    p.mesh.triangles.push_back(tri);
+    p.mesh.triangle_ids.push_back({.acquisition = static_cast<std::uint32_t>(s), .face = t});
+    p.triangle_index.push_back(static_cast<std::uint32_t>(m.source_triangle[t]));
+    p.roles.push_back(TileRole::owned);
+  }
+  std::vector<TilePiece> out;
+  for (auto& [s, p] : by_source) out.push_back(std::move(p));
+  return out;
+}
+
+KeyedPiece sample_piece() {
+  KeyedPiece p;
+  p.keys = {3, input_vertex_key(2, 7), kNewVertexKey | 5};
+  p.positions = {{651000.25, 6861000.5, 35.125}, {651001.0, 6861000.0, 35.0}, {651000.0, 6861001.0, 36.0}};
+  p.sensors = {{651005.0, 6861000.0, 37.5}, {651005.0, 6861000.1, 37.5}, {651005.0, 6861000.2, 37.5}};
+  p.intensities = {0.5f, 0.25f, 1.0f};
+  p.colors = {{1, 2, 3}, {4, 5, 6}, {7, 8, 9}};
+  p.triangles = {{0, 1, 2}};
+  p.ids = {{.acquisition = 2, .fan = 1, .face = 1234567890123}};
+  p.source_acq = {2};
+  p.source_triangle = {42};
+  return p;
+}
+
+TEST(SeamParts, APieceComesBackFromItsBytesAsItWent) {
+  const KeyedPiece p = sample_piece();
+  const KeyedPiece q = decode_keyed_piece(encode_keyed_piece(p), "sample");
+  EXPECT_EQ(q.keys, p.keys);
+  EXPECT_EQ(q.positions, p.positions);
+  EXPECT_EQ(q.sensors, p.sensors);
+  EXPECT_TRUE(q.times.empty());
+  EXPECT_EQ(q.intensities, p.intensities);
+  EXPECT_EQ(q.colors, p.colors);
+  EXPECT_EQ(q.triangles, p.triangles);
+  EXPECT_EQ(q.ids, p.ids);
+  EXPECT_EQ(q.source_acq, p.source_acq);
+  EXPECT_EQ(q.source_triangle, p.source_triangle);
+}
+
+TEST(SeamParts, DamagedPiecesAreRefusedNamingTheFile) {
+  const std::string bytes = encode_keyed_piece(sample_piece());
+  const auto refused = [](const std::string& damaged) {
+    try {
+      (void)decode_keyed_piece(damaged, "parts/0_1_2.input.part");
+    } catch (const ProcessingError& e) {
+      return std::string(e.what()).find("parts/0_1_2.input.part") != std::string::npos;
+    }
+    return false;
+  };
+  EXPECT_TRUE(refused(bytes.substr(0, bytes.size() - 1)));  // truncated
+  EXPECT_TRUE(refused(bytes.substr(0, 20)));                // not even a header
+  std::string flipped = bytes;
+  flipped[flipped.size() - 3] ^= 0x10;  // the payload: the checksum no longer matches
+  EXPECT_TRUE(refused(flipped));
+  std::string magic = bytes;
+  magic[0] = 'X';
+  EXPECT_TRUE(refused(magic));
+  std::string counts = bytes;
+  counts[16] = '\x7f';  // a vertex count far beyond the file: refused before any allocation
+  EXPECT_TRUE(refused(counts));
+}
+
+TEST(SeamParts, TilesAreFiledUnderTheirPartsWhateverTheTiling) {
+  const MergedMesh m = test::four_source_scene();
+  test::TempDir dir;
+  SeamPartFiles one(dir / "one", blocks()), two(dir / "two", blocks());
+  one.add_tile({0, 0}, tile_pieces(m, [](std::uint32_t) { return true; }));
+  // Cut along x = 1.5: triangles on both sides share vertices, which must come out once.
+  const auto west = [&](std::uint32_t t) { return m.mesh.positions[m.mesh.triangles[t][0]].x < 1.5f; };
+  two.add_tile({0, 0}, tile_pieces(m, west));
+  two.add_tile({1, 0}, tile_pieces(m, [&](std::uint32_t t) { return !west(t); }));
+  const std::vector<BlockPart> a = one.finish(), b = two.finish();
+  ASSERT_EQ(a.size(), b.size());
+  EXPECT_GT(a.size(), 9u);
+  EXPECT_EQ(one.source_sizes(), two.source_sizes());
+  std::size_t triangles = 0;
+  for (std::size_t p = 0; p < a.size(); ++p) {
+    EXPECT_EQ(a[p].key, b[p].key);
+    const auto x = one.load(p, false), y = two.load(p, false);
+    EXPECT_EQ(x->keys, y->keys);
+    EXPECT_EQ(x->positions, y->positions);
+    EXPECT_EQ(x->triangles, y->triangles);
+    EXPECT_EQ(x->source_triangle, y->source_triangle);
+    // In input order, each in the part holding its centroid.
+    for (std::size_t t = 0; t < x->triangle_count(); ++t) {
+      if (t > 0) {
+        EXPECT_LT(std::pair(x->source_acq[t - 1], x->source_triangle[t - 1]), std::pair(x->source_acq[t], x->source_triangle[t]));
+      }
+      const Triangle& tri = x->triangles[t];
+      const Vec3d c = (x->positions[tri[0]] + x->positions[tri[1]] + x->positions[tri[2]]) / 3.0;
+      EXPECT_EQ(block_part_of(c, blocks()), a[p].key);
+    }
+    triangles += x->triangle_count();
+  }
+  EXPECT_EQ(triangles, m.mesh.triangle_count());
+}
+
+TEST(SeamParts, StitchingFromFilesGivesWhatStitchingInMemoryGives) {
+  MergedMesh in_memory = test::four_source_scene();
+  const BlockStitchStats expected = stitch_in_blocks(in_memory, kParams, blocks());
+
+  test::TempDir dir;
+  SeamPartFiles files(dir / "seams", blocks());
+  files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
+  std::vector<BlockPart> parts = files.finish();
+  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = Vec3d{}};
+  run.blocks.context = block_context(kParams);
+  const double before = parts_open_boundary(parts, files, false, run.blocks);
+  const BlockStitchStats s = stitch_parts(parts, files, run);
+  const double after = parts_open_boundary(parts, files, true, run.blocks);
+  const MergedMesh out = gather_stitched_parts(parts, files);
+
+  EXPECT_EQ(s.parts, expected.parts);
+  EXPECT_EQ(s.stitch.strips, expected.stitch.strips);
+  EXPECT_EQ(s.stitch.vertices_snapped, expected.stitch.vertices_snapped);
+  EXPECT_NEAR(before, expected.stitch.open_boundary_before, 1e-6);
+  EXPECT_NEAR(after, expected.stitch.open_boundary_after, 1e-6);
+  ASSERT_EQ(out.mesh.triangle_count(), in_memory.mesh.triangle_count());
+  for (std::size_t t = 0; t < out.mesh.triangle_count(); ++t) {
+    ASSERT_EQ(out.source_acq[t], in_memory.source_acq[t]) << t;
+    ASSERT_EQ(out.source_triangle[t], in_memory.source_triangle[t]) << t;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec3d p = out.mesh.world_position(out.mesh.triangles[t][k]);
+      const Vec3d q = in_memory.mesh.world_position(in_memory.mesh.triangles[t][k]);
+      ASSERT_LT(norm(p - q), 1e-6) << "triangle " << t << " corner " << k;
+    }
+  }
+  EXPECT_EQ(test::non_manifold_edges(out.mesh), 0u);
+}
+
+}  // namespace
+}  // namespace citymesh::app
