@@ -4,7 +4,7 @@
 #include <algorithm>
 
 #include "citymesh/core/error.h"
-#include "key_union.h"
+#include "citymesh/core/key_union.h"
 
 namespace citymesh::mosaic_detail {
 

@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "citymesh/mosaic/keyed_piece.h"
+#include "citymesh/core/keyed_piece.h"
 #include "citymesh/mosaic/stitch.h"
 
 namespace citymesh {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "citymesh/mosaic/keyed_piece.h"
+#include "citymesh/core/keyed_piece.h"
 
 #include <fmt/format.h>
 
@@ -7,7 +7,7 @@
 #include <functional>
 
 #include "citymesh/core/error.h"
-#include "key_union.h"
+#include "citymesh/core/key_union.h"
 
 namespace citymesh {
 
@@ -89,7 +89,7 @@ KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces) {
     }
     used.push_back(p);
   }
-  const mosaic_detail::KeyUnion all(used);
+  const KeyUnion all(used);
   // Each key's vertex from the first piece holding it.
   std::vector<std::pair<const KeyedPiece*, std::uint32_t>> source(all.keys.size(), {nullptr, 0});
   for (std::size_t p = 0; p < used.size(); ++p) {

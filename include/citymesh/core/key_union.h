@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Internal to the mosaic module: the vertices of several keyed pieces, each key once.
+// The vertices of several keyed pieces, each key once (merging pieces, cutting a part out).
 #pragma once
 
 #include <algorithm>
@@ -7,9 +7,9 @@
 #include <span>
 #include <vector>
 
-#include "citymesh/mosaic/keyed_piece.h"
+#include "citymesh/core/keyed_piece.h"
 
-namespace citymesh::mosaic_detail {
+namespace citymesh {
 
 /// Every vertex of the pieces once, in key order, and where each piece's vertices fall in
 /// that order.
@@ -37,4 +37,4 @@ struct KeyUnion {
   }
 };
 
-}  // namespace citymesh::mosaic_detail
+}  // namespace citymesh

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "citymesh/core/error.h"
-#include "citymesh/mosaic/keyed_piece.h"
+#include "citymesh/core/keyed_piece.h"
 
 namespace citymesh {
 namespace {
