@@ -109,11 +109,10 @@ class RowWriter {
   std::size_t used_ = 0;
 };
 
-std::string make_header(const PlyWriteInput& in) {
+std::string make_header(const PlyWriteInput& in, std::uint64_t vertices, std::uint64_t faces) {
   std::string h = "ply\nformat binary_little_endian 1.0\n";
   for (const std::string& c : in.comments) h += fmt::format("comment {}\n", c);
-  h += fmt::format("element vertex {}\nproperty double x\nproperty double y\nproperty double z\n",
-                   in.positions.size());
+  h += fmt::format("element vertex {}\nproperty double x\nproperty double y\nproperty double z\n", vertices);
   auto declare = [&](const PlyColumn& c) {
     std::visit([&](const auto& s) {
       using T = std::remove_cv_t<typename std::decay_t<decltype(s)>::element_type>;
@@ -121,72 +120,138 @@ std::string make_header(const PlyWriteInput& in) {
     }, c.values);
   };
   for (const PlyColumn& c : in.vertex_columns) declare(c);
-  h += fmt::format("element face {}\nproperty list uchar uint vertex_indices\n", in.triangles.size());
+  h += fmt::format("element face {}\nproperty list uchar uint vertex_indices\n", faces);
   for (const PlyColumn& c : in.face_columns) declare(c);
   return h + "end_header\n";
 }
 
+/// Whether `chunk`'s columns are `layout`'s: the same names and types, in order.
+bool same_columns(const std::vector<PlyColumn>& layout, const std::vector<PlyColumn>& chunk) {
+  if (layout.size() != chunk.size()) return false;
+  for (std::size_t c = 0; c < layout.size(); ++c) {
+    if (layout[c].name != chunk[c].name || layout[c].values.index() != chunk[c].values.index()) return false;
+  }
+  return true;
+}
+
 }  // namespace
+
+struct PlyStreamWriter::Impl {
+  AtomicFile file;
+  PlyWriteInput layout;
+  std::uint64_t vertices, faces, vertices_written = 0, faces_written = 0;
+  Impl(const std::filesystem::path& path, PlyWriteInput l, std::uint64_t v, std::uint64_t f)
+      : file(path), layout(std::move(l)), vertices(v), faces(f) {}
+};
+
+PlyStreamWriter::PlyStreamWriter(const std::filesystem::path& path, const PlyWriteInput& layout, std::uint64_t vertices,
+                                 std::uint64_t faces)
+    : impl_(std::make_unique<Impl>(path, PlyWriteInput{{}, {}, layout.vertex_columns, layout.face_columns, layout.comments},
+                                   vertices, faces)) {
+  impl_->file.write(make_header(impl_->layout, vertices, faces));
+}
+
+PlyStreamWriter::~PlyStreamWriter() = default;
+
+void PlyStreamWriter::add_vertices(const PlyWriteInput& chunk) {
+  const std::filesystem::path& path = impl_->file.path();
+  if (!same_columns(impl_->layout.vertex_columns, chunk.vertex_columns) || impl_->faces_written > 0 ||
+      impl_->vertices_written + chunk.positions.size() > impl_->vertices) {
+    throw ProcessingError(fmt::format("{}: vertex rows that do not fit the header", path.string()));
+  }
+  check_columns(chunk.vertex_columns, chunk.positions.size(), "vertex", path);
+  const std::vector<RawColumn> columns = raw_columns(chunk.vertex_columns);
+  RowWriter out(impl_->file, columns, sizeof(Vec3d));
+  for (std::size_t v = 0; v < chunk.positions.size(); ++v) {
+    char* at = out.start_row();
+    std::memcpy(at, &chunk.positions[v], sizeof(Vec3d));
+    out.finish_row(at + sizeof(Vec3d), v);
+  }
+  out.flush();
+  impl_->vertices_written += chunk.positions.size();
+}
+
+void PlyStreamWriter::add_faces(const PlyWriteInput& chunk) {
+  const std::filesystem::path& path = impl_->file.path();
+  if (!same_columns(impl_->layout.face_columns, chunk.face_columns) || impl_->vertices_written != impl_->vertices ||
+      impl_->faces_written + chunk.triangles.size() > impl_->faces) {
+    throw ProcessingError(fmt::format("{}: face rows that do not fit the header", path.string()));
+  }
+  check_columns(chunk.face_columns, chunk.triangles.size(), "face", path);
+  const std::vector<RawColumn> columns = raw_columns(chunk.face_columns);
+  RowWriter out(impl_->file, columns, 1 + sizeof(Triangle));
+  for (std::size_t f = 0; f < chunk.triangles.size(); ++f) {
+    char* at = out.start_row();
+    *at = 3;  // the list's length
+    std::memcpy(at + 1, &chunk.triangles[f], sizeof(Triangle));
+    out.finish_row(at + 1 + sizeof(Triangle), f);
+  }
+  out.flush();
+  impl_->faces_written += chunk.triangles.size();
+}
+
+void PlyStreamWriter::commit() {
+  if (impl_->vertices_written != impl_->vertices || impl_->faces_written != impl_->faces) {
+    throw ProcessingError(fmt::format("{}: {} of {} vertices and {} of {} faces written", impl_->file.path().string(),
+                                      impl_->vertices_written, impl_->vertices, impl_->faces_written, impl_->faces));
+  }
+  impl_->file.commit();
+}
 
 void write_ply(const std::filesystem::path& path, const PlyWriteInput& in) {
   check_columns(in.vertex_columns, in.positions.size(), "vertex", path);
   check_columns(in.face_columns, in.triangles.size(), "face", path);
-  AtomicFile file(path);
-  file.write(make_header(in));
-  const std::vector<RawColumn> vertex_columns = raw_columns(in.vertex_columns), face_columns = raw_columns(in.face_columns);
-  {
-    RowWriter out(file, vertex_columns, sizeof(Vec3d));
-    for (std::size_t v = 0; v < in.positions.size(); ++v) {
-      char* at = out.start_row();
-      std::memcpy(at, &in.positions[v], sizeof(Vec3d));
-      out.finish_row(at + sizeof(Vec3d), v);
-    }
-    out.flush();
+  PlyStreamWriter out(path, in, in.positions.size(), in.triangles.size());
+  out.add_vertices(in);
+  out.add_faces(in);
+  out.commit();
+}
+
+MeshVertexRows::MeshVertexRows(const MeshVertexAttributes& has) : has_(has) {}
+
+void MeshVertexRows::add(const Vec3d& position, const Vec3d& sensor, double time, float intensity, Rgb8 color) {
+  positions.push_back(position);
+  if (has_.sensors) {
+    sx_.push_back(sensor.x);
+    sy_.push_back(sensor.y);
+    sz_.push_back(sensor.z);
   }
-  RowWriter out(file, face_columns, 1 + sizeof(Triangle));
-  for (std::size_t f = 0; f < in.triangles.size(); ++f) {
-    char* at = out.start_row();
-    *at = 3;  // the list's length
-    std::memcpy(at + 1, &in.triangles[f], sizeof(Triangle));
-    out.finish_row(at + 1 + sizeof(Triangle), f);
+  if (has_.times) times_.push_back(time);
+  if (has_.intensities) intensities_.push_back(intensity);
+  if (has_.colors) {
+    red_.push_back(color.r);
+    green_.push_back(color.g);
+    blue_.push_back(color.b);
   }
-  out.flush();
-  file.commit();
+}
+
+std::vector<PlyColumn> MeshVertexRows::columns() const {
+  std::vector<PlyColumn> c;
+  if (has_.sensors) {
+    c.push_back({"x_origin", std::span<const double>(sx_)});
+    c.push_back({"y_origin", std::span<const double>(sy_)});
+    c.push_back({"z_origin", std::span<const double>(sz_)});
+  }
+  if (has_.times) c.push_back({"gps_time", std::span<const double>(times_)});
+  if (has_.intensities) c.push_back({"intensity", std::span<const float>(intensities_)});
+  if (has_.colors) {
+    c.push_back({"red", std::span<const std::uint8_t>(red_)});
+    c.push_back({"green", std::span<const std::uint8_t>(green_)});
+    c.push_back({"blue", std::span<const std::uint8_t>(blue_)});
+  }
+  return c;
 }
 
 void write_mesh_ply(const std::filesystem::path& path, const Mesh& mesh, std::vector<PlyColumn> face_columns) {
   mesh.check_invariants();
-  std::vector<Vec3d> positions(mesh.vertex_count());
-  for (std::size_t v = 0; v < positions.size(); ++v) positions[v] = mesh.world_position(v);
-  std::vector<double> sx, sy, sz;
-  PlyWriteInput in{positions, mesh.triangles, {}, std::move(face_columns), {"written by citymesh"}};
-  std::vector<std::uint8_t> red, green, blue;
-  if (mesh.has_sensor_positions()) {
-    for (std::size_t v = 0; v < positions.size(); ++v) {
-      const Vec3d s = mesh.world_sensor_position(v);
-      sx.push_back(s.x);
-      sy.push_back(s.y);
-      sz.push_back(s.z);
-    }
-    in.vertex_columns.push_back({"x_origin", std::span<const double>(sx)});
-    in.vertex_columns.push_back({"y_origin", std::span<const double>(sy)});
-    in.vertex_columns.push_back({"z_origin", std::span<const double>(sz)});
+  MeshVertexRows rows({.sensors = mesh.has_sensor_positions(), .times = !mesh.times.empty(),
+                       .intensities = !mesh.intensities.empty(), .colors = !mesh.colors.empty()});
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    rows.add(mesh.world_position(v), mesh.has_sensor_positions() ? mesh.world_sensor_position(v) : Vec3d{},
+             mesh.times.empty() ? 0.0 : mesh.times[v], mesh.intensities.empty() ? 0.0f : mesh.intensities[v],
+             mesh.colors.empty() ? Rgb8{} : mesh.colors[v]);
   }
-  if (!mesh.times.empty()) in.vertex_columns.push_back({"gps_time", std::span<const double>(mesh.times)});
-  if (!mesh.intensities.empty()) {
-    in.vertex_columns.push_back({"intensity", std::span<const float>(mesh.intensities)});
-  }
-  if (!mesh.colors.empty()) {
-    for (const Rgb8& c : mesh.colors) {
-      red.push_back(c.r);
-      green.push_back(c.g);
-      blue.push_back(c.b);
-    }
-    in.vertex_columns.push_back({"red", std::span<const std::uint8_t>(red)});
-    in.vertex_columns.push_back({"green", std::span<const std::uint8_t>(green)});
-    in.vertex_columns.push_back({"blue", std::span<const std::uint8_t>(blue)});
-  }
-  write_ply(path, in);
+  write_ply(path, {rows.positions, mesh.triangles, rows.columns(), std::move(face_columns), {std::string(kPlyComment)}});
 }
 
 }  // namespace citymesh

@@ -96,3 +96,64 @@ TEST(PlyWriter, MismatchedColumnIsRefusedAndNothingIsWritten) {
 
 }  // namespace
 }  // namespace citymesh
+
+namespace citymesh {
+namespace {
+
+/// `m`'s vertices [first, last) as rows with its attributes.
+MeshVertexRows rows_of(const Mesh& m, std::size_t first, std::size_t last) {
+  MeshVertexRows rows({.sensors = true, .times = true, .intensities = true, .colors = true});
+  for (std::size_t v = first; v < last; ++v) {
+    rows.add(m.world_position(v), m.world_sensor_position(v), m.times[v], m.intensities[v], m.colors[v]);
+  }
+  return rows;
+}
+
+TEST(PlyStreamWriter, ChunksGiveTheBytesOfTheWholeWrite) {
+  test::TempDir dir;
+  const Mesh m = random_mesh(11, 300, 500);
+  std::vector<std::int32_t> source(m.triangle_count());
+  for (std::size_t t = 0; t < source.size(); ++t) source[t] = static_cast<std::int32_t>(t % 5) - 1;
+  write_mesh_ply(dir / "whole.ply", m, {{"source_acq", std::span<const std::int32_t>(source)}});
+
+  const MeshVertexRows all = rows_of(m, 0, m.vertex_count());
+  const PlyWriteInput layout{{}, {}, all.columns(), {{"source_acq", std::span<const std::int32_t>(source)}},
+                             {std::string(kPlyComment)}};
+  PlyStreamWriter out(dir / "chunks.ply", layout, m.vertex_count(), m.triangle_count());
+  for (std::size_t first = 0; first < m.vertex_count(); first += 70) {
+    const MeshVertexRows rows = rows_of(m, first, std::min(first + 70, m.vertex_count()));
+    out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
+  }
+  for (std::size_t first = 0; first < m.triangle_count(); first += 130) {
+    const std::size_t n = std::min<std::size_t>(130, m.triangle_count() - first);
+    out.add_faces({{}, std::span(m.triangles).subspan(first, n), {},
+                   {{"source_acq", std::span<const std::int32_t>(source).subspan(first, n)}}, {}});
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "chunks.ply")) << "nothing before commit";
+  out.commit();
+  EXPECT_EQ(test::read_text(dir / "chunks.ply"), test::read_text(dir / "whole.ply"));
+}
+
+TEST(PlyStreamWriter, RowsThatDoNotFitTheHeaderAreRefusedAndNothingIsWritten) {
+  test::TempDir dir;
+  const Mesh m = random_mesh(12, 20, 10);
+  const MeshVertexRows rows = rows_of(m, 0, m.vertex_count());
+  const PlyWriteInput layout{{}, {}, rows.columns(), {}, {}};
+  {
+    PlyStreamWriter out(dir / "short.ply", layout, m.vertex_count() + 1, m.triangle_count());
+    out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
+    EXPECT_THROW(out.add_faces({{}, m.triangles, {}, {}, {}}), ProcessingError);  // a vertex is missing
+    EXPECT_THROW(out.commit(), ProcessingError);
+  }
+  {
+    PlyStreamWriter out(dir / "other.ply", layout, m.vertex_count(), m.triangle_count());
+    const MeshVertexRows bare({});
+    EXPECT_THROW(out.add_vertices({rows.positions, {}, bare.columns(), {}, {}}), ProcessingError);  // other columns
+    EXPECT_THROW(out.add_vertices({std::vector<Vec3d>(m.vertex_count() + 1), {}, {}, {}, {}}), ProcessingError);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "short.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "other.ply"));
+}
+
+}  // namespace
+}  // namespace citymesh

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <string>
 #include <variant>
@@ -32,9 +33,61 @@ struct PlyWriteInput {
   std::vector<std::string> comments;
 };
 
+/// A PLY written in parts, for an output too large to hold at once: the counts first (the
+/// header needs them), then the vertices chunk by chunk, then the faces. Written as
+/// write_ply writes: nothing appears under the path unless commit() is reached.
+class PlyStreamWriter {
+ public:
+  /// `layout`'s columns name the vertex and face properties and their types (its rows are not
+  /// read); `vertices` and `faces` rows are to come. Throws OutputError naming the file.
+  PlyStreamWriter(const std::filesystem::path& path, const PlyWriteInput& layout, std::uint64_t vertices,
+                  std::uint64_t faces);
+  ~PlyStreamWriter();
+  PlyStreamWriter(const PlyStreamWriter&) = delete;
+  PlyStreamWriter& operator=(const PlyStreamWriter&) = delete;
+  /// Appends `chunk`'s vertex rows: its positions and vertex columns (laid out as the
+  /// layout's). Throws ProcessingError when they do not fit the header.
+  void add_vertices(const PlyWriteInput& chunk);
+  /// Appends `chunk`'s face rows (its triangles and face columns), once every vertex is in.
+  void add_faces(const PlyWriteInput& chunk);
+  /// Throws ProcessingError when fewer rows came than the header announced.
+  void commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Writes `input` to `path` (temporary name, fsync, rename). Throws ProcessingError when a
 /// column's size disagrees with its element, OutputError when the file cannot be written.
 void write_ply(const std::filesystem::path& path, const PlyWriteInput& input);
+
+/// The comment every PLY citymesh writes carries.
+inline constexpr std::string_view kPlyComment = "written by citymesh";
+
+/// Which optional vertex attributes rows carry.
+struct MeshVertexAttributes {
+  bool sensors = false, times = false, intensities = false, colors = false;
+};
+
+/// Vertex rows in the input format of citymesh (DESIGN §3): x, y, z and x_origin, y_origin,
+/// z_origin as double, gps_time, intensity and colour, those `has` names.
+class MeshVertexRows {
+ public:
+  explicit MeshVertexRows(const MeshVertexAttributes& has);
+  /// Appends a row; the attributes the rows do not carry are ignored.
+  void add(const Vec3d& position, const Vec3d& sensor, double time, float intensity, Rgb8 color);
+  /// The columns other than x, y, z over the rows added so far (every carried one, even empty).
+  [[nodiscard]] std::vector<PlyColumn> columns() const;
+
+  std::vector<Vec3d> positions;  ///< absolute: the x, y, z of each row
+
+ private:
+  MeshVertexAttributes has_;
+  std::vector<double> sx_, sy_, sz_, times_;
+  std::vector<float> intensities_;
+  std::vector<std::uint8_t> red_, green_, blue_;
+};
 
 /// Writes a mesh in the input format of citymesh (DESIGN §3): x, y, z and x_origin, y_origin,
 /// z_origin as double, gps_time, intensity and colour when present, plus `face_columns`.
