@@ -83,7 +83,7 @@ struct Projected {
 /// A triangle whose box holds at least one pixel centre.
 struct Candidate {
   std::array<std::uint32_t, 3> corners;  ///< into the projected vertices
-  std::uint32_t layer, triangle;
+  std::uint32_t triangle;
   std::int32_t row0, row1;  ///< the rows of pixel centres its box holds
 };
 
@@ -106,17 +106,58 @@ bool inside(double e, const Projected& a, const Projected& b) { return e > 0 || 
 
 constexpr std::int32_t kBandRows = 32;
 
-/// What one band of rows shows: per pixel the nearest candidate (lowest index on a tie, so the
-/// picture does not depend on the order of work).
-void draw_band(std::int32_t row0, std::int32_t row1, std::uint32_t width, std::span<const std::uint32_t> candidates,
-               std::span<const Candidate> all, std::span<const Projected> points, std::vector<float>& depth,
-               std::vector<std::uint32_t>& nearest) {
-  const std::size_t pixels = std::size_t(row1 - row0) * width;
-  depth.assign(pixels, std::numeric_limits<float>::infinity());
-  nearest.assign(pixels, UINT32_MAX);
-  for (const std::uint32_t index : candidates) {
-    const Candidate& c = all[index];
-    Projected a = points[c.corners[0]], b = points[c.corners[1]], d = points[c.corners[2]];
+/// A layer's vertices on the picture and its triangles whose box holds a pixel centre,
+/// listed by band of rows (a triangle in every band it reaches).
+struct LayerOnPicture {
+  std::vector<Projected> points;
+  std::vector<Candidate> candidates;
+  std::vector<std::uint32_t> band_start, in_band;
+};
+
+LayerOnPicture project(const RenderLayer& layer, const Camera& cam, const Vec3d& origin) {
+  const Mesh& mesh = *layer.mesh;
+  LayerOnPicture out;
+  const Vec3f shift(mesh.origin - origin);
+  for (const Vec3f& p : mesh.positions) {
+    const Vec3d q(p + shift);
+    out.points.push_back({static_cast<float>((dot(q, cam.right) - cam.u0) / cam.pixel - 0.5),
+                          static_cast<float>((cam.v1 - dot(q, cam.up)) / cam.pixel - 0.5),
+                          static_cast<float>(dot(q, cam.forward) - cam.depth0)});
+  }
+  const auto bands = static_cast<std::size_t>((cam.height + kBandRows - 1) / kBandRows);
+  out.band_start.assign(bands + 1, 0);
+  for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
+    const Triangle& tri = mesh.triangles[t];
+    const Projected &a = out.points[tri[0]], &b = out.points[tri[1]], &d = out.points[tri[2]];
+    // Nothing to draw, and no defined conversion to a pixel index, for a non-finite corner.
+    if (!std::isfinite(a.x + a.y + a.depth + b.x + b.y + b.depth + d.x + d.y + d.depth)) continue;
+    const auto row0 = static_cast<std::int32_t>(std::ceil(std::min({a.y, b.y, d.y})));
+    const auto row1 = std::min(static_cast<std::int32_t>(std::floor(std::max({a.y, b.y, d.y}))),
+                               static_cast<std::int32_t>(cam.height) - 1);
+    const auto col0 = static_cast<std::int32_t>(std::ceil(std::min({a.x, b.x, d.x})));
+    const auto col1 = static_cast<std::int32_t>(std::floor(std::max({a.x, b.x, d.x})));
+    if (row0 > row1 || col0 > col1 || row1 < 0 || col1 < 0) continue;
+    out.candidates.push_back({tri, t, std::max(row0, 0), row1});
+    for (std::int32_t band = std::max(row0, 0) / kBandRows; band <= row1 / kBandRows; ++band) ++out.band_start[band + 1];
+  }
+  for (std::size_t b = 0; b < bands; ++b) out.band_start[b + 1] += out.band_start[b];
+  out.in_band.resize(out.band_start.back());
+  std::vector<std::uint32_t> fill(out.band_start.begin(), out.band_start.end() - 1);
+  for (std::uint32_t k = 0; k < out.candidates.size(); ++k) {
+    for (std::int32_t band = out.candidates[k].row0 / kBandRows; band <= out.candidates[k].row1 / kBandRows; ++band) {
+      out.in_band[fill[band]++] = k;
+    }
+  }
+  return out;
+}
+
+/// Draws the candidates of one band of rows into the picture: per pixel the nearest so far,
+/// the first drawn on a tie (so the picture does not depend on the order of work).
+void draw_band(std::int32_t row0, std::int32_t row1, std::span<const std::uint32_t> listed, const LayerOnPicture& on,
+               const RenderLayer& layer, const Vec3d& forward, std::vector<float>& depth, Image& image) {
+  for (const std::uint32_t index : listed) {
+    const Candidate& c = on.candidates[index];
+    Projected a = on.points[c.corners[0]], b = on.points[c.corners[1]], d = on.points[c.corners[2]];
     double area = edge(a, b, d.x, d.y);
     if (area == 0) continue;  // seen edge-on
     if (area < 0) {
@@ -125,16 +166,16 @@ void draw_band(std::int32_t row0, std::int32_t row1, std::uint32_t width, std::s
     }
     const auto col0 = static_cast<std::int32_t>(std::ceil(std::min({a.x, b.x, d.x})));
     const auto col1 = std::min<std::int32_t>(static_cast<std::int32_t>(std::floor(std::max({a.x, b.x, d.x}))),
-                                             static_cast<std::int32_t>(width) - 1);
+                                             static_cast<std::int32_t>(image.width) - 1);
     for (std::int32_t row = std::max(c.row0, row0); row <= std::min(c.row1, row1 - 1); ++row) {
       for (std::int32_t col = std::max(col0, 0); col <= col1; ++col) {
         const double ea = edge(b, d, col, row), eb = edge(d, a, col, row), ed = edge(a, b, col, row);
         if (!inside(ea, b, d) || !inside(eb, d, a) || !inside(ed, a, b)) continue;
         const auto z = static_cast<float>((ea * a.depth + eb * b.depth + ed * d.depth) / area);
-        const std::size_t at = std::size_t(row - row0) * width + std::size_t(col);
+        const std::size_t at = std::size_t(row) * image.width + std::size_t(col);
         if (z < depth[at]) {
           depth[at] = z;
-          nearest[at] = index;
+          image.pixels[at] = shade(layer.face_colors[c.triangle], *layer.mesh, layer.mesh->triangles[c.triangle], forward);
         }
       }
     }
@@ -143,74 +184,55 @@ void draw_band(std::int32_t row0, std::int32_t row1, std::uint32_t width, std::s
 
 }  // namespace
 
-Image render_orthographic(std::span<const RenderLayer> layers, const ViewParams& params) {
+struct OrthographicCanvas::Impl {
+  Camera camera;
+  Vec3d origin;
+  std::vector<float> depth;  ///< per pixel, of what it shows
   Image image;
-  if (layers.empty()) return image;
-  const Vec3d origin = layers.front().mesh->origin;
-  const Box3d box = layers_box(layers, origin);
-  if (box.empty()) return image;
-  const Camera cam = make_camera(box, params);
-  image.width = cam.width;
-  image.height = cam.height;
-  image.pixels.assign(std::size_t(cam.width) * cam.height, params.background);
+};
 
-  // Vertices onto the picture, and the triangles whose box holds a pixel centre, by band.
-  std::vector<Projected> points;
-  std::vector<Candidate> candidates;
-  const auto bands = static_cast<std::size_t>((cam.height + kBandRows - 1) / kBandRows);
-  std::vector<std::uint32_t> band_start(bands + 1, 0);
-  for (std::uint32_t l = 0; l < layers.size(); ++l) {
-    const Mesh& mesh = *layers[l].mesh;
-    const auto base = static_cast<std::uint32_t>(points.size());
-    const Vec3f shift(mesh.origin - origin);
-    for (const Vec3f& p : mesh.positions) {
-      const Vec3d q(p + shift);
-      points.push_back({static_cast<float>((dot(q, cam.right) - cam.u0) / cam.pixel - 0.5),
-                        static_cast<float>((cam.v1 - dot(q, cam.up)) / cam.pixel - 0.5),
-                        static_cast<float>(dot(q, cam.forward) - cam.depth0)});
-    }
-    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) {
-      const Triangle& tri = mesh.triangles[t];
-      const Projected &a = points[base + tri[0]], &b = points[base + tri[1]], &d = points[base + tri[2]];
-      // Nothing to draw, and no defined conversion to a pixel index, for a non-finite corner.
-      if (!std::isfinite(a.x + a.y + a.depth + b.x + b.y + b.depth + d.x + d.y + d.depth)) continue;
-      const auto row0 = static_cast<std::int32_t>(std::ceil(std::min({a.y, b.y, d.y})));
-      const auto row1 = std::min(static_cast<std::int32_t>(std::floor(std::max({a.y, b.y, d.y}))),
-                                 static_cast<std::int32_t>(cam.height) - 1);
-      const auto col0 = static_cast<std::int32_t>(std::ceil(std::min({a.x, b.x, d.x})));
-      const auto col1 = static_cast<std::int32_t>(std::floor(std::max({a.x, b.x, d.x})));
-      if (row0 > row1 || col0 > col1 || row1 < 0 || col1 < 0) continue;
-      candidates.push_back({{base + tri[0], base + tri[1], base + tri[2]}, l, t, std::max(row0, 0), row1});
-      for (std::int32_t band = std::max(row0, 0) / kBandRows; band <= row1 / kBandRows; ++band) ++band_start[band + 1];
-    }
-  }
-  for (std::size_t b = 0; b < bands; ++b) band_start[b + 1] += band_start[b];
-  std::vector<std::uint32_t> in_band(band_start.back());
-  std::vector<std::uint32_t> fill(band_start.begin(), band_start.end() - 1);
-  for (std::uint32_t k = 0; k < candidates.size(); ++k) {
-    for (std::int32_t band = candidates[k].row0 / kBandRows; band <= candidates[k].row1 / kBandRows; ++band) {
-      in_band[fill[band]++] = k;
-    }
-  }
+OrthographicCanvas::OrthographicCanvas(const Box3d& box, const Vec3d& origin, const ViewParams& params)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->origin = origin;
+  if (box.empty()) return;
+  impl_->camera = make_camera(box, params);
+  impl_->image.width = impl_->camera.width;
+  impl_->image.height = impl_->camera.height;
+  const std::size_t pixels = std::size_t(impl_->camera.width) * impl_->camera.height;
+  impl_->image.pixels.assign(pixels, params.background);
+  impl_->depth.assign(pixels, std::numeric_limits<float>::infinity());
+}
 
+OrthographicCanvas::~OrthographicCanvas() = default;
+
+void OrthographicCanvas::draw(const RenderLayer& layer) {
+  if (layer.face_colors.size() != layer.mesh->triangle_count()) {
+    throw ProcessingError(fmt::format("render: {} colours for {} triangles", layer.face_colors.size(),
+                                      layer.mesh->triangle_count()));
+  }
+  if (impl_->image.pixels.empty()) return;
+  const Camera& cam = impl_->camera;
+  const LayerOnPicture on = project(layer, cam, impl_->origin);
+  const std::size_t bands = on.band_start.size() - 1;
   parallel_for_blocks(bands, 1, [&](std::size_t begin, std::size_t end) {
-    std::vector<float> depth;
-    std::vector<std::uint32_t> nearest;
     for (std::size_t band = begin; band < end; ++band) {
       const auto row0 = static_cast<std::int32_t>(band) * kBandRows;
       const std::int32_t row1 = std::min(row0 + kBandRows, static_cast<std::int32_t>(cam.height));
-      draw_band(row0, row1, cam.width, std::span(in_band).subspan(band_start[band], band_start[band + 1] - band_start[band]),
-                candidates, points, depth, nearest);
-      for (std::size_t at = 0; at < nearest.size(); ++at) {
-        if (nearest[at] == UINT32_MAX) continue;
-        const Candidate& c = candidates[nearest[at]];
-        const RenderLayer& layer = layers[c.layer];
-        image.pixels[std::size_t(row0) * cam.width + at] =
-            shade(layer.face_colors[c.triangle], *layer.mesh, layer.mesh->triangles[c.triangle], cam.forward);
-      }
+      draw_band(row0, row1,
+                std::span(on.in_band).subspan(on.band_start[band], on.band_start[band + 1] - on.band_start[band]), on,
+                layer, cam.forward, impl_->depth, impl_->image);
     }
   });
-  return image;
+}
+
+Image OrthographicCanvas::take() { return std::move(impl_->image); }
+
+Image render_orthographic(std::span<const RenderLayer> layers, const ViewParams& params) {
+  if (layers.empty()) return {};
+  const Vec3d origin = layers.front().mesh->origin;
+  OrthographicCanvas canvas(layers_box(layers, origin), origin, params);
+  for (const RenderLayer& layer : layers) canvas.draw(layer);
+  return canvas.take();
 }
 
 Rgb8 palette_color(std::uint32_t index) {

@@ -190,5 +190,35 @@ TEST(Render, TrianglesWithANonFiniteCornerAreLeftOut) {
   EXPECT_EQ(red, 0u);
 }
 
+TEST(OrthographicCanvas, AMeshDrawnInPartsInTheirOwnFramesGivesThePictureOfTheWhole) {
+  const Mesh whole = random_triangles(3000, 21);
+  const std::vector<Rgb8> colors = distinct_colors(whole.triangle_count());
+  const RenderLayer all{&whole, colors};
+  ViewParams view;
+  view.pixel_size = 0.03;
+  const Image expected = render_orthographic(std::span(&all, 1), view);
+  // The triangles in three parts, each in a frame of its own whole metres away, drawn in order.
+  Box3d box;
+  for (const Vec3f& p : whole.positions) box.extend(Vec3d(p));
+  OrthographicCanvas canvas(box, whole.origin, view);
+  for (std::uint32_t part = 0; part < 3; ++part) {
+    Mesh m;
+    m.origin = whole.origin + Vec3d{-3.0 * part, 2.0 * part, 1.0};
+    const Vec3f shift(whole.origin - m.origin);
+    std::vector<Rgb8> c;
+    for (std::uint32_t t = part * 1000; t < (part + 1) * 1000; ++t) {
+      const auto base = static_cast<std::uint32_t>(m.positions.size());
+      for (const std::uint32_t v : whole.triangles[t]) m.positions.push_back(whole.positions[v] + shift);
+      m.triangles.push_back({base, base + 1, base + 2});
+      c.push_back(colors[t]);
+    }
+    canvas.draw({&m, c});
+  }
+  const Image drawn = canvas.take();
+  ASSERT_EQ(drawn.width, expected.width);
+  ASSERT_EQ(drawn.height, expected.height);
+  EXPECT_TRUE(drawn.pixels == expected.pixels);
+}
+
 }  // namespace
 }  // namespace citymesh

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,27 @@ struct ViewParams {
 struct Image {
   std::uint32_t width = 0, height = 0;
   std::vector<Rgb8> pixels;  ///< row-major, top row first
+};
+
+/// A picture drawn one layer at a time, for meshes too large to hold at once: framed by a box
+/// given first, each layer drawn over the others as render_orthographic draws them (a pixel
+/// shows the nearest triangle holding its centre, the first one drawn on a tie).
+class OrthographicCanvas {
+ public:
+  /// `box`: what the picture frames, in the frame whose origin is `origin` (layers are moved
+  /// into it from their own).
+  OrthographicCanvas(const Box3d& box, const Vec3d& origin, const ViewParams& params);
+  ~OrthographicCanvas();
+  OrthographicCanvas(const OrthographicCanvas&) = delete;
+  OrthographicCanvas& operator=(const OrthographicCanvas&) = delete;
+  /// Throws ProcessingError when the layer's colours do not match its triangles.
+  void draw(const RenderLayer& layer);
+  /// The picture (once).
+  [[nodiscard]] Image take();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 /// Draws every layer, seen along the view direction, shaded by the angle between each
