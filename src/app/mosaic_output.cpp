@@ -7,6 +7,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/render/render.h"
+#include "leaf_outputs.h"
 
 namespace citymesh::app {
 
@@ -51,15 +52,28 @@ std::vector<std::int32_t> source_faces(const MergedMesh& merged) {
   return out;
 }
 
-void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
-                          const MosaicStats& s, const MosaicOutputParams& params) {
-  std::filesystem::create_directories(params.dir);
-  const std::vector<std::int32_t> faces = source_faces(merged);
-  write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
-                 {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
-                  {"source_face", std::span<const std::int32_t>(faces)}});
-  if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
+namespace {
 
+/// What the summary says of the output: its triangles per source and stitching's.
+struct OutputCounts {
+  std::vector<std::uint64_t> per_source;
+  std::uint64_t stitched = 0, triangles = 0;
+};
+
+OutputCounts counts_of(const MergedMesh& merged, std::size_t acquisitions) {
+  OutputCounts c{std::vector<std::uint64_t>(acquisitions, 0), 0, merged.mesh.triangle_count()};
+  for (const std::int32_t a : merged.source_acq) {
+    if (a >= 0) {
+      ++c.per_source[static_cast<std::size_t>(a)];
+    } else {
+      ++c.stitched;
+    }
+  }
+  return c;
+}
+
+void write_summary(const Config& config, const LoadedAcquisitions& input, const OutputCounts& counts,
+                   const MosaicStats& s, const MosaicOutputParams& params) {
   nlohmann::json summary;
   summary["config"] = config.file.string();
   summary["method"] = mosaic_method_name(config.mosaic.method);
@@ -72,24 +86,15 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                         {"crease", config.mosaic.crease_weight}};
   summary["crease_angle"] = config.mosaic.crease_angle;
   summary["seen_through_quality"] = config.mosaic.seen_through_quality;
-  std::vector<std::uint64_t> per_source(input.acquisitions.size(), 0);
-  std::uint64_t stitched = 0;
-  for (const std::int32_t a : merged.source_acq) {
-    if (a >= 0) {
-      ++per_source[static_cast<std::size_t>(a)];
-    } else {
-      ++stitched;
-    }
-  }
   for (std::size_t k = 0; k < input.acquisitions.size(); ++k) {
     nlohmann::json entry = acquisition_json(config, input, k);
-    entry["triangles_kept"] = per_source[k];
+    entry["triangles_kept"] = k < counts.per_source.size() ? counts.per_source[k] : 0;
     summary["acquisitions"].push_back(std::move(entry));
   }
   summary["counts"] = {{"candidates", s.candidates},       {"selected", s.selected}, {"filled", s.filled},
                        {"seen_through", s.seen_through},
                        {"fill_seen_through", s.fill_seen_through},
-                       {"output_triangles", merged.mesh.triangle_count()}, {"stitch_triangles", stitched},
+                       {"output_triangles", counts.triangles}, {"stitch_triangles", counts.stitched},
                        {"overlap_terms", s.overlap_terms}, {"seam_terms", s.seam_terms}};
   summary["energy"] = {{"total", s.energy},
                        {"quality", s.quality},
@@ -112,6 +117,50 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
   summary["ply"] = kMosaicFile;
   summary["png"] = params.pictures ? "mosaic.png" : "";
   write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
+}
+
+/// The picture of the output's tiles, drawn one at a time.
+void write_leaves_picture(const std::filesystem::path& path, const OutputLeaves& leaves, double pixel_size) {
+  const Box3d box = leaves.box();
+  const Vec3d origin = box.empty() ? Vec3d{} : whole_metre_origin(box.min);
+  ViewParams view;
+  view.pixel_size = pixel_size;
+  OrthographicCanvas canvas({box.min - origin, box.max - origin}, origin, view);
+  for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
+    const KeyedPiece piece = leaves.load(l);
+    Mesh m;
+    m.origin = whole_metre_origin(leaves.leaves()[l].box.min);
+    for (const Vec3d& p : piece.positions) m.positions.push_back(to_local(p, m.origin));
+    m.triangles = piece.triangles;
+    RenderLayer layer{&m, {}};
+    for (const std::int32_t a : piece.source_acq) layer.face_colors.push_back(source_color(a));
+    canvas.draw(layer);
+  }
+  write_png(path, canvas.take());
+}
+
+}  // namespace
+
+void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
+                          const MosaicStats& stats, const MosaicOutputParams& params) {
+  std::filesystem::create_directories(params.dir);
+  const std::vector<std::int32_t> faces = source_faces(merged);
+  write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
+                 {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
+                  {"source_face", std::span<const std::int32_t>(faces)}});
+  if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
+  write_summary(config, input, counts_of(merged, input.acquisitions.size()), stats, params);
+}
+
+void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const OutputLeaves& leaves,
+                          const MosaicStats& stats, const MosaicOutputParams& params) {
+  std::filesystem::create_directories(params.dir);
+  write_leaves_ply(params.dir / kMosaicFile, leaves);
+  if (params.pictures) write_leaves_picture(params.dir / "mosaic.png", leaves, params.pixel_size);
+  OutputCounts counts{leaves.per_source(), leaves.stitched(), 0};
+  counts.per_source.resize(input.acquisitions.size(), 0);
+  for (const OutputLeaf& leaf : leaves.leaves()) counts.triangles += leaf.triangles;
+  write_summary(config, input, counts, stats, params);
 }
 
 }  // namespace citymesh::app

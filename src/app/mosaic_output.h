@@ -10,6 +10,7 @@
 #include "acquisitions.h"
 #include "citymesh/mosaic/merged_mesh.h"
 #include "citymesh/mosaic/mosaic.h"
+#include "seam_parts.h"
 
 namespace citymesh::app {
 
@@ -34,6 +35,12 @@ struct MosaicOutputParams {
 /// only its acquisitions and dates; each face's source_face comes from the merged mesh's
 /// triangle ids (merging, snapping and stitching keep them).
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
+                          const MosaicStats& stats, const MosaicOutputParams& params);
+
+/// The same from the output's tiles in files (a tiled run's seam pass block by block): the
+/// PLY's vertices are numbered tile by tile (write_leaves_ply), the picture drawn a tile at
+/// a time.
+void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const OutputLeaves& leaves,
                           const MosaicStats& stats, const MosaicOutputParams& params);
 
 /// Per triangle of the merged mesh: its face index in its source acquisition's file

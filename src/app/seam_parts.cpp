@@ -73,6 +73,20 @@ KeyedPiece read_piece(const std::filesystem::path& path) {
   return decode_keyed_piece(*bytes, path.string());
 }
 
+/// The pieces in `files` merged, in order; the files are removed (they were scratch).
+KeyedPiece merge_and_remove(std::span<const std::filesystem::path> files) {
+  std::vector<KeyedPiece> pieces;
+  for (const std::filesystem::path& f : files) pieces.push_back(read_piece(f));
+  std::vector<const KeyedPiece*> all;
+  for (const KeyedPiece& p : pieces) all.push_back(&p);
+  KeyedPiece merged = merge_pieces(all);
+  for (const std::filesystem::path& f : files) {
+    std::error_code ec;
+    std::filesystem::remove(f, ec);
+  }
+  return merged;
+}
+
 /// The triangles of `piece` in input order (acquisition, then its triangle).
 KeyedPiece in_input_order(const KeyedPiece& piece) {
   std::vector<std::uint32_t> order(piece.triangle_count());
@@ -231,16 +245,8 @@ std::vector<BlockPart> SeamPartFiles::finish() {
   for (const BlockPart& p : parts) keys_.push_back(p.key);
   parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      const std::vector<std::filesystem::path>& files = fragments_.at(keys_[i]);
-      std::vector<KeyedPiece> fragments;
-      for (const std::filesystem::path& f : files) fragments.push_back(read_piece(f));
-      std::vector<const KeyedPiece*> all;
-      for (const KeyedPiece& f : fragments) all.push_back(&f);
-      write_scratch_file(part_file(keys_[i], false), encode_keyed_piece(in_input_order(merge_pieces(all))));
-      for (const std::filesystem::path& f : files) {
-        std::error_code ec;
-        std::filesystem::remove(f, ec);
-      }
+      const KeyedPiece merged = merge_and_remove(fragments_.at(keys_[i]));
+      write_scratch_file(part_file(keys_[i], false), encode_keyed_piece(in_input_order(merged)));
     }
   });
   fragments_.clear();
@@ -254,6 +260,87 @@ std::shared_ptr<const KeyedPiece> SeamPartFiles::load(std::size_t part, bool sti
 void SeamPartFiles::save_stitched(std::size_t part, KeyedPiece stitched) {
   write_scratch_file(part_file(keys_.at(part), true), encode_keyed_piece(stitched));
 }
+
+OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
+                           const PartStore& store)
+    : dir_(std::move(dir)) {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);
+  std::filesystem::create_directories(dir_, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create a folder for the output's tiles: {}", dir_.string(), ec.message()));
+  // Each part's share of each tile, written in parallel, then listed in part order.
+  struct Share {
+    TileKey key;
+    Box3d box;
+    std::uint64_t triangles;
+    std::filesystem::path file;
+    std::vector<std::int32_t> sources;  ///< of its triangles
+  };
+  std::vector<std::vector<Share>> shares(parts.size());
+  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t p = begin; p < end; ++p) {
+      const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
+      std::map<TileKey, std::vector<std::uint32_t>> by_tile;
+      for (std::uint32_t t = 0; t < piece->triangle_count(); ++t) {
+        const Triangle& tri = piece->triangles[t];
+        by_tile[grid.owner((piece->positions[tri[0]] + piece->positions[tri[1]] + piece->positions[tri[2]]) / 3.0)]
+            .push_back(t);
+      }
+      for (const auto& [key, ts] : by_tile) {
+        const KeyedPiece share = subset(*piece, ts);
+        const std::filesystem::path file = dir_ / fmt::format("{}.{}.share", key.name(), p);
+        write_scratch_file(file, encode_keyed_piece(share));
+        shares[p].push_back({key, share.box(), ts.size(), file, share.source_acq});
+      }
+    }
+  });
+  std::map<TileKey, std::size_t> index;
+  for (const std::vector<Share>& of_part : shares) {
+    for (const Share& s : of_part) index.try_emplace(s.key, 0);
+  }
+  for (auto& [key, i] : index) {
+    i = leaves_.size();
+    leaves_.push_back({key, {}, 0});
+  }
+  std::vector<std::vector<std::filesystem::path>> fragments(leaves_.size());
+  for (const std::vector<Share>& of_part : shares) {
+    for (const Share& s : of_part) {
+      OutputLeaf& leaf = leaves_[index.at(s.key)];
+      leaf.box.extend(s.box);
+      leaf.triangles += s.triangles;
+      fragments[index.at(s.key)].push_back(s.file);
+      for (const std::int32_t a : s.sources) {
+        if (a < 0) {
+          ++stitched_;
+          continue;
+        }
+        if (per_source_.size() <= static_cast<std::size_t>(a)) per_source_.resize(static_cast<std::size_t>(a) + 1, 0);
+        ++per_source_[static_cast<std::size_t>(a)];
+      }
+    }
+  }
+  // Each tile's shares in one file (in part order), read once per output.
+  files_.resize(leaves_.size());
+  parallel_for_blocks(leaves_.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t l = begin; l < end; ++l) {
+      files_[l] = dir_ / fmt::format("{}.leaf", leaves_[l].key.name());
+      write_scratch_file(files_[l], encode_keyed_piece(merge_and_remove(fragments[l])));
+    }
+  });
+}
+
+Box3d OutputLeaves::box() const {
+  Box3d b;
+  for (const OutputLeaf& leaf : leaves_) b.extend(leaf.box);
+  return b;
+}
+
+OutputLeaves::~OutputLeaves() {
+  std::error_code ec;
+  std::filesystem::remove_all(dir_, ec);  // best effort: scratch of this pass
+}
+
+KeyedPiece OutputLeaves::load(std::size_t leaf) const { return read_piece(files_.at(leaf)); }
 
 MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store) {
   // First every key, then each part's vertices and triangles in place: the output and one

@@ -71,6 +71,43 @@ class SeamPartFiles final : public PartStore {
   std::vector<std::uint64_t> source_sizes_;
 };
 
+/// A grid tile of the output: its key and what its triangles span.
+struct OutputLeaf {
+  TileKey key;
+  Box3d box;  ///< of its triangles' corners, in the project CRS
+  std::uint64_t triangles = 0;
+};
+
+/// The stitched output by grid tile (the tile holding each triangle's centroid), in files:
+/// what the outputs read one tile at a time.
+class OutputLeaves {
+ public:
+  /// Files the triangles of the stitched `parts` under their tiles, in `dir` (created empty,
+  /// removed with this); reads each part once.
+  OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
+               const PartStore& store);
+  ~OutputLeaves();
+  OutputLeaves(const OutputLeaves&) = delete;
+  OutputLeaves& operator=(const OutputLeaves&) = delete;
+
+  /// The tiles holding triangles, keys ascending.
+  [[nodiscard]] const std::vector<OutputLeaf>& leaves() const { return leaves_; }
+  /// Tile `leaf`'s triangles (part by part, each part's in order), vertices in key order.
+  [[nodiscard]] KeyedPiece load(std::size_t leaf) const;
+  /// The output's triangles per source acquisition (index: source_acq), and stitching's.
+  [[nodiscard]] const std::vector<std::uint64_t>& per_source() const { return per_source_; }
+  [[nodiscard]] std::uint64_t stitched() const { return stitched_; }
+  /// The box of every triangle's corners, in the project CRS.
+  [[nodiscard]] Box3d box() const;
+
+ private:
+  std::filesystem::path dir_;
+  std::vector<OutputLeaf> leaves_;
+  std::vector<std::filesystem::path> files_;  ///< per leaf
+  std::vector<std::uint64_t> per_source_;
+  std::uint64_t stitched_ = 0;
+};
+
 /// The stitched parts as one output mesh: vertices in key order, floats relative to the
 /// first one in whole metres, triangles part by part. Holds the output; reads each part twice.
 MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store);

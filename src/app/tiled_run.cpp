@@ -21,6 +21,7 @@
 #include "run_state.h"
 #include "tile_assembly.h"
 #include "run_stages.h"
+#include "leaf_outputs.h"
 #include "seam_parts.h"
 #include "tile_job.h"
 #include "tileset_output.h"
@@ -154,10 +155,12 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // The seam pass: stitching runs on the assembled mesh (or its parts), so seams between tiles
   // are joined like seams inside a tile.
   nlohmann::json stitched = nlohmann::json::object();
+  std::optional<OutputLeaves> leaves;
   if (seams) {
     stitched = stitch_parts_and_report(config, parts, *seams, seams->source_sizes());
-    merged = gather_stitched_parts(parts, *seams);
-    seams.reset();
+    // The outputs read the stitched output one grid tile at a time.
+    leaves.emplace(seam_parts_folder(config.project.work) / "tiles",
+                   TileGrid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin}), parts, *seams);
   } else if (config.mosaic.method == MosaicMethod::energy) {
     stitched = stitch_and_report(config, merged);
   }
@@ -170,13 +173,23 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // filled triangle is one of the selected owned ones).
   stats.selected = selected - std::min(selected, stats.filled);
   stats.fill_seen_through = assembly.fill_left_out();
-  write_mosaic_outputs(config, describe_acquisitions(config), merged, stats,
-                       {.dir = config.project.output / "mosaic",
-                        .pixel_size = pictures.pixel_size,
-                        .pictures = pictures.pictures,
-                        .seconds = seconds,
-                        .stitch = stitched,
-                        .solved_per_tile = true});
+  const MosaicOutputParams mosaic_params{.dir = config.project.output / "mosaic",
+                                         .pixel_size = pictures.pixel_size,
+                                         .pictures = pictures.pictures,
+                                         .seconds = seconds,
+                                         .stitch = stitched,
+                                         .solved_per_tile = true};
+  std::uint64_t output_triangles = merged.mesh.triangle_count();
+  if (leaves) {
+    write_mosaic_outputs(config, describe_acquisitions(config), *leaves, stats, mosaic_params);
+    output_triangles = 0;
+    for (const OutputLeaf& leaf : leaves->leaves()) output_triangles += leaf.triangles;
+    merged = gather_stitched_parts(parts, *seams);  // for the export, until it reads the tiles too
+    leaves.reset();
+    seams.reset();
+  } else {
+    write_mosaic_outputs(config, describe_acquisitions(config), merged, stats, mosaic_params);
+  }
   stage_done("outputs");
   const nlohmann::json exported = write_tileset_outputs(config, merged);
   stage_done("export");
@@ -190,7 +203,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   report["tiles"] = store.tiles.size();
   report["reused_tiles"] = reused;
   report["input_triangles"] = assembly.owned();
-  report["output_triangles"] = merged.mesh.triangle_count();
+  report["output_triangles"] = output_triangles;
   report["ranks"] = ranks;
   report["threads"] = available_threads();
   report["memory_budget"] = format_byte_size(config.run.memory);
@@ -206,7 +219,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
   std::cout << fmt::format("run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
                            "({:.2f} M triangles/s), {} rank(s), peak memory {:.0f} MiB (rank 0)\n",
-                           store.tiles.size(), reused, assembly.owned(), merged.mesh.triangle_count(), wall,
+                           store.tiles.size(), reused, assembly.owned(), output_triangles, wall,
                            static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6, ranks,
                            static_cast<double>(peak_resident_bytes()) / (1 << 20));
 }

@@ -6,9 +6,12 @@
 
 #include <algorithm>
 #include <map>
+#include <set>
 
 #include "../mosaic/stitch_fixtures.h"
 #include "citymesh/core/error.h"
+#include "face_table.h"
+#include "leaf_outputs.h"
 #include "seam_parts.h"
 #include "test_support.h"
 
@@ -170,6 +173,57 @@ TEST(SeamParts, StitchingFromFilesGivesWhatStitchingInMemoryGives) {
     }
   }
   EXPECT_EQ(test::non_manifold_edges(out.mesh), 0u);
+}
+
+/// The triangles of an output as (corner positions, source) triples, whatever its numbering.
+std::multiset<std::array<double, 10>> geometry(std::span<const Vec3d> positions, std::span<const Triangle> triangles,
+                                               std::span<const double> sources) {
+  std::multiset<std::array<double, 10>> out;
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    std::array<double, 10> row{};
+    for (std::size_t k = 0; k < 3; ++k) {
+      const Vec3d& p = positions[triangles[t][k]];
+      row[3 * k] = p.x;
+      row[3 * k + 1] = p.y;
+      row[3 * k + 2] = p.z;
+    }
+    row[9] = sources[t];
+    out.insert(row);
+  }
+  return out;
+}
+
+TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce) {
+  test::TempDir dir;
+  SeamPartFiles files(dir / "seams", blocks());
+  files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
+  std::vector<BlockPart> parts = files.finish();
+  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = std::nullopt};
+  (void)stitch_parts(parts, files, run);
+  const MergedMesh gathered = gather_stitched_parts(parts, files);
+  // Tiles of 1 m: vertices shared by up to four tiles, some by tiles that meet at a corner only.
+  const OutputLeaves leaves(dir / "tiles", TileGrid({.tile_size = 1.0, .halo = 0.1, .origin = {0.3, 0.3}}), parts, files);
+  EXPECT_GT(leaves.leaves().size(), 12u);
+  write_leaves_ply(dir / "mosaic.ply", leaves);
+
+  const FaceTable written = read_face_table(dir / "mosaic.ply", {"source_acq", "source_face"});
+  EXPECT_EQ(written.positions.size(), gathered.mesh.vertex_count()) << "each vertex once";
+  // The positions as the parts hold them, exactly (the gathered mesh has floats).
+  std::multiset<std::array<double, 10>> expected;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const auto piece = files.load(p, true);
+    const std::vector<double> sources(piece->source_acq.begin(), piece->source_acq.end());
+    expected.merge(geometry(piece->positions, piece->triangles, sources));
+  }
+  EXPECT_EQ(geometry(written.positions, written.triangles, written.extras[0]), expected);
+  Mesh as_mesh = written.local_mesh(Vec3d{});
+  EXPECT_EQ(test::non_manifold_edges(as_mesh), 0u);
+  EXPECT_EQ(test::non_manifold_edges(as_mesh), test::non_manifold_edges(gathered.mesh));
+  EXPECT_EQ(open_boundary_length(as_mesh) > 0, true);
+  EXPECT_NEAR(open_boundary_length(as_mesh), open_boundary_length(gathered.mesh), 1e-3);
+  std::uint64_t counted = leaves.stitched();
+  for (const std::uint64_t n : leaves.per_source()) counted += n;
+  EXPECT_EQ(counted, gathered.mesh.triangle_count());
 }
 
 }  // namespace

@@ -1,0 +1,171 @@
+// SPDX-License-Identifier: MIT
+#include "leaf_outputs.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <optional>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/io/ply_writer.h"
+#include "citymesh/mosaic/merged_mesh.h"
+#include "detect_output.h"
+#include "mosaic_output.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// The tiles before `leaf` (in key order) whose boxes meet its box: the only ones that can
+/// hold its vertices (a shared vertex lies in both boxes).
+std::vector<std::size_t> earlier_neighbours(const std::vector<OutputLeaf>& leaves, std::size_t leaf) {
+  std::vector<std::size_t> out;
+  for (std::size_t m = 0; m < leaf; ++m) {
+    if (leaves[m].box.intersects(leaves[leaf].box)) out.push_back(m);
+  }
+  return out;
+}
+
+/// Where `key` is in `piece`'s vertices (ascending keys), or nothing.
+std::optional<std::uint32_t> find_key(const KeyedPiece& piece, std::uint64_t key) {
+  const auto it = std::lower_bound(piece.keys.begin(), piece.keys.end(), key);
+  if (it == piece.keys.end() || *it != key) return std::nullopt;
+  return static_cast<std::uint32_t>(it - piece.keys.begin());
+}
+
+/// Which tile writes each vertex: the first, in key order, holding it. Per tile and vertex,
+/// whether it does, and per tile the number of the first vertex it writes.
+struct VertexNumbering {
+  std::vector<std::vector<std::uint8_t>> owned;
+  std::vector<std::vector<std::uint32_t>> rank;  ///< per tile and vertex: owned vertices before it
+  std::vector<std::uint64_t> first;
+  std::uint64_t vertices = 0;
+
+  explicit VertexNumbering(const OutputLeaves& leaves) {
+    const std::vector<OutputLeaf>& all = leaves.leaves();
+    owned.resize(all.size());
+    rank.resize(all.size());
+    parallel_for_blocks(all.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t l = begin; l < end; ++l) {
+        const KeyedPiece piece = leaves.load(l);
+        std::vector<std::uint8_t>& mine = owned[l];
+        mine.assign(piece.vertex_count(), 1);
+        for (const std::size_t m : earlier_neighbours(all, l)) {
+          const KeyedPiece other = leaves.load(m);
+          for (std::size_t v = 0; v < mine.size(); ++v) {
+            if (mine[v] != 0 && find_key(other, piece.keys[v])) mine[v] = 0;
+          }
+        }
+        rank[l].resize(mine.size());
+        std::uint32_t before = 0;
+        for (std::size_t v = 0; v < mine.size(); ++v) {
+          rank[l][v] = before;
+          before += mine[v];
+        }
+      }
+    });
+    for (std::size_t l = 0; l < all.size(); ++l) {
+      first.push_back(vertices);
+      vertices += std::count(owned[l].begin(), owned[l].end(), std::uint8_t{1});
+    }
+  }
+};
+
+MeshVertexAttributes attributes_of(const KeyedPiece& p) {
+  return {.sensors = !p.sensors.empty(), .times = !p.times.empty(), .intensities = !p.intensities.empty(),
+          .colors = !p.colors.empty()};
+}
+
+/// The rows of the vertices tile `leaf` writes.
+MeshVertexRows owned_rows(const KeyedPiece& piece, std::span<const std::uint8_t> owned) {
+  MeshVertexRows rows(attributes_of(piece));
+  for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
+    if (owned[v] == 0) continue;
+    rows.add(piece.positions[v], piece.sensors.empty() ? Vec3d{} : piece.sensors[v],
+             piece.times.empty() ? 0.0 : piece.times[v], piece.intensities.empty() ? 0.0f : piece.intensities[v],
+             piece.colors.empty() ? Rgb8{} : piece.colors[v]);
+  }
+  return rows;
+}
+
+/// A tile's faces on the file's vertex numbers, with their provenance columns.
+struct FaceRows {
+  std::vector<Triangle> triangles;
+  std::vector<std::int32_t> source_acq, source_face;
+};
+
+FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf) {
+  const KeyedPiece piece = leaves.load(leaf);
+  std::vector<KeyedPiece> earlier;
+  std::vector<std::size_t> earlier_index;
+  for (const std::size_t m : earlier_neighbours(leaves.leaves(), leaf)) {
+    earlier.push_back(leaves.load(m));
+    earlier_index.push_back(m);
+  }
+  std::vector<std::uint32_t> number(piece.vertex_count());
+  for (std::size_t v = 0; v < number.size(); ++v) {
+    std::uint64_t n = numbers.first[leaf] + numbers.rank[leaf][v];
+    if (numbers.owned[leaf][v] == 0) {
+      // The first earlier tile holding it writes it (every tile holding it meets this one).
+      for (std::size_t e = 0; e < earlier.size(); ++e) {
+        if (const auto at = find_key(earlier[e], piece.keys[v])) {
+          n = numbers.first[earlier_index[e]] + numbers.rank[earlier_index[e]][*at];
+          break;
+        }
+      }
+    }
+    number[v] = static_cast<std::uint32_t>(n);
+  }
+  FaceRows rows;
+  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
+    const Triangle& tri = piece.triangles[t];
+    rows.triangles.push_back({number[tri[0]], number[tri[1]], number[tri[2]]});
+    rows.source_acq.push_back(piece.source_acq[t]);
+    rows.source_face.push_back(piece.source_acq[t] == kNoSource ? kNoSource
+                                                                 : static_cast<std::int32_t>(piece.ids[t].face));
+  }
+  return rows;
+}
+
+/// Tiles prepared at a time before their rows are written in order.
+constexpr std::size_t kLeavesInFlight = 4;
+
+}  // namespace
+
+void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& leaves) {
+  const std::vector<OutputLeaf>& all = leaves.leaves();
+  const VertexNumbering numbers(leaves);
+  if (numbers.vertices > UINT32_MAX) {
+    throw ProcessingError(fmt::format("{}: {} vertices do not fit the PLY's 32-bit indices", path.string(), numbers.vertices));
+  }
+  std::uint64_t faces = 0;
+  for (const OutputLeaf& leaf : all) faces += leaf.triangles;
+  const KeyedPiece first = all.empty() ? KeyedPiece{} : leaves.load(0);
+  const MeshVertexRows layout_rows(attributes_of(first));
+  const std::vector<std::int32_t> none;
+  const PlyWriteInput layout{{}, {}, layout_rows.columns(),
+                             {{std::string(kSourceAcqProperty), std::span(none)}, {kSourceFaceProperty, std::span(none)}},
+                             {std::string(kPlyComment)}};
+  PlyStreamWriter out(path, layout, numbers.vertices, faces);
+  for (std::size_t l = 0; l < all.size(); ++l) {
+    const MeshVertexRows rows = owned_rows(leaves.load(l), numbers.owned[l]);
+    out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
+  }
+  for (std::size_t begin = 0; begin < all.size(); begin += kLeavesInFlight) {
+    const std::size_t count = std::min(kLeavesInFlight, all.size() - begin);
+    std::vector<FaceRows> rows(count);
+    parallel_for_blocks(count, 1, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) rows[i] = face_rows(leaves, numbers, begin + i);
+    });
+    for (const FaceRows& r : rows) {
+      out.add_faces({{}, r.triangles, {},
+                     {{std::string(kSourceAcqProperty), std::span<const std::int32_t>(r.source_acq)},
+                      {kSourceFaceProperty, std::span<const std::int32_t>(r.source_face)}},
+                     {}});
+    }
+  }
+  out.commit();
+}
+
+}  // namespace citymesh::app
