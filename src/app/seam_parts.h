@@ -108,8 +108,4 @@ class OutputLeaves {
   std::uint64_t stitched_ = 0;
 };
 
-/// The stitched parts as one output mesh: vertices in key order, floats relative to the
-/// first one in whole metres, triangles part by part. Holds the output; reads each part twice.
-MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store);
-
 }  // namespace citymesh::app

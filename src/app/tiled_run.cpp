@@ -184,14 +184,13 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     write_mosaic_outputs(config, describe_acquisitions(config), *leaves, stats, mosaic_params);
     output_triangles = 0;
     for (const OutputLeaf& leaf : leaves->leaves()) output_triangles += leaf.triangles;
-    merged = gather_stitched_parts(parts, *seams);  // for the export, until it reads the tiles too
-    leaves.reset();
-    seams.reset();
   } else {
     write_mosaic_outputs(config, describe_acquisitions(config), merged, stats, mosaic_params);
   }
   stage_done("outputs");
-  const nlohmann::json exported = write_tileset_outputs(config, merged);
+  const nlohmann::json exported = leaves ? write_tileset_outputs(config, *leaves) : write_tileset_outputs(config, merged);
+  leaves.reset();
+  seams.reset();
   stage_done("export");
 
   double wall = total.seconds();

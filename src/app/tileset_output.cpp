@@ -22,14 +22,17 @@ TileGridParams grid_params(const Config& config) {
   return {.tile_size = config.tiling.tile_size, .halo = config.tiling.halo, .origin = config.tiling.origin};
 }
 
-nlohmann::json write_3d_tiles(const Config& config, const MergedMesh& merged) {
+TilesetExportParams export_params(const Config& config) {
   TilesetExportParams params;
   params.dir = config.project.output / "tiles";
   params.grid = grid_params(config);
   params.tolerance = config.output.draco_tolerance;
   for (const AcquisitionEntry& a : config.acquisitions) params.acquisitions.push_back({a.name, format_iso8601(a.time)});
-  const Crs crs = config.crs();
-  const TilesetExportStats s = export_tileset({merged.mesh, merged.source_acq, crs}, params);
+  return params;
+}
+
+/// Prints the export's line and returns its figures for the run report.
+nlohmann::json report_3d_tiles(const TilesetExportStats& s, const TilesetExportParams& params) {
   std::cout << fmt::format("3D Tiles: {} tiles ({} leaves, {} levels) of {} triangles, {:.1f} bytes per leaf triangle, "
                            "{}-bit positions ({:.2f} mm step), {:.2f} s -> {}\n",
                            s.tiles, s.leaves, s.levels, s.leaf_triangles,
@@ -66,6 +69,46 @@ Mesh sub_mesh(const Mesh& mesh, std::span<const std::uint32_t> keep) {
   return out;
 }
 
+nlohmann::json write_3d_tiles(const Config& config, const MergedMesh& merged) {
+  const TilesetExportParams params = export_params(config);
+  const Crs crs = config.crs();
+  return report_3d_tiles(export_tileset({merged.mesh, merged.source_acq, crs}, params), params);
+}
+
+/// The output's tiles, as the export reads them.
+class LeavesToExport final : public TilesetLeaves {
+ public:
+  explicit LeavesToExport(const OutputLeaves& leaves) : leaves_(leaves) {
+    for (std::size_t l = 0; l < leaves.leaves().size(); ++l) index_[leaves.leaves()[l].key] = l;
+  }
+  [[nodiscard]] std::vector<TileKey> keys() const override {
+    std::vector<TileKey> out;
+    for (const OutputLeaf& leaf : leaves_.leaves()) out.push_back(leaf.key);
+    return out;
+  }
+  [[nodiscard]] Box3d box() const override { return leaves_.box(); }
+  [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
+    return tile_mesh(leaves_.load(index_.at(key)), to_local);
+  }
+
+ private:
+  const OutputLeaves& leaves_;
+  std::map<TileKey, std::size_t> index_;
+};
+
+/// The provenance columns of `piece`'s triangles.
+struct Provenance {
+  std::vector<std::int32_t> acq, face;
+  explicit Provenance(const KeyedPiece& piece) : acq(piece.source_acq) {
+    for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
+      face.push_back(acq[t] == kNoSource ? kNoSource : static_cast<std::int32_t>(piece.ids[t].face));
+    }
+  }
+  [[nodiscard]] std::vector<PlyColumn> columns() const {
+    return {{kSourceAcqProperty, std::span<const std::int32_t>(acq)}, {"source_face", std::span<const std::int32_t>(face)}};
+  }
+};
+
 nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   Stopwatch clock;
   const std::vector<TileKey> keys = leaf_keys(merged.mesh, TileGrid(grid_params(config)));
@@ -98,6 +141,45 @@ std::filesystem::path find_tileset(const std::filesystem::path& given) {
   }
   throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
                                given.string()));
+}
+
+/// One provenance PLY per tile from the output's tiles in files.
+nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves) {
+  Stopwatch clock;
+  const std::filesystem::path dir = config.project.output / "ply";
+  const std::filesystem::path staged = staging_directory(dir);
+  std::filesystem::remove_all(staged);
+  std::filesystem::create_directories(staged);
+  for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
+    const KeyedPiece piece = leaves.load(l);
+    MeshVertexRows rows({.sensors = !piece.sensors.empty(), .times = !piece.times.empty(),
+                         .intensities = !piece.intensities.empty(), .colors = !piece.colors.empty()});
+    for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
+      rows.add(piece.positions[v], piece.sensors.empty() ? Vec3d{} : piece.sensors[v],
+               piece.times.empty() ? 0.0 : piece.times[v], piece.intensities.empty() ? 0.0f : piece.intensities[v],
+               piece.colors.empty() ? Rgb8{} : piece.colors[v]);
+    }
+    const Provenance provenance(piece);
+    write_ply(staged / (leaves.leaves()[l].key.name() + ".ply"),
+              {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
+  }
+  replace_directory_atomically(staged, dir);
+  std::cout << fmt::format("provenance PLY: {} tiles -> {}\n", leaves.leaves().size(), dir.string());
+  return {{"files", leaves.leaves().size()}, {"seconds", clock.seconds()}};
+}
+
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves) {
+  nlohmann::json report = nlohmann::json::object();
+  if (leaves.leaves().empty()) {
+    if (config.output.tiles_3d || config.output.ply) log::warn("the output has no triangles: no tileset written");
+    return report;
+  }
+  if (config.output.tiles_3d) {
+    const TilesetExportParams params = export_params(config);
+    report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params), params);
+  }
+  if (config.output.ply) report["ply"] = write_tile_plys(config, leaves);
+  return report;
 }
 
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged) {

@@ -9,6 +9,7 @@
 
 #include "citymesh/config/config.h"
 #include "citymesh/mosaic/merged_mesh.h"
+#include "seam_parts.h"
 
 namespace citymesh::app {
 
@@ -18,5 +19,7 @@ std::filesystem::path find_tileset(const std::filesystem::path& given);
 
 /// Writes what [output] asks for; returns figures for the run report ({} when nothing).
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged);
+/// The same from the output's tiles in files (a tiled run's seam pass block by block).
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves);
 
 }  // namespace citymesh::app

@@ -19,10 +19,14 @@ namespace {
 
 /// Origin of the local frame: the centre of the output's x-y extent at its lowest z, in whole
 /// metres so that it reads well and does not depend on float rounding.
-Vec3d frame_origin(const Mesh& mesh) {
+Vec3d frame_origin(const Box3d& box) {
+  return {std::round((box.min.x + box.max.x) / 2), std::round((box.min.y + box.max.y) / 2), std::round(box.min.z)};
+}
+
+Box3d world_box(const Mesh& mesh) {
   Box3d box;
   for (std::size_t v = 0; v < mesh.vertex_count(); ++v) box.extend(mesh.world_position(v));
-  return {std::round((box.min.x + box.max.x) / 2), std::round((box.min.y + box.max.y) / 2), std::round(box.min.z)};
+  return box;
 }
 
 std::vector<Vec3f> local_positions(const Mesh& mesh, const Crs& crs, const EnuFrame& frame) {
@@ -113,10 +117,15 @@ SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source
   return out;
 }
 
-/// The Draco lattice covering every vertex, with bits for the tolerance.
-DracoEncodeParams shared_lattice(std::span<const Vec3f> positions, const TilesetExportParams& params) {
+Box3d positions_box(std::span<const Vec3f> positions) {
   Box3d box;
   for (const Vec3f& p : positions) box.extend(Vec3d(p));
+  return box;
+}
+
+/// The Draco lattice covering `box` (every vertex, in the local frame), with bits for the
+/// tolerance.
+DracoEncodeParams shared_lattice(const Box3d& box, const TilesetExportParams& params) {
   // Whole metres, one metre of margin: exact in float, the same whatever the tile.
   const Vec3d lo{std::floor(box.min.x) - 1, std::floor(box.min.y) - 1, std::floor(box.min.z) - 1};
   const double range = std::ceil(std::max({box.max.x - lo.x, box.max.y - lo.y, box.max.z - lo.z})) + 1;
@@ -135,23 +144,12 @@ DracoEncodeParams shared_lattice(std::span<const Vec3f> positions, const Tileset
   return draco;
 }
 
-/// The tile's own vertex attributes, gathered from the shared buffer.
-struct TileAttributes {
-  std::vector<Vec3f> positions;
-  std::vector<std::uint16_t> feature_ids;
-  std::vector<float> intensities;
-  std::vector<Rgb8> colors;
-};
-
-TileAttributes gather(const TilesetVertices& all, const TileMesh& mesh) {
-  TileAttributes a;
-  for (const std::uint32_t v : mesh.vertices) {
-    a.positions.push_back(all.positions[v]);
-    a.feature_ids.push_back(all.feature_ids[v]);
-    if (!all.intensities.empty()) a.intensities.push_back(all.intensities[v]);
-    if (!all.colors.empty()) a.colors.push_back(all.colors[v]);
-  }
-  return a;
+/// A tile's feature ids: its vertices' keys carry them.
+std::vector<std::uint16_t> feature_ids(const TileMesh& mesh) {
+  std::vector<std::uint16_t> out;
+  out.reserve(mesh.vertex_count());
+  for (const TileVertexKey& k : mesh.keys) out.push_back(k.feature);
+  return out;
 }
 
 /// Tiles on the longest path from the root to a leaf (a parent may skip levels of the grid).
@@ -176,23 +174,20 @@ std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid) {
   return keys;
 }
 
-TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params) {
+namespace {
+
+/// Builds the tree with `build` (given the sink that writes each tile) and writes the tileset:
+/// the glb of every tile as the tree hands it over, then the JSON files.
+TilesetExportStats write_tileset(const Geodetic& origin, const DracoEncodeParams& lattice,
+                                 const TilesetExportParams& params,
+                                 const std::function<TileTree(const TileNodeSink&)>& build) {
   Stopwatch clock;
-  const Mesh& mesh = source.mesh;
-  if (mesh.triangle_count() == 0) throw ProcessingError("3D Tiles: the output has no triangles to export");
-  if (source.source_acq.size() != mesh.triangle_count()) {
-    throw ProcessingError("3D Tiles: one source acquisition per triangle is needed");
-  }
   TilesetExportStats stats;
-  stats.origin = source.crs.to_geodetic(frame_origin(mesh));
-  const EnuFrame frame(stats.origin);
-  // The positions in the local frame live only while the split copies them.
-  const SplitMesh split = split_by_source(mesh, source.source_acq, local_positions(mesh, source.crs, frame));
-  GlbParams glb{.draco = params.draco, .draco_params = shared_lattice(split.vertices.positions, params),
-                .acquisitions = params.acquisitions};
+  stats.origin = origin;
+  const EnuFrame frame(origin);
+  const GlbParams glb{.draco = params.draco, .draco_params = lattice, .acquisitions = params.acquisitions};
   const double step = static_cast<double>(glb.draco_params.lattice->range) /
                       static_cast<double>((std::uint64_t{1} << glb.draco_params.position_bits) - 1);
-
   const std::filesystem::path staged = staging_directory(params.dir);
   std::error_code ec;
   std::filesystem::remove_all(staged, ec);
@@ -203,15 +198,14 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   std::atomic<std::uint64_t> glb_bytes{0};
   const auto write_tile = [&](const TileNode& node) {
     if (node.mesh.triangles.empty()) return;
-    const TileAttributes a = gather(split.vertices, node.mesh);
+    const TileMesh& m = node.mesh;
     const std::vector<std::uint8_t> content =
-        write_glb({a.positions, node.mesh.triangles, a.feature_ids, a.intensities, a.colors}, glb);
+        write_glb({m.positions, m.triangles, feature_ids(m), m.intensities, m.colors}, glb);
     write_file_atomically(staged / (node.name() + ".glb"),
                           {reinterpret_cast<const char*>(content.data()), content.size()});
     glb_bytes += content.size();
   };
-  const TileTree tree = build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
-                                        params.tree, write_tile);
+  const TileTree tree = build(write_tile);
   const auto files = tileset_json_files(tree, {.transform = frame.to_ecef_matrix(),
                                                .max_tiles_per_file = params.max_tiles_per_file,
                                                .box_margin = step,
@@ -234,6 +228,84 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   stats.quantization_step = step;
   stats.seconds = clock.seconds();
   return stats;
+}
+
+}  // namespace
+
+TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params) {
+  Stopwatch clock;
+  const Mesh& mesh = source.mesh;
+  if (mesh.triangle_count() == 0) throw ProcessingError("3D Tiles: the output has no triangles to export");
+  if (source.source_acq.size() != mesh.triangle_count()) {
+    throw ProcessingError("3D Tiles: one source acquisition per triangle is needed");
+  }
+  const Geodetic origin = source.crs.to_geodetic(frame_origin(world_box(mesh)));
+  const EnuFrame frame(origin);
+  // The positions in the local frame live only while the split copies them.
+  const SplitMesh split = split_by_source(mesh, source.source_acq, local_positions(mesh, source.crs, frame));
+  TilesetExportStats stats =
+      write_tileset(origin, shared_lattice(positions_box(split.vertices.positions), params), params,
+                    [&](const TileNodeSink& sink) {
+                      return build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
+                                             params.tree, sink);
+                    });
+  stats.seconds = clock.seconds();
+  return stats;
+}
+
+TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params) {
+  Stopwatch clock;
+  const std::vector<TileKey> keys = leaves.keys();
+  if (keys.empty()) throw ProcessingError("3D Tiles: the output has no triangles to export");
+  const Geodetic origin = crs.to_geodetic(frame_origin(leaves.box()));
+  const EnuFrame frame(origin);
+  const LocalMapping to_local = [&](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
+  // The lattice must hold every vertex in the local frame, whose box only the leaves know: one
+  // pass over them first, a leaf at a time.
+  std::vector<Box3d> boxes(keys.size());
+  parallel_for_blocks(keys.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) boxes[k] = positions_box(leaves.leaf(keys[k], to_local).positions);
+  });
+  Box3d box;
+  for (const Box3d& b : boxes) box.extend(b);
+  TilesetExportStats stats =
+      write_tileset(origin, shared_lattice(box, params), params, [&](const TileNodeSink& sink) {
+        return build_tile_tree(keys, [&](const TileKey& key) { return leaves.leaf(key, to_local); }, params.tree, sink);
+      });
+  stats.seconds = clock.seconds();
+  return stats;
+}
+
+TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {
+  // One tile vertex per (vertex, feature) the triangles draw: a vertex shared by two sources
+  // is drawn twice, each with its own feature id.
+  std::vector<TileVertexKey> keys;
+  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
+    const std::uint16_t f = feature_of(piece.source_acq[t]);
+    for (const std::uint32_t v : piece.triangles[t]) keys.push_back({piece.keys[v], f});
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  TileMesh m;
+  const auto vertex = [&](std::uint64_t key) {  // piece.keys ascend
+    return static_cast<std::uint32_t>(std::lower_bound(piece.keys.begin(), piece.keys.end(), key) - piece.keys.begin());
+  };
+  for (const TileVertexKey& k : keys) {
+    const std::uint32_t v = vertex(k.vertex);
+    m.keys.push_back(k);
+    m.positions.push_back(to_local(piece.positions[v]));
+    if (!piece.intensities.empty()) m.intensities.push_back(piece.intensities[v]);
+    if (!piece.colors.empty()) m.colors.push_back(piece.colors[v]);
+  }
+  const auto index = [&](const TileVertexKey& k) {
+    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), k) - keys.begin());
+  };
+  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
+    const std::uint16_t f = feature_of(piece.source_acq[t]);
+    const Triangle& tri = piece.triangles[t];
+    m.triangles.push_back({index({piece.keys[tri[0]], f}), index({piece.keys[tri[1]], f}), index({piece.keys[tri[2]], f})});
+  }
+  return m;
 }
 
 }  // namespace citymesh

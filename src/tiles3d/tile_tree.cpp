@@ -20,68 +20,100 @@ std::string TileNode::name() const { return fmt::format("t{}_{}_{}", level, key.
 
 namespace {
 
-/// A tile mesh from triangles in global vertex indices (< vertex_count): vertices ascending,
-/// triangle order kept. Each thread keeps one slot per global vertex (its index in the tile
-/// being built, reset after use), so only the tile's distinct vertices are sorted and each
-/// corner is found in one step; sorting every corner and binary-searching them was an eighth
-/// of the export's time on a city.
-TileMesh compact(std::span<const Triangle> global, std::size_t vertex_count) {
+/// A tile mesh from triangles in the buffer's vertex indices: vertices ascending (keyed by
+/// their index), triangle order kept. Each thread keeps one slot per buffer vertex (its index
+/// in the tile being built, reset after use), so only the tile's distinct vertices are sorted
+/// and each corner is found in one step; sorting every corner and binary-searching them was an
+/// eighth of the export's time on a city.
+TileMesh compact(const TilesetVertices& buffer, std::span<const Triangle> global) {
   constexpr std::uint32_t kAbsent = UINT32_MAX;
   thread_local std::vector<std::uint32_t> slot;
-  if (slot.size() < vertex_count) slot.resize(vertex_count, kAbsent);
-  TileMesh m;
-  m.triangles.reserve(global.size());
+  if (slot.size() < buffer.positions.size()) slot.resize(buffer.positions.size(), kAbsent);
+  std::vector<std::uint32_t> vertices;
   for (const Triangle& t : global) {
     for (const std::uint32_t v : t) {
       if (slot[v] == kAbsent) {
         slot[v] = 0;
-        m.vertices.push_back(v);
+        vertices.push_back(v);
       }
     }
   }
-  std::sort(m.vertices.begin(), m.vertices.end());
-  for (std::size_t i = 0; i < m.vertices.size(); ++i) slot[m.vertices[i]] = static_cast<std::uint32_t>(i);
+  std::sort(vertices.begin(), vertices.end());
+  TileMesh m;
+  for (std::size_t i = 0; i < vertices.size(); ++i) {
+    const std::uint32_t v = vertices[i];
+    slot[v] = static_cast<std::uint32_t>(i);
+    m.keys.push_back({v, buffer.feature_ids[v]});
+    m.positions.push_back(buffer.positions[v]);
+    if (!buffer.intensities.empty()) m.intensities.push_back(buffer.intensities[v]);
+    if (!buffer.colors.empty()) m.colors.push_back(buffer.colors[v]);
+  }
+  m.triangles.reserve(global.size());
   for (const Triangle& t : global) m.triangles.push_back({slot[t[0]], slot[t[1]], slot[t[2]]});
-  for (const std::uint32_t v : m.vertices) slot[v] = kAbsent;
+  for (const std::uint32_t v : vertices) slot[v] = kAbsent;
   return m;
 }
 
-/// Appends m's triangles to `out` in global vertex indices.
-void append_global(const TileMesh& m, std::vector<Triangle>& out) {
-  for (const Triangle& t : m.triangles) out.push_back({m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]});
+/// The triangles `triangles` of `m` (indices into it) on the vertices they use, in key order.
+TileMesh subset(const TileMesh& m, std::span<const Triangle> triangles) {
+  std::vector<std::uint32_t> local(m.vertex_count(), UINT32_MAX);
+  for (const Triangle& t : triangles) {
+    for (const std::uint32_t v : t) local[v] = 0;
+  }
+  TileMesh out;
+  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+    if (local[v] == UINT32_MAX) continue;
+    local[v] = static_cast<std::uint32_t>(out.vertex_count());
+    out.append_vertex(m, v);
+  }
+  for (const Triangle& t : triangles) out.triangles.push_back({local[t[0]], local[t[1]], local[t[2]]});
+  return out;
 }
 
-Box3d mesh_box(const TilesetVertices& vertices, const TileMesh& m) {
+/// The meshes as one: each key once (the first mesh's copy), the triangles of each in turn.
+TileMesh merge(std::span<const TileMesh* const> meshes) {
+  std::vector<TileVertexKey> keys;
+  for (const TileMesh* m : meshes) keys.insert(keys.end(), m->keys.begin(), m->keys.end());
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  std::vector<std::pair<const TileMesh*, std::uint32_t>> source(keys.size(), {nullptr, 0});
+  std::vector<std::vector<std::uint32_t>> index(meshes.size());
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    const TileMesh& m = *meshes[k];
+    std::size_t at = 0;
+    for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
+      while (keys[at] != m.keys[v]) ++at;  // both ascend
+      index[k].push_back(static_cast<std::uint32_t>(at));
+      if (source[at].first == nullptr) source[at] = {&m, v};
+    }
+  }
+  TileMesh out;
+  for (const auto& [m, v] : source) out.append_vertex(*m, v);
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    for (const Triangle& t : meshes[k]->triangles) out.triangles.push_back({index[k][t[0]], index[k][t[1]], index[k][t[2]]});
+  }
+  return out;
+}
+
+Box3d mesh_box(const TileMesh& m) {
   Box3d box;
-  for (const std::uint32_t v : m.vertices) box.extend(Vec3d(vertices.positions[v]));
+  for (const Vec3f& p : m.positions) box.extend(Vec3d(p));
   return box;
 }
 
 /// Merges the children's meshes (children index `nodes`) and simplifies the result with
 /// locked borders.
-void build_parent(const TilesetVertices& vertices, std::span<const TileNode> nodes, TileNode& parent,
-                  const TileTreeParams& params) {
-  std::vector<Triangle> merged;
-  std::size_t total = 0;
-  for (const std::uint32_t c : parent.children) total += nodes[c].mesh.triangles.size();
-  merged.reserve(total);
+void build_parent(std::span<const TileNode> nodes, TileNode& parent, const TileTreeParams& params) {
+  std::vector<const TileMesh*> children;
   double child_error = 0.0;
   for (const std::uint32_t c : parent.children) {
-    append_global(nodes[c].mesh, merged);
+    children.push_back(&nodes[c].mesh);
     child_error = std::max(child_error, nodes[c].geometric_error);
     parent.box.extend(nodes[c].box);
   }
-  const TileMesh whole = compact(merged, vertices.positions.size());
-  std::vector<Vec3f> positions;
-  positions.reserve(whole.vertices.size());
-  for (const std::uint32_t v : whole.vertices) positions.push_back(vertices.positions[v]);
-  const SimplifiedMesh simplified = simplify_mesh(positions, whole.triangles, params.simplify);
-  std::vector<Triangle> kept;
-  kept.reserve(simplified.triangles.size());
-  for (const Triangle& t : simplified.triangles) {
-    kept.push_back({whole.vertices[t[0]], whole.vertices[t[1]], whole.vertices[t[2]]});
-  }
-  parent.mesh = compact(kept, vertices.positions.size());
+  const TileMesh whole = merge(children);
+  const SimplifiedMesh simplified = simplify_mesh(whole.positions, whole.triangles, params.simplify);
+  parent.mesh = subset(whole, simplified.triangles);
   parent.triangle_count = parent.mesh.triangles.size();
   parent.geometric_error = std::max(child_error + simplified.error, params.min_geometric_error);
 }
@@ -105,13 +137,11 @@ constexpr double kMaxSingleChildShare = 0.5;
 /// mesh simplifies the same way).
 bool settled_alone(const Group& g) { return g.size() == 1 && g[0].alone_is_final; }
 
-/// What one build shares: the input grouped by leaf and the caller's settings.
+/// What one build shares: the leaves and the caller's settings.
 struct TreeBuild {
-  const TilesetVertices& vertices;
-  std::span<const Triangle> triangles;
-  std::vector<TileKey> leaves;        ///< ascending
-  std::vector<std::uint32_t> start;   ///< per leaf: its first entry in `order`
-  std::vector<std::uint32_t> order;   ///< triangle indices grouped by leaf, input order kept
+  std::vector<TileKey> leaves;  ///< ascending, less `offset`
+  TileKey offset;               ///< what was subtracted from the grid's keys (see key_offset)
+  const LeafSource& source;
   const TileTreeParams& params;
   const TileNodeSink& sink;
 };
@@ -137,40 +167,12 @@ TileKey key_offset(std::span<const TileKey> leaf_keys) {
   return {from(lo_i, hi_i), from(lo_j, hi_j)};
 }
 
-/// Groups the triangles by leaf as indices (a counting sort), not as copies: a vector of
-/// triangles per leaf, grown by doubling, was the peak of a city's export. Leaf keys are
-/// taken less `offset`.
-void group_by_leaf(TreeBuild& b, std::span<const TileKey> leaf_keys, TileKey offset) {
-  const auto shifted = [&](const TileKey& k) { return TileKey{k.i - offset.i, k.j - offset.j}; };
-  std::map<TileKey, std::uint32_t> leaf_of;
-  for (const TileKey& key : leaf_keys) leaf_of.try_emplace(shifted(key), 0);
-  for (auto& [key, leaf] : leaf_of) {
-    leaf = static_cast<std::uint32_t>(b.leaves.size());
-    b.leaves.push_back(key);
-  }
-  b.start.assign(b.leaves.size() + 1, 0);
-  std::vector<std::uint32_t> leaf_index(leaf_keys.size());
-  for (std::size_t t = 0; t < leaf_keys.size(); ++t) {
-    // Consecutive triangles mostly share a leaf (the output is in input order): look up only
-    // when the key changes.
-    leaf_index[t] = t > 0 && leaf_keys[t] == leaf_keys[t - 1] ? leaf_index[t - 1] : leaf_of.at(shifted(leaf_keys[t]));
-    ++b.start[leaf_index[t] + 1];
-  }
-  for (std::size_t n = 0; n < b.leaves.size(); ++n) b.start[n + 1] += b.start[n];
-  b.order.resize(leaf_keys.size());
-  std::vector<std::uint32_t> at(b.start.begin(), b.start.end() - 1);
-  for (std::size_t t = 0; t < leaf_keys.size(); ++t) b.order[at[leaf_index[t]]++] = static_cast<std::uint32_t>(t);
-}
-
 TileNode make_leaf(const TreeBuild& b, std::uint32_t leaf) {
-  std::vector<Triangle> own;
-  own.reserve(b.start[leaf + 1] - b.start[leaf]);
-  for (std::uint32_t i = b.start[leaf]; i < b.start[leaf + 1]; ++i) own.push_back(b.triangles[b.order[i]]);
   TileNode node;
   node.key = b.leaves[leaf];
-  node.mesh = compact(own, b.vertices.positions.size());
+  node.mesh = b.source({node.key.i + b.offset.i, node.key.j + b.offset.j});
   node.triangle_count = node.mesh.triangles.size();
-  node.box = mesh_box(b.vertices, node.mesh);
+  node.box = mesh_box(node.mesh);
   return node;
 }
 
@@ -190,7 +192,7 @@ std::optional<TileNode> parent_of(const TreeBuild& b, std::span<TileNode> nodes,
   parent.level = level;
   parent.key = key;
   for (const OpenNode& o : g) parent.children.push_back(o.node);
-  build_parent(b.vertices, nodes, parent, b.params);
+  build_parent(nodes, parent, b.params);
   const auto child_triangles = static_cast<double>(nodes[g[0].node].triangle_count);
   if (g.size() == 1 && static_cast<double>(parent.triangle_count) > kMaxSingleChildShare * child_triangles) {
     return std::nullopt;
@@ -295,13 +297,13 @@ DepthFirstCells depth_first_cells(std::span<const TileKey> leaves, int top, std:
 
 }  // namespace
 
-TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
-                         std::span<const TileKey> leaf_keys, const TileTreeParams& params, const TileNodeSink& sink) {
+TileTree build_tile_tree(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
+                         const TileNodeSink& sink) {
   TileTree tree;
-  TreeBuild b{.vertices = vertices, .triangles = triangles, .leaves = {}, .start = {}, .order = {}, .params = params,
-              .sink = sink};
-  group_by_leaf(b, leaf_keys, key_offset(leaf_keys));
-  if (b.leaves.empty()) return tree;
+  if (leaves.empty()) return tree;
+  const TileKey offset = key_offset(leaves);
+  TreeBuild b{.leaves = {}, .offset = offset, .source = source, .params = params, .sink = sink};
+  for (const TileKey& k : leaves) b.leaves.push_back({k.i - offset.i, k.j - offset.j});
   const auto [split, listed] =
       depth_first_cells(b.leaves, top_level(b.leaves), std::max<std::size_t>(params.depth_first_cells, 1));
   // Below `split`, cell by cell in parallel; each cell's nodes are then appended in key order.
@@ -311,17 +313,56 @@ TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triang
     for (std::size_t c = begin; c < end; ++c) open[c] = build_cell(b, listed[c].second, split, listed[c].first, subtrees[c]);
   });
   for (std::size_t c = 0; c < listed.size(); ++c) {
-    const auto offset = static_cast<std::uint32_t>(tree.nodes.size());
+    const auto at = static_cast<std::uint32_t>(tree.nodes.size());
     for (TileNode& node : subtrees[c]) {
-      for (std::uint32_t& child : node.children) child += offset;
+      for (std::uint32_t& child : node.children) child += at;
       tree.nodes.push_back(std::move(node));
     }
-    open[c].node += offset;
+    open[c].node += at;
   }
   // Above it, level by level.
   for (int level = split + 1; open.size() > 1; ++level) open = add_level(b, tree, open, level);
   hand_over(b, tree.nodes[open[0].node]);
   return tree;
+}
+
+TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
+                         std::span<const TileKey> leaf_keys, const TileTreeParams& params, const TileNodeSink& sink) {
+  // The triangles grouped by leaf as indices (a counting sort), not as copies: a vector of
+  // triangles per leaf, grown by doubling, was the peak of a city's export.
+  std::map<TileKey, std::uint32_t> leaf_of;
+  for (const TileKey& key : leaf_keys) leaf_of.try_emplace(key, 0);
+  std::vector<TileKey> leaves;
+  for (auto& [key, leaf] : leaf_of) {
+    leaf = static_cast<std::uint32_t>(leaves.size());
+    leaves.push_back(key);
+  }
+  std::vector<std::uint32_t> start(leaves.size() + 1, 0), leaf_index(leaf_keys.size());
+  for (std::size_t t = 0; t < leaf_keys.size(); ++t) {
+    // Consecutive triangles mostly share a leaf (the output is in input order): look up only
+    // when the key changes.
+    leaf_index[t] = t > 0 && leaf_keys[t] == leaf_keys[t - 1] ? leaf_index[t - 1] : leaf_of.at(leaf_keys[t]);
+    ++start[leaf_index[t] + 1];
+  }
+  for (std::size_t n = 0; n < leaves.size(); ++n) start[n + 1] += start[n];
+  std::vector<std::uint32_t> order(leaf_keys.size());
+  std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+  for (std::size_t t = 0; t < leaf_keys.size(); ++t) order[at[leaf_index[t]]++] = static_cast<std::uint32_t>(t);
+  const LeafSource from_buffer = [&](const TileKey& key) {
+    const std::uint32_t leaf = leaf_of.at(key);
+    std::vector<Triangle> own;
+    own.reserve(start[leaf + 1] - start[leaf]);
+    for (std::uint32_t i = start[leaf]; i < start[leaf + 1]; ++i) own.push_back(triangles[order[i]]);
+    return compact(vertices, own);
+  };
+  return build_tile_tree(leaves, from_buffer, params, sink);
+}
+
+void TileMesh::append_vertex(const TileMesh& from, std::uint32_t v) {
+  keys.push_back(from.keys[v]);
+  positions.push_back(from.positions[v]);
+  if (!from.intensities.empty()) intensities.push_back(from.intensities[v]);
+  if (!from.colors.empty()) colors.push_back(from.colors[v]);
 }
 
 }  // namespace citymesh

@@ -55,6 +55,58 @@ std::vector<TilePiece> tile_pieces(const MergedMesh& m, Keep keep) {
   return out;
 }
 
+/// The stitched parts as one mesh (vertices in key order, floats relative to the first in
+/// whole metres, triangles part by part): the whole output, to compare against.
+MergedMesh gather_stitched_parts(std::span<const BlockPart> parts, const PartStore& store) {
+  // First every key, then each part's vertices and triangles in place: the output and one
+  // part in memory, never every part at once.
+  std::vector<std::uint64_t> keys;
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
+    keys.insert(keys.end(), piece->keys.begin(), piece->keys.end());
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  MergedMesh out;
+  Mesh& m = out.mesh;
+  bool first = true;
+  std::vector<std::uint8_t> placed(keys.size(), 0);
+  for (std::size_t p = 0; p < parts.size(); ++p) {
+    const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
+    if (piece->vertex_count() == 0) continue;
+    if (first) {
+      m.origin = whole_metre_origin(piece->positions.front());
+      m.positions.resize(keys.size());
+      if (!piece->sensors.empty()) m.sensor_positions.resize(keys.size());
+      if (!piece->times.empty()) m.times.resize(keys.size());
+      if (!piece->intensities.empty()) m.intensities.resize(keys.size());
+      if (!piece->colors.empty()) m.colors.resize(keys.size());
+      first = false;
+    }
+    std::vector<std::uint32_t> index(piece->vertex_count());
+    std::size_t at = 0;
+    for (std::size_t v = 0; v < index.size(); ++v) {
+      while (keys[at] != piece->keys[v]) ++at;  // both ascend
+      index[v] = static_cast<std::uint32_t>(at);
+      if (placed[at] != 0) continue;
+      placed[at] = 1;
+      m.positions[at] = to_local(piece->positions[v], m.origin);
+      if (!m.sensor_positions.empty()) m.sensor_positions[at] = to_local(piece->sensors[v], m.origin);
+      if (!m.times.empty()) m.times[at] = piece->times[v];
+      if (!m.intensities.empty()) m.intensities[at] = piece->intensities[v];
+      if (!m.colors.empty()) m.colors[at] = piece->colors[v];
+    }
+    for (std::size_t t = 0; t < piece->triangle_count(); ++t) {
+      const Triangle& tri = piece->triangles[t];
+      m.triangles.push_back({index[tri[0]], index[tri[1]], index[tri[2]]});
+      m.triangle_ids.push_back(piece->ids[t]);
+      out.source_acq.push_back(piece->source_acq[t]);
+      out.source_triangle.push_back(piece->source_triangle[t]);
+    }
+  }
+  return out;
+}
+
 KeyedPiece sample_piece() {
   KeyedPiece p;
   p.keys = {3, input_vertex_key(2, 7), kNewVertexKey | 5};

@@ -226,6 +226,63 @@ TEST(TilesetExport, SameBytesOnOneAndTwoThreads) {
   EXPECT_TRUE(a == b);
 }
 
+/// The scene given a leaf at a time, each leaf's triangles keyed by the scene's vertex indices.
+class SceneLeaves final : public TilesetLeaves {
+ public:
+  SceneLeaves(const Scene& s, const TileGridParams& grid) : scene_(s) {
+    const std::vector<TileKey> keys = leaf_keys(s.mesh, TileGrid(grid));
+    for (std::uint32_t t = 0; t < keys.size(); ++t) by_leaf_[keys[t]].push_back(t);
+  }
+  [[nodiscard]] std::vector<TileKey> keys() const override {
+    std::vector<TileKey> out;
+    for (const auto& [key, ts] : by_leaf_) out.push_back(key);
+    return out;
+  }
+  [[nodiscard]] Box3d box() const override {
+    Box3d b;
+    for (std::size_t v = 0; v < scene_.mesh.vertex_count(); ++v) b.extend(scene_.mesh.world_position(v));
+    return b;
+  }
+  [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
+    KeyedPiece p;
+    const std::vector<std::uint32_t>& ts = by_leaf_.at(key);
+    for (const std::uint32_t t : ts) p.keys.insert(p.keys.end(), scene_.mesh.triangles[t].begin(), scene_.mesh.triangles[t].end());
+    std::sort(p.keys.begin(), p.keys.end());
+    p.keys.erase(std::unique(p.keys.begin(), p.keys.end()), p.keys.end());
+    for (const std::uint64_t v : p.keys) p.positions.push_back(scene_.mesh.world_position(static_cast<std::size_t>(v)));
+    for (const std::uint32_t t : ts) {
+      Triangle tri{};
+      for (std::size_t k = 0; k < 3; ++k) {
+        tri[k] = static_cast<std::uint32_t>(std::lower_bound(p.keys.begin(), p.keys.end(), scene_.mesh.triangles[t][k]) -
+                                            p.keys.begin());
+      }
+      p.triangles.push_back(tri);
+      p.ids.push_back({});
+      p.source_acq.push_back(scene_.source[t]);
+      p.source_triangle.push_back(static_cast<std::int32_t>(t));
+    }
+    return tile_mesh(p, to_local);
+  }
+
+ private:
+  const Scene& scene_;
+  std::map<TileKey, std::vector<std::uint32_t>> by_leaf_;
+};
+
+TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
+  // The scene's positions are exact in floats and doubles alike, so both ways see the same
+  // vertices: every file must be the same, stitch triangles' vertices split by feature too.
+  test::TempDir tmp;
+  const Scene s = scene();
+  const TilesetExportStats whole = export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "whole"));
+  const TilesetExportStats leaves = export_tileset(SceneLeaves(s, params(tmp.path()).grid), lambert93(), params(tmp / "leaves"));
+  EXPECT_EQ(leaves.tiles, whole.tiles);
+  EXPECT_EQ(leaves.all_triangles, whole.all_triangles);
+  const auto a = folder_bytes(tmp / "whole"), b = folder_bytes(tmp / "leaves");
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b);
+}
+
 TEST(TilesetExport, ReExportReplacesTheWholeFolder) {
   test::TempDir tmp;
   const Scene s = scene();

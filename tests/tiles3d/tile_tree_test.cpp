@@ -132,7 +132,8 @@ struct TileView {
 
 std::vector<Triangle> global_triangles(const TileMesh& m) {
   std::vector<Triangle> out;
-  for (const Triangle& t : m.triangles) out.push_back({m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]});
+  const auto global = [&](std::uint32_t v) { return static_cast<std::uint32_t>(m.keys[v].vertex); };
+  for (const Triangle& t : m.triangles) out.push_back({global(t[0]), global(t[1]), global(t[2])});
   return out;
 }
 
@@ -208,7 +209,7 @@ TEST(TileTree, TheSinkGetsEveryTileOnceChildrenFirstAndItsMeshIsThenReleased) {
   ASSERT_EQ(handed.size(), kept.nodes.size());
   const auto expected = view_of(kept);
   for (const TileNode& node : tree.nodes) {
-    EXPECT_TRUE(node.mesh.triangles.empty() && node.mesh.vertices.empty()) << node.name();
+    EXPECT_TRUE(node.mesh.triangles.empty() && node.mesh.keys.empty()) << node.name();
     EXPECT_EQ(handed.at(node.name()), expected.at(node.name()).triangles) << node.name();
     EXPECT_EQ(node.triangle_count, expected.at(node.name()).triangles.size()) << node.name();
   }

@@ -5,10 +5,12 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "citymesh/core/keyed_piece.h"
 #include "citymesh/core/mesh.h"
 #include "citymesh/encode/glb.h"
 #include "citymesh/geo/crs.h"
@@ -51,6 +53,31 @@ struct TilesetSource {
 /// bit-identically in neighbouring tiles. Throws ConfigError when the tolerance is too fine
 /// for the output's extent, OutputError when a file cannot be written.
 TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params);
+
+/// Where a position in the project CRS lies in the tileset's local frame.
+using LocalMapping = std::function<Vec3f(const Vec3d&)>;
+
+/// An output given to the export one grid tile at a time, for an output too large to hold at
+/// once. Called from several threads at once.
+class TilesetLeaves {
+ public:
+  virtual ~TilesetLeaves() = default;
+  /// The grid tiles holding triangles (the tree's leaves), ascending.
+  [[nodiscard]] virtual std::vector<TileKey> keys() const = 0;
+  /// The box of the output's vertices in the project CRS (the local frame is put at its centre).
+  [[nodiscard]] virtual Box3d box() const = 0;
+  /// Leaf `key`'s mesh (the triangles whose centroid the tile holds), positions mapped by
+  /// `to_local`, each vertex keyed as the same vertex in every leaf (see tile_mesh).
+  [[nodiscard]] virtual TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const = 0;
+};
+
+/// Writes the tileset of `leaves` as export_tileset writes a mesh's, reading each leaf twice
+/// (once for the lattice, once for the tree) and holding only the tiles the tree is building.
+TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params);
+
+/// Some triangles of the output as a tile's mesh: one vertex per (vertex key, feature id of a
+/// triangle using it; stitch triangles have none), positions mapped by `to_local`.
+TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local);
 
 /// The leaf (grid tile) of each triangle: the tile containing its centroid.
 std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid);

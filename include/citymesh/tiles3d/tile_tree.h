@@ -24,11 +24,30 @@ struct TilesetVertices {
   std::vector<Rgb8> colors;        ///< empty or one per vertex
 };
 
-/// A tile's mesh: the global vertices it uses (ascending) and its triangles in local indices.
-struct TileMesh {
-  std::vector<std::uint32_t> vertices;
-  std::vector<Triangle> triangles;
+/// A vertex of a tile: a vertex of the output drawn with one feature id. The same key in two
+/// tiles is the same vertex: a parent joining them merges it.
+struct TileVertexKey {
+  std::uint64_t vertex = 0;
+  std::uint16_t feature = 0;
+  friend constexpr auto operator<=>(const TileVertexKey&, const TileVertexKey&) = default;
 };
+
+/// A tile's mesh, whole: its vertices (keys ascending) with their attributes, and its triangles.
+struct TileMesh {
+  std::vector<TileVertexKey> keys;
+  std::vector<Vec3f> positions;    ///< in the tileset's local frame
+  std::vector<float> intensities;  ///< empty or one per vertex
+  std::vector<Rgb8> colors;        ///< empty or one per vertex
+  std::vector<Triangle> triangles;
+
+  [[nodiscard]] std::size_t vertex_count() const { return keys.size(); }
+  /// Appends vertex v of `from` (same attributes); its key must pass every key so far.
+  void append_vertex(const TileMesh& from, std::uint32_t v);
+};
+
+/// The mesh of one leaf (grid tile), given as the tree needs it; called from several threads
+/// at once.
+using LeafSource = std::function<TileMesh(const TileKey&)>;
 
 struct TileNode {
   int level = 0;  ///< 0: leaves; a level-l tile covers 2^l x 2^l grid tiles
@@ -63,16 +82,21 @@ struct TileTreeParams {
 /// returns. Lets a caller write each tile while the tree is built instead of holding them all.
 using TileNodeSink = std::function<void(const TileNode&)>;
 
-/// Builds the tree from the triangles (global vertex indices) and each triangle's leaf key.
-/// Level by level, the nodes without a parent are grouped by their keys one level up and each
+/// Builds the tree over the leaves `leaves` (grid keys, ascending, each holding triangles),
+/// asking `source` for each leaf's mesh when its subtree is built. Level by level, the nodes without a parent are grouped by their keys one level up and each
 /// group gets a parent, except a node alone in its group whose simplification keeps more than
 /// half of it: that node is carried up unchanged (a parent would only repeat it) until it meets
 /// another, so a parent's children may lie several levels below it.
 /// Halving never brings keys of both signs together, so an axis whose leaf keys have both
 /// signs (a grid origin inside the output) is counted from its smallest key; node keys and
 /// names are then relative to it.
-/// The result depends only on the input, never on the thread count. An empty input gives an
-/// empty tree. Without a sink every node keeps its mesh.
+/// The result depends only on the input, never on the thread count. No leaves give an empty
+/// tree. Without a sink every node keeps its mesh.
+TileTree build_tile_tree(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
+                         const TileNodeSink& sink = {});
+
+/// The same from one vertex buffer: the triangles (its vertex indices) and each one's leaf
+/// key. A leaf's vertices are keyed by their index in the buffer (and its feature id).
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,
                          std::span<const TileKey> leaf_keys, const TileTreeParams& params,
                          const TileNodeSink& sink = {});
