@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -100,9 +101,12 @@ nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPa
                           .source_sizes = {source_sizes.begin(), source_sizes.end()},
                           .frame = std::nullopt};
   const double before = parts_open_boundary(parts, store, false, run.blocks);
+  log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   BlockStitchStats s = stitch_parts(parts, store, run);
+  log::debug("stitch by blocks: stitched at {:.2f} s", clock.seconds());
   s.stitch.open_boundary_before = before;
   s.stitch.open_boundary_after = parts_open_boundary(parts, store, true, run.blocks);
+  log::debug("stitch by blocks: open boundary after measured at {:.2f} s", clock.seconds());
   s.stitch.seconds = clock.seconds();
   std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
                            "triangles with its surroundings\n",

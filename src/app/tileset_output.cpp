@@ -90,6 +90,11 @@ class LeavesToExport final : public TilesetLeaves {
   [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
     return tile_mesh(leaves_.load(index_.at(key)), to_local);
   }
+  [[nodiscard]] Box3d local_box(const TileKey& key, const LocalMapping& to_local) const override {
+    Box3d box;  // a tile's vertices are all its triangles'
+    for (const Vec3d& p : leaves_.load(index_.at(key)).positions) box.extend(Vec3d(to_local(p)));
+    return box;
+  }
 
  private:
   const OutputLeaves& leaves_;

@@ -10,11 +10,13 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <tuple>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
+#include "citymesh/core/stopwatch.h"
 #include "gap_fill.h"
 #include "part_cut.h"
 
@@ -186,27 +188,40 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
 }
 
 /// The length of the edges of `own`'s triangles used by exactly one triangle of `own` and
-/// `around` (every triangle sharing an edge with `own` is in one of them).
+/// `around` (every triangle sharing an edge with `own` is in one of them): every edge that
+/// can be one of own's, sorted once, and the runs of one own edge counted.
 double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<const KeyedPiece>> around) {
-  const auto edge = [](std::uint64_t a, std::uint64_t b) { return a < b ? std::pair{a, b} : std::pair{b, a}; };
-  std::map<std::pair<std::uint64_t, std::uint64_t>, std::uint32_t> uses;
-  for (const Triangle& tri : own.triangles) {
-    for (int k = 0; k < 3; ++k) ++uses[edge(own.keys[tri[k]], own.keys[tri[(k + 1) % 3]])];
-  }
+  struct Use {
+    std::uint64_t a, b;      ///< the edge's keys, smaller first
+    std::uint32_t own_edge;  ///< 3 t + k for own's triangle t, edge k; kNotOwn for the others'
+    bool operator<(const Use& o) const { return std::tie(a, b) < std::tie(o.a, o.b); }
+  };
+  constexpr std::uint32_t kNotOwn = UINT32_MAX;
+  std::vector<Use> uses;
+  const auto add = [&](const KeyedPiece& p, const Triangle& tri, std::uint32_t first_edge) {
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const std::uint64_t x = p.keys[tri[k]], y = p.keys[tri[(k + 1) % 3]];
+      uses.push_back({std::min(x, y), std::max(x, y), first_edge == kNotOwn ? kNotOwn : first_edge + k});
+    }
+  };
+  for (std::uint32_t t = 0; t < own.triangle_count(); ++t) add(own, own.triangles[t], 3 * t);
+  const Box3d own_box = own.box();
   for (const auto& piece : around) {
-    for (const Triangle& tri : piece->triangles) {
-      for (int k = 0; k < 3; ++k) {
-        const auto it = uses.find(edge(piece->keys[tri[k]], piece->keys[tri[(k + 1) % 3]]));
-        if (it != uses.end()) ++it->second;
-      }
+    for (std::size_t t = 0; t < piece->triangle_count(); ++t) {
+      if (piece->box(t).intersects(own_box)) add(*piece, piece->triangles[t], kNotOwn);  // else it shares no edge
     }
   }
+  std::sort(uses.begin(), uses.end());
   double length = 0;
-  for (const Triangle& tri : own.triangles) {
-    for (int k = 0; k < 3; ++k) {
-      const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
-      if (uses.at(edge(own.keys[a], own.keys[b])) == 1) length += norm(own.positions[a] - own.positions[b]);
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t end = i + 1;
+    while (end < uses.size() && uses[end].a == uses[i].a && uses[end].b == uses[i].b) ++end;
+    if (end == i + 1 && uses[i].own_edge != kNotOwn) {
+      const Triangle& tri = own.triangles[uses[i].own_edge / 3];
+      const std::uint32_t k = uses[i].own_edge % 3;
+      length += norm(own.positions[tri[k]] - own.positions[tri[(k + 1) % 3]]);
     }
+    i = end;
   }
   return length;
 }
@@ -268,10 +283,11 @@ BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, c
     throw ProcessingError("stitching block by block: the parts are not in key order");
   }
   BlockStitchStats stats;
+  const Stopwatch clock;
   for (int level = 0; level < kLevels; ++level) {
     stitch_level(parts, level, store, run, context, stats);
-    log::debug("stitch by blocks: level {} ({} parts), {}", level, stats.parts[static_cast<std::size_t>(level)],
-               memory_note());
+    log::debug("stitch by blocks: level {} ({} parts) at {:.2f} s, {}", level,
+               stats.parts[static_cast<std::size_t>(level)], clock.seconds(), memory_note());
   }
   return stats;
 }

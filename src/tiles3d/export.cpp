@@ -264,7 +264,7 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
   // pass over them first, a leaf at a time.
   std::vector<Box3d> boxes(keys.size());
   parallel_for_blocks(keys.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) boxes[k] = positions_box(leaves.leaf(keys[k], to_local).positions);
+    for (std::size_t k = begin; k < end; ++k) boxes[k] = leaves.local_box(keys[k], to_local);
   });
   Box3d box;
   for (const Box3d& b : boxes) box.extend(b);
@@ -274,6 +274,10 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       });
   stats.seconds = clock.seconds();
   return stats;
+}
+
+Box3d TilesetLeaves::local_box(const TileKey& key, const LocalMapping& to_local) const {
+  return positions_box(leaf(key, to_local).positions);
 }
 
 TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {

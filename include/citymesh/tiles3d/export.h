@@ -69,6 +69,9 @@ class TilesetLeaves {
   /// Leaf `key`'s mesh (the triangles whose centroid the tile holds), positions mapped by
   /// `to_local`, each vertex keyed as the same vertex in every leaf (see tile_mesh).
   [[nodiscard]] virtual TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const = 0;
+  /// The box of leaf `key`'s vertices mapped by `to_local` (the export's first pass): by
+  /// default that of leaf()'s positions.
+  [[nodiscard]] virtual Box3d local_box(const TileKey& key, const LocalMapping& to_local) const;
 };
 
 /// Writes the tileset of `leaves` as export_tileset writes a mesh's, reading each leaf twice
