@@ -45,10 +45,26 @@ StitchParams stitch_params(const Config& config) {
 
 }  // namespace
 
+namespace {
+
+/// Whether the tiles are wide enough for the bands of the seam pass by blocks.
+bool tiles_fit_blocks(const Config& config) { return 4 * block_context(stitch_params(config)) < config.tiling.tile_size; }
+
+}  // namespace
+
+bool seam_pass_in_blocks(const Config& config) {
+  if (config.mosaic.method != MosaicMethod::energy) return false;  // the baseline is not stitched
+  switch (config.run.seam_pass) {
+    case SeamPass::blocks: return true;
+    case SeamPass::whole: return false;
+    default: return tiles_fit_blocks(config);
+  }
+}
+
 void check_seam_pass(const Config& config) {
   if (config.run.seam_pass != SeamPass::blocks || config.mosaic.method != MosaicMethod::energy) return;
+  if (tiles_fit_blocks(config)) return;
   const double band = block_context(stitch_params(config));
-  if (4 * band < config.tiling.tile_size) return;
   throw ConfigError(fmt::format("{}: [run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m (the "
                                 "stitching's reach): tiling.tile_size must be over {:.2f} m, or use seam_pass = \"whole\"",
                                 config.file.string(), config.tiling.tile_size, band, 4 * band));

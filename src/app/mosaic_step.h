@@ -18,6 +18,10 @@ namespace citymesh::app {
 void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
                      const PictureOptions& pictures, nlohmann::json seconds);
 
+/// Whether a tiled run's seam pass runs block by block (`[run] seam_pass`: "blocks", or "auto"
+/// with tiles wide enough for its bands; the energy mosaic only).
+bool seam_pass_in_blocks(const Config& config);
+
 /// Throws ConfigError when `[run] seam_pass = "blocks"` and the tiles are too small for its bands.
 /// A tiled run checks it first, before hours of tiles, not only when the seam pass starts.
 void check_seam_pass(const Config& config);

@@ -114,8 +114,12 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // Block by block, the selected triangles go to files under their parts as the results are
   // read: the seam pass then holds only the parts around the one it stitches.
   std::optional<SeamPartFiles> seams;
-  if (config.run.seam_pass == SeamPass::blocks && config.mosaic.method == MosaicMethod::energy) {
+  if (seam_pass_in_blocks(config)) {
     seams.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
+  } else if (config.run.seam_pass == SeamPass::automatic && config.mosaic.method == MosaicMethod::energy) {
+    log::info("tiles of {} m are too narrow for the seam pass by blocks (over {:.2f} m): the whole output is "
+              "stitched at once, in memory",
+              config.tiling.tile_size, 4 * tile_grid_blocks(config).band);
   }
   std::vector<nlohmann::json> per_tile;
   // Results are read (and checked) a few at a time in parallel, then added in tile order; a

@@ -14,7 +14,13 @@
 
 namespace citymesh {
 
-std::string_view seam_pass_name(SeamPass p) { return p == SeamPass::blocks ? "blocks" : "whole"; }
+std::string_view seam_pass_name(SeamPass p) {
+  switch (p) {
+    case SeamPass::whole: return "whole";
+    case SeamPass::blocks: return "blocks";
+    default: return "auto";
+  }
+}
 
 using namespace config_detail;
 

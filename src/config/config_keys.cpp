@@ -285,9 +285,11 @@ std::vector<KeyDef> make_keys() {
       },
       [](const Config& c) { return toml_string(format_byte_size(c.run.memory)); }});
   keys.push_back(enum_key(run, "seam_pass",
-      "how a tiled run's final pass stitches the output: whole (at once) or blocks (block by block on the tile "
-      "grid, in parallel; see docs/mosaic.md)",
-      [](auto& c) -> auto& { return c.run.seam_pass; }, {SeamPass::whole, SeamPass::blocks}, seam_pass_name));
+      "how a tiled run's final pass stitches the output: blocks (block by block on the tile grid from files, in "
+      "parallel: memory for a few parts, not the output), whole (at once, in memory), or auto (blocks when the tiles "
+      "are over four times the stitching's reach wide, else whole; see docs/mosaic.md)",
+      [](auto& c) -> auto& { return c.run.seam_pass; }, {SeamPass::automatic, SeamPass::whole, SeamPass::blocks},
+      seam_pass_name));
 
   keys.push_back(bool_key(output, "tiles_3d", "write a 3D Tiles tileset with Draco-compressed glb tiles",
       [](auto& c) -> auto& { return c.output.tiles_3d; }));

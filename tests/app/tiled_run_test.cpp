@@ -141,12 +141,19 @@ TEST(TiledRun, SeamPassByBlocksScoresLikeWholeOnAnyThreadCount) {
   EXPECT_EQ(check.exit_code, 1);
   EXPECT_NE(check.err.find("tiling.tile_size must be over 15.00 m"), std::string::npos) << check.err;
 
+  // "auto" (the default) stitches such tiles whole instead, and says so.
+  const auto fallback = test::run_citymesh(run_args(sim, "a", "--set tiling.tile_size=8"));
+  ASSERT_EQ(fallback.exit_code, 0) << fallback.err;
+  EXPECT_NE(fallback.err.find("too narrow for the seam pass by blocks"), std::string::npos) << fallback.err;
+  EXPECT_TRUE(read_json(dir / "sim/a/mosaic/summary.json")["stitch"]["by_blocks"].is_null());
+
   const std::string tiles = "--set tiling.tile_size=16";
-  for (const auto& [name, extra] : {std::pair{"whole", " --threads 2"}, std::pair{"b1", " --set run.seam_pass=blocks --threads 1"},
-                                    std::pair{"b2", " --set run.seam_pass=blocks --threads 2"}}) {
+  for (const auto& [name, extra] : {std::pair{"whole", " --set run.seam_pass=whole --threads 2"},
+                                    std::pair{"b1", " --threads 1"}, std::pair{"b2", " --set run.seam_pass=blocks --threads 2"}}) {
     const auto run = test::run_citymesh(run_args(sim, name, tiles + extra));
     ASSERT_EQ(run.exit_code, 0) << run.err;
   }
+  // b1 by "auto", b2 by "blocks": the same pass, the same bytes on 1 and 2 threads.
   EXPECT_TRUE(test::result_bytes(dir / "sim/b1") == test::result_bytes(dir / "sim/b2")) << "1 and 2 threads differ";
   const nlohmann::json parts = read_json(dir / "sim/b1/mosaic/summary.json")["stitch"]["by_blocks"]["parts"];
   EXPECT_GE(parts[0].get<int>(), 4);  // tile interiors

@@ -48,17 +48,21 @@ struct TilingParams {
 
 /// How a tiled run's final pass stitches the output.
 enum class SeamPass {
-  whole,   ///< the whole output at once
-  blocks,  ///< block by block on the tile grid, the parts of each level in parallel (stitch_in_blocks)
+  /// blocks where the tiles are large enough for its bands, else whole
+  automatic,
+  whole,   ///< the whole output at once, in memory
+  /// block by block on the tile grid from files, the parts of each level in parallel: memory
+  /// for a few parts, not the output
+  blocks,
 };
 
-/// "whole" or "blocks".
+/// "auto", "whole" or "blocks".
 std::string_view seam_pass_name(SeamPass p);
 
 struct RunParams {
   unsigned threads = 0;  ///< 0: all cores
   std::uint64_t memory = 2ull << 30;
-  SeamPass seam_pass = SeamPass::whole;
+  SeamPass seam_pass = SeamPass::automatic;
 };
 
 struct OutputParams {
