@@ -34,43 +34,51 @@ std::optional<std::uint32_t> find_key(const KeyedPiece& piece, std::uint64_t key
   return static_cast<std::uint32_t>(it - piece.keys.begin());
 }
 
-/// Which tile writes each vertex: the first, in key order, holding it. Per tile and vertex,
-/// whether it does, and per tile the number of the first vertex it writes.
+/// Which tile writes each vertex: the first, in key order, holding it. Per tile, whether it
+/// writes each of its vertices is kept beside it (a byte per vertex, read back when its rows
+/// are written); in memory only the number of the first vertex each tile writes.
 struct VertexNumbering {
-  std::vector<std::vector<std::uint8_t>> owned;
-  std::vector<std::vector<std::uint32_t>> rank;  ///< per tile and vertex: owned vertices before it
+  static constexpr std::string_view kOwned = "owned";
   std::vector<std::uint64_t> first;
   std::uint64_t vertices = 0;
 
   explicit VertexNumbering(const OutputLeaves& leaves) {
     const std::vector<OutputLeaf>& all = leaves.leaves();
-    owned.resize(all.size());
-    rank.resize(all.size());
+    std::vector<std::uint64_t> count(all.size(), 0);
     parallel_for_blocks(all.size(), 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t l = begin; l < end; ++l) {
         const KeyedPiece piece = leaves.load(l);
-        std::vector<std::uint8_t>& mine = owned[l];
-        mine.assign(piece.vertex_count(), 1);
+        std::string mine(piece.vertex_count(), '\1');
         for (const std::size_t m : earlier_neighbours(all, l)) {
           const KeyedPiece other = leaves.load(m);
           for (std::size_t v = 0; v < mine.size(); ++v) {
             if (mine[v] != 0 && find_key(other, piece.keys[v])) mine[v] = 0;
           }
         }
-        rank[l].resize(mine.size());
-        std::uint32_t before = 0;
-        for (std::size_t v = 0; v < mine.size(); ++v) {
-          rank[l][v] = before;
-          before += mine[v];
-        }
+        count[l] = static_cast<std::uint64_t>(std::count(mine.begin(), mine.end(), '\1'));
+        leaves.keep(l, kOwned, mine);
       }
     });
     for (std::size_t l = 0; l < all.size(); ++l) {
       first.push_back(vertices);
-      vertices += std::count(owned[l].begin(), owned[l].end(), std::uint8_t{1});
+      vertices += count[l];
     }
   }
+
+  /// Per vertex of tile `leaf`: 1 when the tile writes it.
+  static std::string owned(const OutputLeaves& leaves, std::size_t leaf) { return leaves.kept(leaf, kOwned); }
 };
+
+/// Per vertex: the vertices written before it by its tile (among those `owned` flags).
+std::vector<std::uint32_t> ranks(std::string_view owned) {
+  std::vector<std::uint32_t> out(owned.size());
+  std::uint32_t before = 0;
+  for (std::size_t v = 0; v < owned.size(); ++v) {
+    out[v] = before;
+    before += owned[v] != 0 ? 1u : 0u;
+  }
+  return out;
+}
 
 MeshVertexAttributes attributes_of(const KeyedPiece& p) {
   return {.sensors = !p.sensors.empty(), .times = !p.times.empty(), .intensities = !p.intensities.empty(),
@@ -78,7 +86,7 @@ MeshVertexAttributes attributes_of(const KeyedPiece& p) {
 }
 
 /// The rows of the vertices tile `leaf` writes.
-MeshVertexRows owned_rows(const KeyedPiece& piece, std::span<const std::uint8_t> owned) {
+MeshVertexRows owned_rows(const KeyedPiece& piece, std::string_view owned) {
   MeshVertexRows rows(attributes_of(piece));
   for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
     if (owned[v] == 0) continue;
@@ -97,20 +105,25 @@ struct FaceRows {
 
 FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf) {
   const KeyedPiece piece = leaves.load(leaf);
-  std::vector<KeyedPiece> earlier;
-  std::vector<std::size_t> earlier_index;
+  const std::string owned = VertexNumbering::owned(leaves, leaf);
+  const std::vector<std::uint32_t> rank = ranks(owned);
+  struct Earlier {
+    std::size_t leaf;
+    KeyedPiece piece;
+    std::vector<std::uint32_t> rank;
+  };
+  std::vector<Earlier> earlier;
   for (const std::size_t m : earlier_neighbours(leaves.leaves(), leaf)) {
-    earlier.push_back(leaves.load(m));
-    earlier_index.push_back(m);
+    earlier.push_back({m, leaves.load(m), ranks(VertexNumbering::owned(leaves, m))});
   }
   std::vector<std::uint32_t> number(piece.vertex_count());
   for (std::size_t v = 0; v < number.size(); ++v) {
-    std::uint64_t n = numbers.first[leaf] + numbers.rank[leaf][v];
-    if (numbers.owned[leaf][v] == 0) {
+    std::uint64_t n = numbers.first[leaf] + rank[v];
+    if (owned[v] == 0) {
       // The first earlier tile holding it writes it (every tile holding it meets this one).
-      for (std::size_t e = 0; e < earlier.size(); ++e) {
-        if (const auto at = find_key(earlier[e], piece.keys[v])) {
-          n = numbers.first[earlier_index[e]] + numbers.rank[earlier_index[e]][*at];
+      for (const Earlier& e : earlier) {
+        if (const auto at = find_key(e.piece, piece.keys[v])) {
+          n = numbers.first[e.leaf] + e.rank[*at];
           break;
         }
       }
@@ -149,7 +162,7 @@ void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& lea
                              {std::string(kPlyComment)}};
   PlyStreamWriter out(path, layout, numbers.vertices, faces);
   for (std::size_t l = 0; l < all.size(); ++l) {
-    const MeshVertexRows rows = owned_rows(leaves.load(l), numbers.owned[l]);
+    const MeshVertexRows rows = owned_rows(leaves.load(l), VertexNumbering::owned(leaves, l));
     out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
   }
   for (std::size_t begin = 0; begin < all.size(); begin += kLeavesInFlight) {

@@ -12,7 +12,7 @@ namespace citymesh::app {
 /// Writes the output held by `leaves` as one PLY in the input format with the provenance
 /// columns (source_acq, source_face), as write_mesh_ply writes a merged mesh: each vertex
 /// once, numbered by the first tile (in key order) holding it, then by key; the faces tile by
-/// tile. Holds a few tiles at a time (and a byte per output vertex).
+/// tile. Holds a few tiles at a time.
 void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& leaves);
 
 }  // namespace citymesh::app

@@ -59,7 +59,7 @@ void take(std::string_view& in, std::vector<T>& values, std::size_t count) {
   in.remove_prefix(count * sizeof(T));
 }
 
-void write_scratch_file(const std::filesystem::path& path, const std::string& bytes) {
+void write_scratch_file(const std::filesystem::path& path, std::string_view bytes) {
   // Scratch for this pass only: the folder is this process's and is never reused, so no
   // fsync (hundreds of them would cost seconds); a killed run's folder is removed whole.
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
@@ -327,6 +327,17 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
       write_scratch_file(files_[l], encode_keyed_piece(merge_and_remove(fragments[l])));
     }
   });
+}
+
+void OutputLeaves::keep(std::size_t leaf, std::string_view name, std::string_view bytes) const {
+  write_scratch_file(dir_ / fmt::format("{}.{}", leaves_.at(leaf).key.name(), name), bytes);
+}
+
+std::string OutputLeaves::kept(std::size_t leaf, std::string_view name) const {
+  const std::filesystem::path path = dir_ / fmt::format("{}.{}", leaves_.at(leaf).key.name(), name);
+  std::optional<std::string> bytes = read_file_bytes(path);
+  if (!bytes) throw ProcessingError(fmt::format("{}: a note of the output's tiles vanished", path.string()));
+  return std::move(*bytes);
 }
 
 Box3d OutputLeaves::box() const {

@@ -99,6 +99,11 @@ class OutputLeaves {
   [[nodiscard]] std::uint64_t stitched() const { return stitched_; }
   /// The box of every triangle's corners, in the project CRS.
   [[nodiscard]] Box3d box() const;
+  /// Keeps `bytes` beside tile `leaf` under `name` (an output's notes on the tile, scratch
+  /// like the tiles); safe from several threads for different tiles.
+  void keep(std::size_t leaf, std::string_view name, std::string_view bytes) const;
+  /// What keep() kept; throws ProcessingError when it is gone.
+  [[nodiscard]] std::string kept(std::size_t leaf, std::string_view name) const;
 
  private:
   std::filesystem::path dir_;
