@@ -79,4 +79,64 @@ std::uint64_t PairSpill::write_sorted(const std::filesystem::path& path, std::st
   return count;
 }
 
+namespace {
+
+/// A label on disk: index (4 bytes), flags (1), first and last (2 each), little-endian.
+constexpr std::size_t kLabelBytes = 9;
+
+}  // namespace
+
+std::filesystem::path LabelSpill::file(std::uint32_t acquisition) const {
+  return dir_ / fmt::format("{}.labels", acquisition);
+}
+
+void LabelSpill::add(std::uint32_t acquisition, std::span<const Label> labels) {
+  std::vector<unsigned char> bytes(labels.size() * kLabelBytes);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    unsigned char* at = bytes.data() + i * kLabelBytes;
+    std::memcpy(at, &labels[i].index, 4);
+    at[4] = labels[i].flags;
+    std::memcpy(at + 5, &labels[i].first, 2);
+    std::memcpy(at + 7, &labels[i].last, 2);
+  }
+  const std::filesystem::path spilled = file(acquisition);
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(spilled.c_str(), "ab"), &std::fclose);
+  if (!f || std::fwrite(bytes.data(), 1, bytes.size(), f.get()) != bytes.size() || std::fflush(f.get()) != 0) {
+    throw OutputError(fmt::format("{}: cannot append labels: {}", spilled.string(), std::strerror(errno)));
+  }
+}
+
+std::vector<LabelSpill::Label> LabelSpill::read(std::uint32_t acquisition, std::uint64_t count) const {
+  const std::filesystem::path spilled = file(acquisition);
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::exists(spilled, ec) ? std::filesystem::file_size(spilled, ec) : 0;
+  if (ec || size != count * kLabelBytes) {
+    throw ProcessingError(fmt::format("tile assembly: {} labels of acquisition {} from the tiles, its file has {} "
+                                      "triangles (a tile is missing or labelled twice)",
+                                      size / kLabelBytes, acquisition, count));
+  }
+  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(spilled.c_str(), "rb"), &std::fclose);
+  if (!f || std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) {
+    throw InputError(fmt::format("{}: cannot read the spilled labels back whole", spilled.string()));
+  }
+  std::vector<Label> out(static_cast<std::size_t>(count));
+  std::vector<std::uint8_t> seen(out.size(), 0);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const unsigned char* at = bytes.data() + i * kLabelBytes;
+    Label l;
+    std::memcpy(&l.index, at, 4);
+    l.flags = at[4];
+    std::memcpy(&l.first, at + 5, 2);
+    std::memcpy(&l.last, at + 7, 2);
+    if (l.index >= out.size() || seen[l.index] != 0) {
+      throw ProcessingError(fmt::format("tile assembly: triangle {} of acquisition {} labelled {} (its file has {})",
+                                        l.index, acquisition, l.index >= out.size() ? "but not in it" : "twice", count));
+    }
+    seen[l.index] = 1;
+    out[l.index] = l;
+  }
+  return out;
+}
+
 }  // namespace citymesh::app

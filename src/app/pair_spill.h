@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <vector>
 #include <string_view>
 
@@ -46,6 +47,30 @@ class PairSpill {
   std::filesystem::path dir_;
   std::uint32_t range_;
   std::uint32_t ranges_ = 0;  ///< 1 + the largest range index written
+};
+
+/// Every input triangle's labels, packed as the assembly keeps them, on disk until each
+/// acquisition's labelled PLY is written: one file per acquisition in a folder that exists
+/// (the pairs' spill folder), so that memory holds one acquisition's labels at a time.
+class LabelSpill {
+ public:
+  struct Label {
+    std::uint32_t index = 0;  ///< the triangle, in its acquisition
+    std::uint8_t flags = 0;   ///< state and bits, as TileAssembly packs them
+    std::uint16_t first = 0, last = 0;  ///< first and last seen, as indices of the dates met
+  };
+
+  explicit LabelSpill(std::filesystem::path dir) : dir_(std::move(dir)) {}
+
+  /// Appends labels of `acquisition`. Throws OutputError naming the file.
+  void add(std::uint32_t acquisition, std::span<const Label> labels);
+  /// Acquisition `acquisition`'s labels by triangle index. Throws ProcessingError naming the
+  /// acquisition unless each of its `count` triangles was labelled exactly once.
+  [[nodiscard]] std::vector<Label> read(std::uint32_t acquisition, std::uint64_t count) const;
+
+ private:
+  [[nodiscard]] std::filesystem::path file(std::uint32_t acquisition) const;
+  std::filesystem::path dir_;
 };
 
 }  // namespace citymesh::app

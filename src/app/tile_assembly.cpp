@@ -24,12 +24,8 @@ TileAssembly::TileAssembly(const TileStore& store, std::optional<std::filesystem
     throw ProcessingError(fmt::format("{} triangles in all: global ids are 32-bit", index_.size()));
   }
   if (!pairs_dir) return;
-  labels_ = true;
-  const std::size_t n = index_.size();
-  flags_.assign(n, static_cast<std::uint8_t>(TriangleState::single));
-  first_.assign(n, 0);
-  last_.assign(n, 0);
   pairs_.emplace(*pairs_dir);
+  labels_.emplace(*pairs_dir);
 }
 
 std::uint16_t TileAssembly::date_index(std::int64_t ms) {
@@ -50,19 +46,30 @@ void TileAssembly::add(TileResult result) {
     return static_cast<std::uint32_t>(index_.offsets[a] + t);
   };
   change_.add(result.change);
-  for (const OwnedLabel& l : result.labels) {
-    const std::uint32_t g = global(l.acquisition, l.index);
+  // The labels wait on disk, per acquisition (a city's are several times the final pass's
+  // memory): the tile hands them over grouped by acquisition.
+  std::vector<LabelSpill::Label> spilled;
+  const auto spill = [&](std::uint32_t acquisition) {
+    if (!spilled.empty()) labels_->add(acquisition, spilled);
+    spilled.clear();
+  };
+  for (std::size_t i = 0; i < result.labels.size(); ++i) {
+    const OwnedLabel& l = result.labels[i];
+    (void)global(l.acquisition, l.index);  // checked against the store
     ++owned_;
     candidates_ += l.kept;
     seen_through_ += (l.notes & kNoteSeenThrough) != 0 ? 1 : 0;
     filled_ += (l.notes & kNoteFilled) != 0 ? 1 : 0;
     fill_left_out_ += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
     if (!labels_) continue;
-    flags_[g] = static_cast<std::uint8_t>(static_cast<std::uint8_t>(l.state) | (l.kept != 0 ? kKeptBit : 0) |
-                                          (l.sustainable != 0 ? kSustainableBit : 0) | (l.refutes != 0 ? kRefutesBit : 0));
-    first_[g] = date_index(l.first_ms);
-    last_[g] = date_index(l.last_ms);
+    if (i > 0 && result.labels[i - 1].acquisition != l.acquisition) spill(result.labels[i - 1].acquisition);
+    spilled.push_back({l.index,
+                       static_cast<std::uint8_t>(static_cast<std::uint8_t>(l.state) | (l.kept != 0 ? kKeptBit : 0) |
+                                                 (l.sustainable != 0 ? kSustainableBit : 0) |
+                                                 (l.refutes != 0 ? kRefutesBit : 0)),
+                       date_index(l.first_ms), date_index(l.last_ms)});
   }
+  if (labels_ && !result.labels.empty()) spill(result.labels.back().acquisition);
   if (labels_) {
     std::vector<TrianglePair> pairs;
     pairs.reserve(result.pairs.size());
@@ -162,6 +169,7 @@ void TileAssembly::check_labelled() const {
 ChangeResult TileAssembly::labels(std::size_t k) const {
   check_labelled();
   const std::size_t begin = index_.offsets[k], n = index_.offsets[k + 1] - begin;
+  const std::vector<LabelSpill::Label> read = labels_->read(static_cast<std::uint32_t>(k), n);
   ChangeResult c;
   c.index.offsets = {0, n};
   c.state.resize(n);
@@ -171,14 +179,14 @@ ChangeResult TileAssembly::labels(std::size_t k) const {
   c.kept.resize(n);
   c.refutes.resize(n);
   for (std::size_t t = 0; t < n; ++t) {
-    const std::uint8_t f = flags_[begin + t];
+    const std::uint8_t f = read[t].flags;
     c.state[t] = static_cast<TriangleState>(f & kStateMask);
     c.kept[t] = (f & kKeptBit) != 0 ? 1 : 0;
     c.sustainable[t] = (f & kSustainableBit) != 0 ? 1 : 0;
     c.refutes[t] = (f & kRefutesBit) != 0 ? 1 : 0;
     // check_labelled(): every triangle was labelled, so dates_ms_ holds its dates.
-    c.first_seen[t] = TimePoint(Duration(dates_ms_[first_[begin + t]]));
-    c.last_seen[t] = TimePoint(Duration(dates_ms_[last_[begin + t]]));
+    c.first_seen[t] = TimePoint(Duration(dates_ms_[read[t].first]));
+    c.last_seen[t] = TimePoint(Duration(dates_ms_[read[t].last]));
   }
   c.stats.triangles = n;
   return c;

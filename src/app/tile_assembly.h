@@ -17,8 +17,9 @@ namespace citymesh::app {
 
 class TileAssembly {
  public:
-  /// With a `pairs_dir`, also gathers every input triangle's labels (5 bytes each) and the
-  /// consistent pairs (spilled to files in that folder, which is removed with the assembly).
+  /// With a `pairs_dir`, also gathers every input triangle's labels and the consistent pairs,
+  /// both spilled to files in that folder (removed with the assembly): memory holds one
+  /// acquisition's labels at a time, when labels() expands them.
   TileAssembly(const TileStore& store, std::optional<std::filesystem::path> pairs_dir);
 
   /// Takes one tile's result (any order: the output does not depend on it).
@@ -57,13 +58,12 @@ class TileAssembly {
   const TileStore& store_;
   GlobalTriangles index_;
   std::vector<TilePiece> pieces_;
-  // Labels, per global triangle: state | kept << 2 | sustainable << 3 | refutes << 4, and
-  // first_seen and last_seen as indices into dates_ms_ (a city's labels in 140 MB, not 560).
-  bool labels_ = false;
-  std::vector<std::uint8_t> flags_;
-  std::vector<std::uint16_t> first_, last_;
+  // Labels, per input triangle: state | kept << 2 | sustainable << 3 | refutes << 4, and
+  // first_seen and last_seen as indices into dates_ms_; on disk by acquisition (in the pairs'
+  // folder, which pairs_ makes and removes: declared first, it outlives labels_).
   std::vector<std::int64_t> dates_ms_;
   std::optional<PairSpill> pairs_;
+  std::optional<LabelSpill> labels_;
   std::uint64_t owned_ = 0, candidates_ = 0, seen_through_ = 0, filled_ = 0, fill_left_out_ = 0;
   ChangeStats change_;
 };

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <span>
 #include <random>
 #include <set>
 
@@ -127,6 +128,35 @@ TEST(TileAssembly, RefusesLabelsWhenATileIsMissing) {
   EXPECT_THROW((void)assembly.labels(0), ProcessingError);
   TileAssembly without(store, std::nullopt);
   EXPECT_THROW((void)without.labels(0), ProcessingError);
+}
+
+TEST(LabelSpill, LabelsAddedInPiecesComeBackByIndexAndGapsOrRepeatsAreRefused) {
+  test::TempDir tmp;
+  std::filesystem::create_directories(tmp / "spill");
+  LabelSpill spill(tmp / "spill");
+  std::vector<LabelSpill::Label> all;
+  for (std::uint32_t t = 0; t < 1000; ++t) {
+    all.push_back({t, static_cast<std::uint8_t>(t % 31), static_cast<std::uint16_t>(t % 7), static_cast<std::uint16_t>(t % 65536)});
+  }
+  std::minstd_rand rng(5);
+  std::vector<LabelSpill::Label> shuffled = all;
+  std::shuffle(shuffled.begin(), shuffled.end(), rng);
+  for (std::size_t first = 0; first < shuffled.size(); first += 97) {
+    spill.add(2, std::span(shuffled).subspan(first, std::min<std::size_t>(97, shuffled.size() - first)));
+  }
+  const std::vector<LabelSpill::Label> back = spill.read(2, 1000);
+  ASSERT_EQ(back.size(), all.size());
+  for (std::size_t t = 0; t < all.size(); ++t) {
+    EXPECT_EQ(back[t].index, all[t].index);
+    EXPECT_EQ(back[t].flags, all[t].flags);
+    EXPECT_EQ(back[t].first, all[t].first);
+    EXPECT_EQ(back[t].last, all[t].last);
+  }
+  EXPECT_THROW((void)spill.read(2, 1001), ProcessingError);  // one triangle never labelled
+  EXPECT_THROW((void)spill.read(3, 10), ProcessingError);    // no file: none labelled
+  spill.add(4, std::span(all).subspan(0, 2));
+  spill.add(4, std::span(all).subspan(1, 1));  // triangle 1 twice, and 2 missing
+  EXPECT_THROW((void)spill.read(4, 3), ProcessingError);
 }
 
 }  // namespace
