@@ -49,12 +49,14 @@ std::uint64_t payload_size(std::uint32_t flags, std::uint64_t n, std::uint64_t t
 
 template <class T>
 void put(std::string& out, const std::vector<T>& values) {
+  if (values.empty()) return;  // an empty vector's data() may be null
   out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
 }
 
 template <class T>
 void take(std::string_view& in, std::vector<T>& values, std::size_t count) {
   values.resize(count);
+  if (count == 0) return;  // no bytes, and data() may be null
   std::memcpy(values.data(), in.data(), count * sizeof(T));
   in.remove_prefix(count * sizeof(T));
 }
