@@ -259,6 +259,18 @@ std::shared_ptr<const KeyedPiece> SeamPartFiles::load(std::size_t part, bool sti
   return std::make_shared<const KeyedPiece>(read_piece(part_file(keys_.at(part), stitched)));
 }
 
+void SeamPartFiles::release_input(std::size_t part) {
+  std::error_code ec;
+  std::filesystem::remove(part_file(keys_.at(part), false), ec);
+}
+
+void SeamPartFiles::release_stitched() {
+  for (const BlockPartKey& key : keys_) {
+    std::error_code ec;
+    std::filesystem::remove(part_file(key, true), ec);
+  }
+}
+
 void SeamPartFiles::save_stitched(std::size_t part, KeyedPiece stitched) {
   write_scratch_file(part_file(keys_.at(part), true), encode_keyed_piece(stitched));
 }

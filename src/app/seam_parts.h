@@ -59,6 +59,10 @@ class SeamPartFiles final : public PartStore {
 
   [[nodiscard]] std::shared_ptr<const KeyedPiece> load(std::size_t part, bool stitched) const override;
   void save_stitched(std::size_t part, KeyedPiece stitched) override;
+  /// Removes the part's input file: the disk holds about two copies of the output at most.
+  void release_input(std::size_t part) override;
+  /// Removes every stitched part's file, once the output is filed by tile (OutputLeaves).
+  void release_stitched();
 
  private:
   [[nodiscard]] std::filesystem::path part_file(const BlockPartKey& key, bool stitched) const;

@@ -165,6 +165,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     // The outputs read the stitched output one grid tile at a time.
     leaves.emplace(seam_parts_folder(config.project.work) / "tiles",
                    TileGrid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin}), parts, *seams);
+    seams->release_stitched();
   } else if (config.mosaic.method == MosaicMethod::energy) {
     stitched = stitch_and_report(config, merged);
   }

@@ -286,6 +286,10 @@ BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, c
   const Stopwatch clock;
   for (int level = 0; level < kLevels; ++level) {
     stitch_level(parts, level, store, run, context, stats);
+    // Later levels see this level's parts stitched only.
+    for (std::size_t p = 0; p < parts.size(); ++p) {
+      if (parts[p].key.level == level) store.release_input(p);
+    }
     log::debug("stitch by blocks: level {} ({} parts) at {:.2f} s, {}", level,
                stats.parts[static_cast<std::size_t>(level)], clock.seconds(), memory_note());
   }

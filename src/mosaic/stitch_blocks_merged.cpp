@@ -24,6 +24,7 @@ class MemoryPartStore final : public PartStore {
   void save_stitched(std::size_t part, KeyedPiece stitched) override {
     stitched_[part] = std::make_shared<const KeyedPiece>(std::move(stitched));
   }
+  void release_input(std::size_t part) override { initial_[part].reset(); }
   /// The stitched parts, handed over.
   std::vector<std::shared_ptr<const KeyedPiece>> take_stitched() {
     initial_.clear();

@@ -92,6 +92,9 @@ class PartStore {
   /// Keeps the stitched triangles of part `part`: once per part, from several threads at once
   /// (never for the same part).
   virtual void save_stitched(std::size_t part, KeyedPiece stitched) = 0;
+  /// Part `part` as it was before stitching is not read again (its level is done): the store
+  /// may let it go.
+  virtual void release_input(std::size_t /*part*/) {}
 };
 
 /// A part of a run: its key and the box of its triangles before and after stitching.
