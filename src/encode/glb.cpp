@@ -214,8 +214,13 @@ std::vector<std::uint8_t> assemble_glb(const nlohmann::json& json, std::span<con
 
 }  // namespace
 
-std::vector<std::uint8_t> write_glb(const DracoMeshView& mesh, const GlbParams& params) {
-  check_mesh(mesh);
+std::vector<std::uint8_t> write_glb(const DracoMeshView& given, const GlbParams& params) {
+  check_mesh(given);
+  // A tile of stitch triangles only has no feature: no feature ids then (ids without the
+  // acquisition table that EXT_mesh_features needs, at least one feature, would be a mesh
+  // feature attribute no viewer can read).
+  DracoMeshView mesh = given;
+  if (distinct_features(mesh.feature_ids) == 0) mesh.feature_ids = {};
   BinBuilder bin;
   nlohmann::json accessors = nlohmann::json::array();
   nlohmann::json primitive = mesh_primitive(mesh, params, bin, accessors);

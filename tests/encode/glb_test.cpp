@@ -98,6 +98,24 @@ void expect_round_trip(bool draco) {
 TEST(Glb, DracoRoundTripKeepsTrianglesPositionsAndAttributes) { expect_round_trip(true); }
 TEST(Glb, PlainRoundTripIsExact) { expect_round_trip(false); }
 
+TEST(Glb, ATileOfStitchTrianglesOnlyHasNoFeatureIds) {
+  // Every vertex of no acquisition (a tile at the edge of a city holding a few triangles that
+  // stitching made): no feature id attribute and no metadata, rather than ids with no table.
+  Tile t = tile(4);
+  std::fill(t.features.begin(), t.features.end(), kNullFeatureId);
+  for (const bool draco : {false, true}) {
+    const std::vector<std::uint8_t> bytes =
+        write_glb({t.positions, t.triangles, t.features, t.intensities, t.colors}, params(draco));
+    const GlbFile glb = parse_glb(bytes, "stitch.glb");
+    const DecodedMesh m = read_glb_mesh(glb, "stitch.glb");
+    EXPECT_TRUE(m.feature_ids.empty());
+    EXPECT_EQ(m.triangles.size(), t.triangles.size());
+    EXPECT_EQ(m.intensities.size(), m.positions.size());
+    EXPECT_FALSE(glb.json.contains("extensions"));
+    EXPECT_FALSE(glb.json["meshes"][0]["primitives"][0]["attributes"].contains("_FEATURE_ID_0"));
+  }
+}
+
 TEST(Glb, ChunksAreFourByteAlignedAndLengthsAgree) {
   const Tile t = tile(4);
   const auto bytes = write_glb({t.positions, t.triangles, t.features, {}, {}}, params(true));
