@@ -112,7 +112,19 @@ void build_parent(std::span<const TileNode> nodes, TileNode& parent, const TileT
     parent.box.extend(nodes[c].box);
   }
   const TileMesh whole = merge(children);
-  const SimplifiedMesh simplified = simplify_mesh(whole.positions, whole.triangles, params.simplify);
+  SimplifiedMesh simplified = simplify_mesh(whole.positions, whole.triangles, params.simplify);
+  // Past the cap: borders free, then vertices clustered whatever the error (non-manifold
+  // pieces and errors beyond the bound stop edge collapses; the cap is what bounds a tile's
+  // memory, and the tile's geometric error tells viewers what it cost), each aiming at the cap.
+  SimplifyParams looser = params.simplify;
+  looser.target_ratio = static_cast<double>(params.max_parent_triangles) / static_cast<double>(whole.triangles.size());
+  looser.lock_border = false;
+  for (const bool sloppy : {false, true}) {
+    if (simplified.triangles.size() <= params.max_parent_triangles) break;
+    looser.sloppy = sloppy;
+    if (sloppy) looser.max_error_fraction = 1.0;
+    simplified = simplify_mesh(whole.positions, whole.triangles, looser);
+  }
   parent.mesh = subset(whole, simplified.triangles);
   parent.triangle_count = parent.mesh.triangles.size();
   parent.geometric_error = std::max(child_error + simplified.error, params.min_geometric_error);

@@ -3,6 +3,7 @@
 // parent that merely repeats its only child.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -28,6 +29,27 @@ struct Input {
       for (int j = 0; j <= n; ++j) add_vertex({x0 + float(i), float(j), 0});
     }
     for (const Triangle& t : test::grid_triangles(n)) add({t[0] + base, t[1] + base, t[2] + base}, key);
+  }
+
+  /// A wavy n x n grid of 1 m cells at x0: every edge collapse moves the surface.
+  void add_wavy_grid(TileKey key, float x0, int n) {
+    const auto base = static_cast<std::uint32_t>(vertices.positions.size());
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; j <= n; ++j) add_vertex({x0 + float(i), float(j), 0.4f * std::sin(1.3f * float(i)) * std::cos(0.9f * float(j))});
+    }
+    for (const Triangle& t : test::grid_triangles(n)) add({t[0] + base, t[1] + base, t[2] + base}, key);
+  }
+
+  /// An n x n grid of 1 m cells at x0 keeping every other row of cells: strips one cell wide,
+  /// every vertex on a border, which locked borders keep in place.
+  void add_strips(TileKey key, float x0, int n) {
+    const auto base = static_cast<std::uint32_t>(vertices.positions.size());
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; j <= n; ++j) add_vertex({x0 + float(i), float(j), 0});
+    }
+    for (const Triangle& t : test::grid_triangles(n, [](int i, int) { return i % 2 == 0; })) {
+      add({t[0] + base, t[1] + base, t[2] + base}, key);
+    }
   }
 
   /// `count` separate triangles at x0: every vertex is on a border, which the simplifier
@@ -213,6 +235,54 @@ TEST(TileTree, TheSinkGetsEveryTileOnceChildrenFirstAndItsMeshIsThenReleased) {
     EXPECT_EQ(handed.at(node.name()), expected.at(node.name()).triangles) << node.name();
     EXPECT_EQ(node.triangle_count, expected.at(node.name()).triangles.size()) << node.name();
   }
+}
+
+TEST(TileTree, AParentThatLockedBordersKeepLargeIsCappedWithItsBordersFree) {
+  // Four leaves of strips (256 triangles each): with every vertex on a locked border the root
+  // keeps all 1024; past a cap of 200 it is simplified again with its borders free.
+  Input in;
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) in.add_strips({i, j}, 40.0f * float(2 * i + j), 16);
+  }
+  TileTreeParams uncapped;
+  uncapped.max_parent_triangles = std::numeric_limits<std::size_t>::max();
+  const TileTree locked = build_tile_tree(in.vertices, in.triangles, in.keys, uncapped);
+  expect_well_formed(locked, in);
+  EXPECT_EQ(locked.root().level, 1);
+  EXPECT_EQ(triangles_of(locked, static_cast<std::uint32_t>(locked.nodes.size() - 1)), 1024u);
+
+  TileTreeParams capped;
+  capped.max_parent_triangles = 200;
+  const TileTree tree = build_tile_tree(in.vertices, in.triangles, in.keys, capped);
+  expect_well_formed(tree, in);
+  EXPECT_EQ(tree.root().level, 1);
+  EXPECT_LE(triangles_of(tree, static_cast<std::uint32_t>(tree.nodes.size() - 1)), 200u);
+  EXPECT_GT(triangles_of(tree, static_cast<std::uint32_t>(tree.nodes.size() - 1)), 0u);
+  // Leaves are never capped.
+  for (const TileNode& node : tree.nodes) {
+    if (node.level == 0) {
+      EXPECT_EQ(node.mesh.triangles.size(), 256u);
+    }
+  }
+}
+
+TEST(TileTree, ACappedParentThatEdgeCollapsesCannotTakeIsClusteredDownToTheCap) {
+  // Wavy grids at a tolerance no edge collapse meets, borders locked or not: clustering
+  // (whatever the error, the cap first) brings the parent to the cap.
+  Input in;
+  for (int i = 0; i < 2; ++i) {
+    for (int j = 0; j < 2; ++j) in.add_wavy_grid({i, j}, 30.0f * float(2 * i + j), 20);
+  }
+  TileTreeParams capped;
+  capped.simplify.max_error_fraction = 1e-9;
+  capped.max_parent_triangles = 600;  // of the 3200 the four leaves hold
+  const TileTree tree = build_tile_tree(in.vertices, in.triangles, in.keys, capped);
+  expect_well_formed(tree, in);
+  EXPECT_EQ(tree.root().level, 1);
+  const std::size_t root = triangles_of(tree, static_cast<std::uint32_t>(tree.nodes.size() - 1));
+  EXPECT_LE(root, 600u);
+  EXPECT_GT(root, 0u);
+  EXPECT_GT(tree.root().geometric_error, 0.0);
 }
 
 }  // namespace

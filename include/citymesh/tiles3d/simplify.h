@@ -16,6 +16,9 @@ struct SimplifyParams {
   /// Keep vertices on open borders in place, so that neighbouring simplified tiles (and
   /// their finer neighbours) still meet without cracks.
   bool lock_border = true;
+  /// Cluster vertices instead of collapsing edges (meshopt_simplifySloppy): reaches its target
+  /// on any mesh, fragments and loose triangles included, but keeps no border nor topology.
+  bool sloppy = false;
 };
 
 struct SimplifiedMesh {

@@ -75,6 +75,13 @@ struct TileTreeParams {
   /// order of `TileTree::nodes` depend on it, never the tiles: 1 builds the whole tree depth
   /// first, SIZE_MAX level by level from every leaf at once.
   std::size_t depth_first_cells = 16;
+  /// A parent whose simplification with locked borders keeps more triangles than this is
+  /// simplified again with its borders free, and if that still keeps more (fragments and
+  /// loose triangles), by clustering vertices, each aiming at this many: locked hole rims (MLS
+  /// meshes are full of holes) stall the simplifier, and upper tiles then grew with the
+  /// output (a 112 M-triangle city's root held 1.06 M triangles). Such a tile may leave cracks
+  /// against its neighbours of the same level; only large outputs' upper tiles are concerned.
+  std::size_t max_parent_triangles = 262144;
 };
 
 /// Called once per node as soon as the tree no longer reads its mesh (its parent is built, or
