@@ -94,6 +94,112 @@ void add_tile_result(const Config& config, const TileContents& tile, bool proces
   assembly.add(std::move(*r));
 }
 
+/// The final pass's output: assembled whole in memory (`[run] seam_pass` whole, or auto on
+/// narrow tiles), or filed by block-stitching part and then by grid tile (blocks), so that
+/// nothing holds it whole. Every step of the pass asks it, whichever it is.
+class FinalOutput {
+ public:
+  explicit FinalOutput(const Config& config) : config_(config) {
+    if (seam_pass_in_blocks(config)) {
+      seams_.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
+    } else if (config.run.seam_pass == SeamPass::automatic && config.mosaic.method == MosaicMethod::energy) {
+      log::info("tiles of {} m are too narrow for the seam pass by blocks (over {:.2f} m): the whole output is "
+                "stitched at once, in memory",
+                config.tiling.tile_size, 4 * tile_grid_blocks(config).band);
+    }
+  }
+
+  /// Takes a tile's selected triangles before its result goes to the assembly (by blocks;
+  /// whole, the assembly keeps them).
+  void add_tile(TileKey key, TileResult& result) {
+    if (!seams_) return;
+    seams_->add_tile(key, result.selected);
+    result.selected.clear();
+  }
+
+  /// After the last tile: the assembled mesh, or the parts. Returns the triangles selected.
+  std::uint64_t assemble(TileAssembly& assembly) {
+    std::uint64_t selected = 0;
+    if (seams_) {
+      parts_ = seams_->finish();
+      for (const std::uint64_t n : seams_->source_sizes()) selected += n;
+    } else {
+      merged_ = assembly.take_merged();
+      selected = merged_.mesh.triangle_count();
+    }
+    return selected;
+  }
+
+  /// The seam pass: stitching runs on the assembled mesh (or its parts), so seams between
+  /// tiles are joined like seams inside a tile. Returns the figures for the summary.
+  nlohmann::json stitch() {
+    if (seams_) {
+      nlohmann::json figures = stitch_parts_and_report(config_, parts_, *seams_, seams_->source_sizes());
+      // The outputs read the stitched output one grid tile at a time.
+      leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
+                      TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}), parts_, *seams_);
+      seams_->release_stitched();
+      return figures;
+    }
+    // The baseline, like the paper's, is not stitched.
+    return config_.mosaic.method == MosaicMethod::energy ? stitch_and_report(config_, merged_) : nlohmann::json::object();
+  }
+
+  void write_mosaic(const MosaicStats& stats, const MosaicOutputParams& params) const {
+    if (leaves_) {
+      write_mosaic_outputs(config_, describe_acquisitions(config_), *leaves_, stats, params);
+    } else {
+      write_mosaic_outputs(config_, describe_acquisitions(config_), merged_, stats, params);
+    }
+  }
+
+  /// The 3D Tiles and per-tile PLYs; then the pass's files go.
+  nlohmann::json export_tiles() {
+    const nlohmann::json exported = leaves_ ? write_tileset_outputs(config_, *leaves_) : write_tileset_outputs(config_, merged_);
+    leaves_.reset();
+    seams_.reset();
+    return exported;
+  }
+
+  [[nodiscard]] std::uint64_t triangles() const {
+    if (!leaves_) return merged_.mesh.triangle_count();
+    std::uint64_t n = 0;
+    for (const OutputLeaf& leaf : leaves_->leaves()) n += leaf.triangles;
+    return n;
+  }
+
+ private:
+  const Config& config_;
+  MergedMesh merged_;
+  std::optional<SeamPartFiles> seams_;
+  std::vector<BlockPart> parts_;
+  std::optional<OutputLeaves> leaves_;
+};
+
+/// Reads every tile's result (checked) into the assembly and the final output, a few at a
+/// time in parallel, then added in tile order: a read result is several times the piece the
+/// assembly keeps of it, so not all at once.
+void read_tile_results(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+                       const TileStageReport& tiles, TileAssembly& assembly, FinalOutput& output,
+                       std::vector<nlohmann::json>& per_tile) {
+  constexpr std::size_t kBatch = 4;
+  std::vector<std::optional<TileResult>> batch(kBatch);
+  for (std::size_t first = 0; first < store.tiles.size(); first += kBatch) {
+    const std::size_t count = std::min(kBatch, store.tiles.size() - first);
+    parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store,
+                                    {.pairs = config.output.labels});
+      }
+    });
+    for (std::size_t i = 0; i < count; ++i) {
+      if (batch[i]) output.add_tile(store.tiles[first + i].key, *batch[i]);
+      add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0, std::move(batch[i]), assembly,
+                      per_tile);
+    }
+  }
+}
+
 /// The outputs from every tile's result: assembly, labels, the seam pass, mosaic, 3D Tiles and
 /// run.json. `seconds` holds the stages timed so far.
 void write_run_outputs(const Config& config, const TileStore& store, std::uint64_t fingerprint,
@@ -108,67 +214,18 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
     seconds[stage] = clock.restart();
     log::debug("final pass: {} done, {}", stage, memory_note());
   };
-  // The pairs wait on disk (a city has 0.7 GB of them), in a folder of this process's own.
+  // The pairs and labels wait on disk (a city has 0.7 GB of pairs), in a folder of this
+  // process's own.
   TileAssembly assembly(store, config.output.labels ? std::optional(pair_spill_folder(config.project.work))
                                                     : std::nullopt);
-  // Block by block, the selected triangles go to files under their parts as the results are
-  // read: the seam pass then holds only the parts around the one it stitches.
-  std::optional<SeamPartFiles> seams;
-  if (seam_pass_in_blocks(config)) {
-    seams.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
-  } else if (config.run.seam_pass == SeamPass::automatic && config.mosaic.method == MosaicMethod::energy) {
-    log::info("tiles of {} m are too narrow for the seam pass by blocks (over {:.2f} m): the whole output is "
-              "stitched at once, in memory",
-              config.tiling.tile_size, 4 * tile_grid_blocks(config).band);
-  }
+  FinalOutput output(config);
   std::vector<nlohmann::json> per_tile;
-  // Results are read (and checked) a few at a time in parallel, then added in tile order; a
-  // read result is several times the piece the assembly keeps of it, so not all at once.
-  constexpr std::size_t kBatch = 4;
-  std::vector<std::optional<TileResult>> batch(kBatch);
-  for (std::size_t first = 0; first < store.tiles.size(); first += kBatch) {
-    const std::size_t count = std::min(kBatch, store.tiles.size() - first);
-    parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store,
-                                    {.pairs = config.output.labels});
-      }
-    });
-    for (std::size_t i = 0; i < count; ++i) {
-      if (seams && batch[i]) {
-        seams->add_tile(store.tiles[first + i].key, batch[i]->selected);
-        batch[i]->selected.clear();
-      }
-      add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0, std::move(batch[i]), assembly,
-                      per_tile);
-    }
-  }
-  std::vector<BlockPart> parts;
-  MergedMesh merged;
-  std::uint64_t selected = 0;
-  if (seams) {
-    parts = seams->finish();
-    for (const std::uint64_t n : seams->source_sizes()) selected += n;
-  } else {
-    merged = assembly.take_merged();
-    selected = merged.mesh.triangle_count();
-  }
+  read_tile_results(config, store, fingerprint, tiles, assembly, output, per_tile);
+  const std::uint64_t selected = output.assemble(assembly);
   stage_done("assembly");
   if (config.output.labels) write_labels(config, assembly, pictures);
   stage_done("labels");
-  // The seam pass: stitching runs on the assembled mesh (or its parts), so seams between tiles
-  // are joined like seams inside a tile.
-  nlohmann::json stitched = nlohmann::json::object();
-  std::optional<OutputLeaves> leaves;
-  if (seams) {
-    stitched = stitch_parts_and_report(config, parts, *seams, seams->source_sizes());
-    // The outputs read the stitched output one grid tile at a time.
-    leaves.emplace(seam_parts_folder(config.project.work) / "tiles",
-                   TileGrid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin}), parts, *seams);
-    seams->release_stitched();
-  } else if (config.mosaic.method == MosaicMethod::energy) {
-    stitched = stitch_and_report(config, merged);
-  }
+  const nlohmann::json stitched = output.stitch();
   stage_done("stitch");
   MosaicStats stats;
   stats.candidates = assembly.candidates();
@@ -178,24 +235,15 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // filled triangle is one of the selected owned ones).
   stats.selected = selected - std::min(selected, stats.filled);
   stats.fill_seen_through = assembly.fill_left_out();
-  const MosaicOutputParams mosaic_params{.dir = config.project.output / "mosaic",
-                                         .pixel_size = pictures.pixel_size,
-                                         .pictures = pictures.pictures,
-                                         .seconds = seconds,
-                                         .stitch = stitched,
-                                         .solved_per_tile = true};
-  std::uint64_t output_triangles = merged.mesh.triangle_count();
-  if (leaves) {
-    write_mosaic_outputs(config, describe_acquisitions(config), *leaves, stats, mosaic_params);
-    output_triangles = 0;
-    for (const OutputLeaf& leaf : leaves->leaves()) output_triangles += leaf.triangles;
-  } else {
-    write_mosaic_outputs(config, describe_acquisitions(config), merged, stats, mosaic_params);
-  }
+  output.write_mosaic(stats, {.dir = config.project.output / "mosaic",
+                              .pixel_size = pictures.pixel_size,
+                              .pictures = pictures.pictures,
+                              .seconds = seconds,
+                              .stitch = stitched,
+                              .solved_per_tile = true});
+  const std::uint64_t output_triangles = output.triangles();
   stage_done("outputs");
-  const nlohmann::json exported = leaves ? write_tileset_outputs(config, *leaves) : write_tileset_outputs(config, merged);
-  leaves.reset();
-  seams.reset();
+  const nlohmann::json exported = output.export_tiles();
   stage_done("export");
 
   double wall = total.seconds();
