@@ -69,6 +69,13 @@ void write_scratch_file(const std::filesystem::path& path, std::string_view byte
   if (!out.flush()) throw OutputError(fmt::format("{}: cannot write a part of the seam pass", path.string()));
 }
 
+void make_empty_folder(const std::filesystem::path& dir, std::string_view what) {
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw OutputError(fmt::format("{}: cannot create a folder for {}: {}", dir.string(), what, ec.message()));
+}
+
 KeyedPiece read_piece(const std::filesystem::path& path) {
   const std::optional<std::string> bytes = read_file_bytes(path);
   if (!bytes) throw ProcessingError(fmt::format("{}: a part of the seam pass vanished", path.string()));
@@ -198,10 +205,7 @@ KeyedPiece keyed_piece(const TilePiece& piece) {
 
 SeamPartFiles::SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks)
     : dir_(std::move(dir)), blocks_(blocks) {
-  std::error_code ec;
-  std::filesystem::remove_all(dir_, ec);
-  std::filesystem::create_directories(dir_, ec);
-  if (ec) throw OutputError(fmt::format("{}: cannot create a folder for the seam pass: {}", dir_.string(), ec.message()));
+  make_empty_folder(dir_, "the seam pass");
 }
 
 SeamPartFiles::~SeamPartFiles() {
@@ -275,23 +279,23 @@ void SeamPartFiles::save_stitched(std::size_t part, KeyedPiece stitched) {
   write_scratch_file(part_file(keys_.at(part), true), encode_keyed_piece(stitched));
 }
 
-OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
-                           const PartStore& store)
-    : dir_(std::move(dir)) {
-  std::error_code ec;
-  std::filesystem::remove_all(dir_, ec);
-  std::filesystem::create_directories(dir_, ec);
-  if (ec) throw OutputError(fmt::format("{}: cannot create a folder for the output's tiles: {}", dir_.string(), ec.message()));
-  // Each part's share of each tile, written in parallel, then listed in part order.
-  struct Share {
-    TileKey key;
-    Box3d box;
-    std::uint64_t triangles;
-    std::filesystem::path file;
-    std::vector<std::int32_t> sources;  ///< of its triangles
-  };
-  std::vector<std::vector<Share>> shares(parts.size());
-  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+namespace {
+
+/// One part's triangles in one grid tile, in a file of their own.
+struct Share {
+  TileKey key;
+  Box3d box;
+  std::uint64_t triangles;
+  std::filesystem::path file;
+  std::vector<std::int32_t> sources;  ///< of its triangles
+};
+
+/// Each stitched part's triangles split by the grid tile holding their centroid and written
+/// to `dir`, the parts in parallel; per part, its shares.
+std::vector<std::vector<Share>> file_shares(const std::filesystem::path& dir, const TileGrid& grid,
+                                            std::size_t parts, const PartStore& store) {
+  std::vector<std::vector<Share>> shares(parts);
+  parallel_for_blocks(parts, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
       const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
       std::map<TileKey, std::vector<std::uint32_t>> by_tile;
@@ -302,12 +306,23 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
       }
       for (const auto& [key, ts] : by_tile) {
         const KeyedPiece share = subset(*piece, ts);
-        const std::filesystem::path file = dir_ / fmt::format("{}.{}.share", key.name(), p);
+        const std::filesystem::path file = dir / fmt::format("{}.{}.share", key.name(), p);
         write_scratch_file(file, encode_keyed_piece(share));
         shares[p].push_back({key, share.box(), ts.size(), file, share.source_acq});
       }
     }
   });
+  return shares;
+}
+
+}  // namespace
+
+OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
+                           const PartStore& store)
+    : dir_(std::move(dir)) {
+  make_empty_folder(dir_, "the output's tiles");
+  const std::vector<std::vector<Share>> shares = file_shares(dir_, grid, parts.size(), store);
+  // The tiles in key order, each with its shares in part order.
   std::map<TileKey, std::size_t> index;
   for (const std::vector<Share>& of_part : shares) {
     for (const Share& s : of_part) index.try_emplace(s.key, 0);
@@ -323,17 +338,10 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
       leaf.box.extend(s.box);
       leaf.triangles += s.triangles;
       fragments[index.at(s.key)].push_back(s.file);
-      for (const std::int32_t a : s.sources) {
-        if (a < 0) {
-          ++stitched_;
-          continue;
-        }
-        if (per_source_.size() <= static_cast<std::size_t>(a)) per_source_.resize(static_cast<std::size_t>(a) + 1, 0);
-        ++per_source_[static_cast<std::size_t>(a)];
-      }
+      count_sources(s.sources);
     }
   }
-  // Each tile's shares in one file (in part order), read once per output.
+  // Each tile's shares in one file, read once per output.
   files_.resize(leaves_.size());
   parallel_for_blocks(leaves_.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t l = begin; l < end; ++l) {
@@ -341,6 +349,17 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
       write_scratch_file(files_[l], encode_keyed_piece(merge_and_remove(fragments[l])));
     }
   });
+}
+
+void OutputLeaves::count_sources(std::span<const std::int32_t> sources) {
+  for (const std::int32_t a : sources) {
+    if (a < 0) {
+      ++stitched_;
+      continue;
+    }
+    if (per_source_.size() <= static_cast<std::size_t>(a)) per_source_.resize(static_cast<std::size_t>(a) + 1, 0);
+    ++per_source_[static_cast<std::size_t>(a)];
+  }
 }
 
 void OutputLeaves::keep(std::size_t leaf, std::string_view name, std::string_view bytes) const {

@@ -112,6 +112,8 @@ class OutputLeaves {
  private:
   std::filesystem::path dir_;
   std::vector<OutputLeaf> leaves_;
+  void count_sources(std::span<const std::int32_t> sources);
+
   std::vector<std::filesystem::path> files_;  ///< per leaf
   std::vector<std::uint64_t> per_source_;
   std::uint64_t stitched_ = 0;
