@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -166,6 +167,7 @@ void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& lea
     out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
   }
   for (std::size_t begin = 0; begin < all.size(); begin += kLeavesInFlight) {
+    throw_if_interrupted(path.string());
     const std::size_t count = std::min(kLeavesInFlight, all.size() - begin);
     std::vector<FaceRows> rows(count);
     parallel_for_blocks(count, 1, [&](std::size_t b, std::size_t e) {

@@ -11,6 +11,7 @@
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/read_file.h"
 
@@ -218,6 +219,7 @@ std::filesystem::path SeamPartFiles::part_file(const BlockPartKey& key, bool sti
 }
 
 void SeamPartFiles::add_tile(TileKey key, const std::vector<TilePiece>& selected) {
+  throw_if_interrupted("the seam pass");
   std::map<BlockPartKey, std::vector<KeyedPiece>> by_part;
   for (const TilePiece& tile_piece : selected) {
     if (tile_piece.triangle_count() == 0) continue;
@@ -297,6 +299,7 @@ std::vector<std::vector<Share>> file_shares(const std::filesystem::path& dir, co
   std::vector<std::vector<Share>> shares(parts);
   parallel_for_blocks(parts, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
+      throw_if_interrupted("the seam pass");
       const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
       std::map<TileKey, std::vector<std::uint32_t>> by_tile;
       for (std::uint32_t t = 0; t < piece->triangle_count(); ++t) {

@@ -8,6 +8,7 @@
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
@@ -88,6 +89,7 @@ class LeavesToExport final : public TilesetLeaves {
   }
   [[nodiscard]] Box3d box() const override { return leaves_.box(); }
   [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
+    throw_if_interrupted("the 3D Tiles export");
     return tile_mesh(leaves_.load(index_.at(key)), to_local);
   }
   [[nodiscard]] Box3d local_box(const TileKey& key, const LocalMapping& to_local) const override {

@@ -13,6 +13,7 @@
 #include <tuple>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
@@ -171,6 +172,7 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
     if (parts[i].key.level == level) of_level.push_back(i);
   }
   for (std::size_t first = 0; first < of_level.size(); first += kPartsInFlight) {
+    throw_if_interrupted("the seam pass");
     const std::size_t count = std::min(kPartsInFlight, of_level.size() - first);
     std::vector<PartOutcome> outcomes(count);
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/mosaic/stitch_blocks.h"
 #include "stitch_fixtures.h"
@@ -129,6 +131,14 @@ TEST(StitchBlocks, RefusesBandsNarrowerThanTheContextOrTooWideForTheBlocks) {
   EXPECT_THROW(stitch_in_blocks(m, kParams, {.size = 1.0, .band = 0.3}), std::invalid_argument);
   EXPECT_THROW(stitch_in_blocks(m, kParams, {.size = 0, .band = 0.3}), std::invalid_argument);
   EXPECT_EQ(m.mesh.triangles, scene().mesh.triangles) << "a refused layout changed the mesh";
+}
+
+TEST(StitchBlocks, AnInterruptionStopsTheSeamPassBetweenParts) {
+  MergedMesh m = scene();
+  request_interrupt();
+  EXPECT_THROW(stitch_in_blocks(m, kParams, blocks_at(0.7)), InterruptedError);
+  clear_interrupt();
+  EXPECT_NO_THROW(stitch_in_blocks(m, kParams, blocks_at(0.7)));
 }
 
 }  // namespace
