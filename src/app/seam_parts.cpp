@@ -172,34 +172,23 @@ KeyedPiece keyed_piece(const TilePiece& piece) {
   const Mesh& m = piece.mesh;
   // A piece holds one acquisition's triangles, whose vertex ids are that acquisition's.
   const std::uint32_t acquisition = m.triangle_ids.empty() ? 0 : m.triangle_ids.front().acquisition;
-  KeyedPiece raw;
-  for (std::uint32_t v = 0; v < m.vertex_count(); ++v) {
-    raw.keys.push_back(input_vertex_key(acquisition, piece.vertex_ids[v]));
-    raw.positions.push_back(m.world_position(v));
-    if (m.has_sensor_positions()) raw.sensors.push_back(m.world_sensor_position(v));
-    if (!m.times.empty()) raw.times.push_back(m.times[v]);
-    if (!m.intensities.empty()) raw.intensities.push_back(m.intensities[v]);
-    if (!m.colors.empty()) raw.colors.push_back(m.colors[v]);
-  }
-  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
-    raw.triangles.push_back(m.triangles[t]);
-    raw.ids.push_back(m.triangle_ids[t]);
-    raw.source_acq.push_back(static_cast<std::int32_t>(m.triangle_ids[t].acquisition));
-    raw.source_triangle.push_back(static_cast<std::int32_t>(piece.triangle_index[t]));
-  }
-  // Vertices into key order.
-  std::vector<std::uint32_t> order(raw.vertex_count());
+  const auto key = [&](std::uint32_t v) { return input_vertex_key(acquisition, piece.vertex_ids[v]); };
+  // The vertices in key order, each copied once.
+  std::vector<std::uint32_t> order(m.vertex_count());
   std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return raw.keys[a] < raw.keys[b]; });
+  std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
   std::vector<std::uint32_t> rank(order.size());
   KeyedPiece out;
   for (std::uint32_t i = 0; i < order.size(); ++i) {
     rank[order[i]] = i;
-    out.append_vertex(raw, order[i], raw.keys[order[i]]);
+    out.append_mesh_vertex(m, order[i], key(order[i]));
   }
-  for (std::size_t t = 0; t < raw.triangle_count(); ++t) {
-    const Triangle& tri = raw.triangles[t];
-    out.append_triangle(raw, t, {rank[tri[0]], rank[tri[1]], rank[tri[2]]});
+  for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+    const Triangle& tri = m.triangles[t];
+    out.triangles.push_back({rank[tri[0]], rank[tri[1]], rank[tri[2]]});
+    out.ids.push_back(m.triangle_ids[t]);
+    out.source_acq.push_back(static_cast<std::int32_t>(m.triangle_ids[t].acquisition));
+    out.source_triangle.push_back(static_cast<std::int32_t>(piece.triangle_index[t]));
   }
   return out;
 }

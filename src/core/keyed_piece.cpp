@@ -42,6 +42,15 @@ void KeyedPiece::append_vertex(const KeyedPiece& from, std::uint32_t v, std::uin
   if (!from.colors.empty()) colors.push_back(from.colors[v]);
 }
 
+void KeyedPiece::append_mesh_vertex(const Mesh& m, std::uint32_t v, std::uint64_t key) {
+  keys.push_back(key);
+  positions.push_back(m.world_position(v));
+  if (m.has_sensor_positions()) sensors.push_back(m.world_sensor_position(v));
+  if (!m.times.empty()) times.push_back(m.times[v]);
+  if (!m.intensities.empty()) intensities.push_back(m.intensities[v]);
+  if (!m.colors.empty()) colors.push_back(m.colors[v]);
+}
+
 void KeyedPiece::append_triangle(const KeyedPiece& from, std::size_t t, const Triangle& corners) {
   triangles.push_back(corners);
   ids.push_back(from.ids[t]);

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Block stitching: the parts, the levels and the parts of a level in parallel. Cutting one
 // part out and taking it back is part_cut.cpp's; keeping the parts between levels is the
-// PartStore's (memory_part_store.cpp for stitch_in_blocks, files for a tiled run).
+// PartStore's (in memory in stitch_blocks_merged.cpp for stitch_in_blocks, in files for a
+// tiled run: src/app/seam_parts.cpp).
 #include "citymesh/mosaic/stitch_blocks.h"
 
 #include <fmt/format.h>

@@ -42,14 +42,10 @@ KeyedPiece piece_of(const MergedMesh& m, std::span<const std::uint32_t> ts) {
   for (const std::uint32_t t : ts) p.keys.insert(p.keys.end(), mesh.triangles[t].begin(), mesh.triangles[t].end());
   std::sort(p.keys.begin(), p.keys.end());
   p.keys.erase(std::unique(p.keys.begin(), p.keys.end()), p.keys.end());
-  for (const std::uint64_t key : p.keys) {
-    const auto v = static_cast<std::size_t>(key);
-    p.positions.push_back(mesh.world_position(v));
-    if (mesh.has_sensor_positions()) p.sensors.push_back(mesh.world_sensor_position(v));
-    if (!mesh.times.empty()) p.times.push_back(mesh.times[v]);
-    if (!mesh.intensities.empty()) p.intensities.push_back(mesh.intensities[v]);
-    if (!mesh.colors.empty()) p.colors.push_back(mesh.colors[v]);
-  }
+  // The keys are the mesh's vertex indices, taken in order: re-appended with their vertices.
+  std::vector<std::uint64_t> keys;
+  keys.swap(p.keys);
+  for (const std::uint64_t key : keys) p.append_mesh_vertex(mesh, static_cast<std::uint32_t>(key), key);
   const auto local = [&](std::uint32_t v) {
     return static_cast<std::uint32_t>(std::lower_bound(p.keys.begin(), p.keys.end(), v) - p.keys.begin());
   };

@@ -33,6 +33,9 @@ struct KeyedPiece {
   [[nodiscard]] Box3d box(std::size_t t) const;
   /// Appends vertex v of `from` (same attributes) with `key`, which must pass every key so far.
   void append_vertex(const KeyedPiece& from, std::uint32_t v, std::uint64_t key);
+  /// Appends vertex v of mesh `m` (its attributes, which must be this piece's; positions made
+  /// absolute) with `key`, which must pass every key so far.
+  void append_mesh_vertex(const Mesh& m, std::uint32_t v, std::uint64_t key);
   /// Appends triangle t of `from` on the vertices `corners` of this piece.
   void append_triangle(const KeyedPiece& from, std::size_t t, const Triangle& corners);
   /// Throws ProcessingError naming `what` when the arrays disagree, keys are not ascending
