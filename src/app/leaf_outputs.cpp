@@ -81,27 +81,10 @@ std::vector<std::uint32_t> ranks(std::string_view owned) {
   return out;
 }
 
-MeshVertexAttributes attributes_of(const KeyedPiece& p) {
-  return {.sensors = !p.sensors.empty(), .times = !p.times.empty(), .intensities = !p.intensities.empty(),
-          .colors = !p.colors.empty()};
-}
-
-/// The rows of the vertices tile `leaf` writes.
-MeshVertexRows owned_rows(const KeyedPiece& piece, std::string_view owned) {
-  MeshVertexRows rows(attributes_of(piece));
-  for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
-    if (owned[v] == 0) continue;
-    rows.add(piece.positions[v], piece.sensors.empty() ? Vec3d{} : piece.sensors[v],
-             piece.times.empty() ? 0.0 : piece.times[v], piece.intensities.empty() ? 0.0f : piece.intensities[v],
-             piece.colors.empty() ? Rgb8{} : piece.colors[v]);
-  }
-  return rows;
-}
-
 /// A tile's faces on the file's vertex numbers, with their provenance columns.
 struct FaceRows {
   std::vector<Triangle> triangles;
-  std::vector<std::int32_t> source_acq, source_face;
+  Provenance provenance;
 };
 
 FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf) {
@@ -131,14 +114,8 @@ FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, s
     }
     number[v] = static_cast<std::uint32_t>(n);
   }
-  FaceRows rows;
-  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
-    const Triangle& tri = piece.triangles[t];
-    rows.triangles.push_back({number[tri[0]], number[tri[1]], number[tri[2]]});
-    rows.source_acq.push_back(piece.source_acq[t]);
-    rows.source_face.push_back(piece.source_acq[t] == kNoSource ? kNoSource
-                                                                 : static_cast<std::int32_t>(piece.ids[t].face));
-  }
+  FaceRows rows{{}, Provenance(piece)};
+  for (const Triangle& tri : piece.triangles) rows.triangles.push_back({number[tri[0]], number[tri[1]], number[tri[2]]});
   return rows;
 }
 
@@ -146,6 +123,29 @@ FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, s
 constexpr std::size_t kLeavesInFlight = 4;
 
 }  // namespace
+
+MeshVertexRows piece_rows(const KeyedPiece& piece, std::string_view owned) {
+  MeshVertexRows rows({.sensors = !piece.sensors.empty(), .times = !piece.times.empty(),
+                       .intensities = !piece.intensities.empty(), .colors = !piece.colors.empty()});
+  for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
+    if (!owned.empty() && owned[v] == 0) continue;
+    rows.add(piece.positions[v], piece.sensors.empty() ? Vec3d{} : piece.sensors[v],
+             piece.times.empty() ? 0.0 : piece.times[v], piece.intensities.empty() ? 0.0f : piece.intensities[v],
+             piece.colors.empty() ? Rgb8{} : piece.colors[v]);
+  }
+  return rows;
+}
+
+Provenance::Provenance(const KeyedPiece& piece) : acq(piece.source_acq) {
+  face.reserve(acq.size());
+  for (std::size_t t = 0; t < acq.size(); ++t) {
+    face.push_back(acq[t] == kNoSource ? kNoSource : static_cast<std::int32_t>(piece.ids[t].face));
+  }
+}
+
+std::vector<PlyColumn> Provenance::columns() const {
+  return {{kSourceAcqProperty, std::span<const std::int32_t>(acq)}, {kSourceFaceProperty, std::span<const std::int32_t>(face)}};
+}
 
 void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& leaves) {
   const std::vector<OutputLeaf>& all = leaves.leaves();
@@ -156,14 +156,13 @@ void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& lea
   std::uint64_t faces = 0;
   for (const OutputLeaf& leaf : all) faces += leaf.triangles;
   const KeyedPiece first = all.empty() ? KeyedPiece{} : leaves.load(0);
-  const MeshVertexRows layout_rows(attributes_of(first));
-  const std::vector<std::int32_t> none;
-  const PlyWriteInput layout{{}, {}, layout_rows.columns(),
-                             {{std::string(kSourceAcqProperty), std::span(none)}, {kSourceFaceProperty, std::span(none)}},
-                             {std::string(kPlyComment)}};
+  // The columns the tiles carry (the first tile's), with no rows.
+  const MeshVertexRows layout_rows = piece_rows(first, std::string(first.vertex_count(), '\0'));
+  const Provenance no_faces;
+  const PlyWriteInput layout{{}, {}, layout_rows.columns(), no_faces.columns(), {std::string(kPlyComment)}};
   PlyStreamWriter out(path, layout, numbers.vertices, faces);
   for (std::size_t l = 0; l < all.size(); ++l) {
-    const MeshVertexRows rows = owned_rows(leaves.load(l), VertexNumbering::owned(leaves, l));
+    const MeshVertexRows rows = piece_rows(leaves.load(l), VertexNumbering::owned(leaves, l));
     out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
   }
   for (std::size_t begin = 0; begin < all.size(); begin += kLeavesInFlight) {
@@ -174,10 +173,7 @@ void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& lea
       for (std::size_t i = b; i < e; ++i) rows[i] = face_rows(leaves, numbers, begin + i);
     });
     for (const FaceRows& r : rows) {
-      out.add_faces({{}, r.triangles, {},
-                     {{std::string(kSourceAcqProperty), std::span<const std::int32_t>(r.source_acq)},
-                      {kSourceFaceProperty, std::span<const std::int32_t>(r.source_face)}},
-                     {}});
+      out.add_faces({{}, r.triangles, {}, r.provenance.columns(), {}});
     }
   }
   out.commit();

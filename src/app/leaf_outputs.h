@@ -3,11 +3,29 @@
 // pass ran block by block in files): the PLY and the picture.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <string_view>
+#include <vector>
+
+#include "citymesh/io/ply_writer.h"
 
 #include "seam_parts.h"
 
 namespace citymesh::app {
+
+/// The vertex rows of `piece` in citymesh's input format: those `owned` marks (a byte per
+/// vertex, non-zero: written), or every one when `owned` is empty.
+MeshVertexRows piece_rows(const KeyedPiece& piece, std::string_view owned = {});
+
+/// The provenance columns of a piece's triangles, as the mosaic's PLYs carry them:
+/// source_acq, and source_face (kNoSource for the triangles stitching made).
+struct Provenance {
+  std::vector<std::int32_t> acq, face;
+  Provenance() = default;  ///< no triangles: the columns' layout
+  explicit Provenance(const KeyedPiece& piece);
+  [[nodiscard]] std::vector<PlyColumn> columns() const;
+};
 
 /// Writes the output held by `leaves` as one PLY in the input format with the provenance
 /// columns (source_acq, source_face), as write_mesh_ply writes a merged mesh: each vertex

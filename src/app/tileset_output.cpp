@@ -13,6 +13,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/tiles3d/export.h"
+#include "leaf_outputs.h"
 #include "mosaic_output.h"
 
 namespace citymesh::app {
@@ -103,19 +104,6 @@ class LeavesToExport final : public TilesetLeaves {
   std::map<TileKey, std::size_t> index_;
 };
 
-/// The provenance columns of `piece`'s triangles.
-struct Provenance {
-  std::vector<std::int32_t> acq, face;
-  explicit Provenance(const KeyedPiece& piece) : acq(piece.source_acq) {
-    for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
-      face.push_back(acq[t] == kNoSource ? kNoSource : static_cast<std::int32_t>(piece.ids[t].face));
-    }
-  }
-  [[nodiscard]] std::vector<PlyColumn> columns() const {
-    return {{kSourceAcqProperty, std::span<const std::int32_t>(acq)}, {"source_face", std::span<const std::int32_t>(face)}};
-  }
-};
-
 nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   Stopwatch clock;
   const std::vector<TileKey> keys = leaf_keys(merged.mesh, TileGrid(grid_params(config)));
@@ -140,16 +128,6 @@ nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   return {{"files", tiles.size()}, {"seconds", clock.seconds()}};
 }
 
-}  // namespace
-
-std::filesystem::path find_tileset(const std::filesystem::path& given) {
-  for (const std::filesystem::path& candidate : {given / "tiles" / "tileset.json", given / "tileset.json", given}) {
-    if (std::filesystem::is_regular_file(candidate)) return candidate;
-  }
-  throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
-                               given.string()));
-}
-
 /// One provenance PLY per tile from the output's tiles in files.
 nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves) {
   Stopwatch clock;
@@ -159,13 +137,7 @@ nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves)
   std::filesystem::create_directories(staged);
   for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
     const KeyedPiece piece = leaves.load(l);
-    MeshVertexRows rows({.sensors = !piece.sensors.empty(), .times = !piece.times.empty(),
-                         .intensities = !piece.intensities.empty(), .colors = !piece.colors.empty()});
-    for (std::size_t v = 0; v < piece.vertex_count(); ++v) {
-      rows.add(piece.positions[v], piece.sensors.empty() ? Vec3d{} : piece.sensors[v],
-               piece.times.empty() ? 0.0 : piece.times[v], piece.intensities.empty() ? 0.0f : piece.intensities[v],
-               piece.colors.empty() ? Rgb8{} : piece.colors[v]);
-    }
+    const MeshVertexRows rows = piece_rows(piece);
     const Provenance provenance(piece);
     write_ply(staged / (leaves.leaves()[l].key.name() + ".ply"),
               {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
@@ -173,6 +145,16 @@ nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves)
   replace_directory_atomically(staged, dir);
   std::cout << fmt::format("provenance PLY: {} tiles -> {}\n", leaves.leaves().size(), dir.string());
   return {{"files", leaves.leaves().size()}, {"seconds", clock.seconds()}};
+}
+
+}  // namespace
+
+std::filesystem::path find_tileset(const std::filesystem::path& given) {
+  for (const std::filesystem::path& candidate : {given / "tiles" / "tileset.json", given / "tileset.json", given}) {
+    if (std::filesystem::is_regular_file(candidate)) return candidate;
+  }
+  throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
+                               given.string()));
 }
 
 nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves) {
