@@ -4,6 +4,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cstring>
+#include <map>
 #include <optional>
 
 #include "citymesh/core/error.h"
@@ -35,11 +37,17 @@ std::optional<std::uint32_t> find_key(const KeyedPiece& piece, std::uint64_t key
   return static_cast<std::uint32_t>(it - piece.keys.begin());
 }
 
-/// Which tile writes each vertex: the first, in key order, holding it. Per tile, whether it
-/// writes each of its vertices is kept beside it (a byte per vertex, read back when its rows
-/// are written); in memory only the number of the first vertex each tile writes.
+/// Where a vertex of a tile is written: by the tile `leaf`, as its vertex `index`.
+struct Owner {
+  std::uint32_t leaf, index;
+};
+
+/// Which tile writes each vertex: the first, in key order, holding it. Each tile's owners
+/// are found once, when its earlier neighbours are read, and kept beside it (8 bytes per
+/// vertex): numbering its faces then reads those notes, not the neighbours again. In memory
+/// only the number of the first vertex each tile writes.
 struct VertexNumbering {
-  static constexpr std::string_view kOwned = "owned";
+  static constexpr std::string_view kOwners = "owners";
   std::vector<std::uint64_t> first;
   std::uint64_t vertices = 0;
 
@@ -47,18 +55,7 @@ struct VertexNumbering {
     const std::vector<OutputLeaf>& all = leaves.leaves();
     std::vector<std::uint64_t> count(all.size(), 0);
     parallel_for_blocks(all.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t l = begin; l < end; ++l) {
-        const KeyedPiece piece = leaves.load(l);
-        std::string mine(piece.vertex_count(), '\1');
-        for (const std::size_t m : earlier_neighbours(all, l)) {
-          const KeyedPiece other = leaves.load(m);
-          for (std::size_t v = 0; v < mine.size(); ++v) {
-            if (mine[v] != 0 && find_key(other, piece.keys[v])) mine[v] = 0;
-          }
-        }
-        count[l] = static_cast<std::uint64_t>(std::count(mine.begin(), mine.end(), '\1'));
-        leaves.keep(l, kOwned, mine);
-      }
+      for (std::size_t l = begin; l < end; ++l) count[l] = find_owners(leaves, l);
     });
     for (std::size_t l = 0; l < all.size(); ++l) {
       first.push_back(vertices);
@@ -66,8 +63,40 @@ struct VertexNumbering {
     }
   }
 
+  /// Per vertex of tile `leaf`: where it is written.
+  static std::vector<Owner> owners(const OutputLeaves& leaves, std::size_t leaf) {
+    const std::string bytes = leaves.kept(leaf, kOwners);
+    std::vector<Owner> out(bytes.size() / sizeof(Owner));
+    if (!out.empty()) std::memcpy(out.data(), bytes.data(), out.size() * sizeof(Owner));
+    return out;
+  }
+
   /// Per vertex of tile `leaf`: 1 when the tile writes it.
-  static std::string owned(const OutputLeaves& leaves, std::size_t leaf) { return leaves.kept(leaf, kOwned); }
+  static std::string owned(const OutputLeaves& leaves, std::size_t leaf) {
+    const std::vector<Owner> o = owners(leaves, leaf);
+    std::string flags(o.size(), '\0');
+    for (std::size_t v = 0; v < o.size(); ++v) flags[v] = o[v].leaf == leaf ? '\1' : '\0';
+    return flags;
+  }
+
+ private:
+  /// Keeps tile `leaf`'s owners; returns how many of its vertices it writes itself.
+  static std::uint64_t find_owners(const OutputLeaves& leaves, std::size_t leaf) {
+    const KeyedPiece piece = leaves.load(leaf);
+    std::vector<Owner> owner(piece.vertex_count());
+    for (std::uint32_t v = 0; v < owner.size(); ++v) owner[v] = {static_cast<std::uint32_t>(leaf), v};
+    // Earlier tiles in key order: the first holding a vertex writes it.
+    for (const std::size_t m : earlier_neighbours(leaves.leaves(), leaf)) {
+      const KeyedPiece other = leaves.load(m);
+      for (std::size_t v = 0; v < owner.size(); ++v) {
+        if (owner[v].leaf != leaf) continue;
+        if (const auto at = find_key(other, piece.keys[v])) owner[v] = {static_cast<std::uint32_t>(m), *at};
+      }
+    }
+    leaves.keep(leaf, kOwners, {reinterpret_cast<const char*>(owner.data()), owner.size() * sizeof(Owner)});
+    return static_cast<std::uint64_t>(
+        std::count_if(owner.begin(), owner.end(), [&](const Owner& o) { return o.leaf == leaf; }));
+  }
 };
 
 /// Per vertex: the vertices written before it by its tile (among those `owned` flags).
@@ -89,30 +118,15 @@ struct FaceRows {
 
 FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf) {
   const KeyedPiece piece = leaves.load(leaf);
-  const std::string owned = VertexNumbering::owned(leaves, leaf);
-  const std::vector<std::uint32_t> rank = ranks(owned);
-  struct Earlier {
-    std::size_t leaf;
-    KeyedPiece piece;
-    std::vector<std::uint32_t> rank;
-  };
-  std::vector<Earlier> earlier;
-  for (const std::size_t m : earlier_neighbours(leaves.leaves(), leaf)) {
-    earlier.push_back({m, leaves.load(m), ranks(VertexNumbering::owned(leaves, m))});
+  const std::vector<Owner> owners = VertexNumbering::owners(leaves, leaf);
+  // Each owning tile's ranks, from its notes (a few tiles: this one and its earlier neighbours).
+  std::map<std::uint32_t, std::vector<std::uint32_t>> rank;
+  for (const Owner& o : owners) {
+    if (!rank.contains(o.leaf)) rank[o.leaf] = ranks(VertexNumbering::owned(leaves, o.leaf));
   }
   std::vector<std::uint32_t> number(piece.vertex_count());
   for (std::size_t v = 0; v < number.size(); ++v) {
-    std::uint64_t n = numbers.first[leaf] + rank[v];
-    if (owned[v] == 0) {
-      // The first earlier tile holding it writes it (every tile holding it meets this one).
-      for (const Earlier& e : earlier) {
-        if (const auto at = find_key(e.piece, piece.keys[v])) {
-          n = numbers.first[e.leaf] + e.rank[*at];
-          break;
-        }
-      }
-    }
-    number[v] = static_cast<std::uint32_t>(n);
+    number[v] = static_cast<std::uint32_t>(numbers.first[owners[v].leaf] + rank.at(owners[v].leaf)[owners[v].index]);
   }
   FaceRows rows{{}, Provenance(piece)};
   for (const Triangle& tri : piece.triangles) rows.triangles.push_back({number[tri[0]], number[tri[1]], number[tri[2]]});
