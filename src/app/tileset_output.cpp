@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <cstring>
 #include <iostream>
 #include <map>
 
@@ -89,17 +90,31 @@ class LeavesToExport final : public TilesetLeaves {
     return out;
   }
   [[nodiscard]] Box3d box() const override { return leaves_.box(); }
-  [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
+  /// The positions the first pass mapped (local_box), read back: each vertex is mapped once.
+  [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& /*to_local*/) const override {
     throw_if_interrupted("the 3D Tiles export");
-    return tile_mesh(leaves_.load(index_.at(key)), to_local);
+    const std::size_t l = index_.at(key);
+    const std::string mapped = leaves_.kept(l, kMapped);
+    std::vector<Vec3f> local(mapped.size() / sizeof(Vec3f));
+    if (!local.empty()) std::memcpy(local.data(), mapped.data(), local.size() * sizeof(Vec3f));
+    return tile_mesh(leaves_.load(l), local);
   }
+  /// Maps the tile's vertices (all its triangles' own), keeps them beside it for leaf(), and
+  /// returns their box.
   [[nodiscard]] Box3d local_box(const TileKey& key, const LocalMapping& to_local) const override {
-    Box3d box;  // a tile's vertices are all its triangles'
-    for (const Vec3d& p : leaves_.load(index_.at(key)).positions) box.extend(Vec3d(to_local(p)));
+    const std::size_t l = index_.at(key);
+    std::vector<Vec3f> local;
+    Box3d box;
+    for (const Vec3d& p : leaves_.load(l).positions) {
+      local.push_back(to_local(p));
+      box.extend(Vec3d(local.back()));
+    }
+    leaves_.keep(l, kMapped, {reinterpret_cast<const char*>(local.data()), local.size() * sizeof(Vec3f)});
     return box;
   }
 
  private:
+  static constexpr std::string_view kMapped = "local";
   const OutputLeaves& leaves_;
   std::map<TileKey, std::size_t> index_;
 };

@@ -281,6 +281,16 @@ Box3d TilesetLeaves::local_box(const TileKey& key, const LocalMapping& to_local)
 }
 
 TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {
+  std::vector<Vec3f> local;
+  local.reserve(piece.vertex_count());
+  for (const Vec3d& p : piece.positions) local.push_back(to_local(p));
+  return tile_mesh(piece, local);
+}
+
+TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
+  if (local.size() != piece.vertex_count())
+    throw ProcessingError(fmt::format("3D Tiles: {} mapped positions for a piece of {} vertices", local.size(),
+                                      piece.vertex_count()));
   // One tile vertex per (vertex, feature) the triangles draw: a vertex shared by two sources
   // is drawn twice, each with its own feature id.
   std::vector<TileVertexKey> keys;
@@ -297,7 +307,7 @@ TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {
   for (const TileVertexKey& k : keys) {
     const std::uint32_t v = vertex(k.vertex);
     m.keys.push_back(k);
-    m.positions.push_back(to_local(piece.positions[v]));
+    m.positions.push_back(local[v]);
     if (!piece.intensities.empty()) m.intensities.push_back(piece.intensities[v]);
     if (!piece.colors.empty()) m.colors.push_back(piece.colors[v]);
   }

@@ -69,8 +69,9 @@ class TilesetLeaves {
   /// Leaf `key`'s mesh (the triangles whose centroid the tile holds), positions mapped by
   /// `to_local`, each vertex keyed as the same vertex in every leaf (see tile_mesh).
   [[nodiscard]] virtual TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const = 0;
-  /// The box of leaf `key`'s vertices mapped by `to_local` (the export's first pass): by
-  /// default that of leaf()'s positions.
+  /// The box of leaf `key`'s vertices mapped by `to_local` (the export's first pass, which
+  /// asks it of every leaf before leaf() is asked of any): by default that of leaf()'s
+  /// positions.
   [[nodiscard]] virtual Box3d local_box(const TileKey& key, const LocalMapping& to_local) const;
 };
 
@@ -81,6 +82,8 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
 /// Some triangles of the output as a tile's mesh: one vertex per (vertex key, feature id of a
 /// triangle using it; stitch triangles have none), positions mapped by `to_local`.
 TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local);
+/// The same with the piece's positions already mapped: `local`, one per vertex of `piece`.
+TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local);
 
 /// The leaf (grid tile) of each triangle: the tile containing its centroid.
 std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid);
