@@ -119,11 +119,13 @@ class AcquisitionTiler {
                                          file.string(), faces.faces[t], v));
           }
         }
-        add_triangle({tri, faces.fans[t], faces.faces[t], next_index_++}, file);
+        if (!add_triangle({tri, faces.fans[t], faces.faces[t], next_index_}, file)) continue;
+        ++next_index_;
         if (batch_bytes() > buffer_bytes_ || batch_.size() >= kMaxBatchTriangles) flush();
       }
     }
     flush();
+    if (zero_area_dropped_ > 0) log::info("{}: dropped {} zero-area triangles", file.string(), zero_area_dropped_);
     out_.triangles = next_index_;
     out_.stats.input_bytes += reader.stats().bytes;
   }
@@ -145,14 +147,20 @@ class AcquisitionTiler {
            std::uint64_t{largest_tile_} * kBlockBytesPerCopy;
   }
 
-  /// Records where `triangle` goes (`file` names the input for its errors).
-  void add_triangle(const BatchTriangle& triangle, const std::filesystem::path& file) {
+  /// Records where `triangle` goes (`file` names the input for its errors), unless it is
+  /// degenerate: then returns false (whole-mesh reading drops the same triangles, so both
+  /// number the others alike).
+  bool add_triangle(const BatchTriangle& triangle, const std::filesystem::path& file) {
     const Triangle& tri = triangle.corners;
     const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
                                  vertices_.positions[tri[2]]};
     Box3d corners;
     for (const Vec3d& p : c) corners.extend(p);
     check_face_extent(file, triangle.face, corners, c[0], c[1], c[2]);
+    if (degenerate_input_triangle(c[0], c[1], c[2])) {
+      ++zero_area_dropped_;
+      return false;
+    }
     const auto t = static_cast<std::uint32_t>(batch_.size());
     batch_.push_back(triangle);
     const Vec3d viewpoint =
@@ -163,7 +171,7 @@ class AcquisitionTiler {
     reach.extend(viewpoint);
     if (last_interior_.holds(reach)) {
       add_copy(last_interior_.key, t, TileRole::owned);
-      return;
+      return true;
     }
     const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
     last_interior_ = grid_.interior(owner);
@@ -173,6 +181,7 @@ class AcquisitionTiler {
     for (const TileKey k : crossed_) add_copy(k, t, TileRole::empty_space);
     out_.stats.halo_copies += halo_.size();
     out_.stats.empty_space_copies += crossed_.size();
+    return true;
   }
 
   void add_copy(TileKey key, std::uint32_t triangle, TileRole role) {
@@ -248,6 +257,7 @@ class AcquisitionTiler {
   std::uint64_t buffer_bytes_;
   AcquisitionVertices vertices_;
   std::uint32_t next_index_ = 0;
+  std::uint64_t zero_area_dropped_ = 0;
   // The batch: triangles read since the last flush and their copies.
   std::vector<BatchTriangle> batch_;
   std::vector<TileCopy> copies_;

@@ -13,7 +13,8 @@ namespace citymesh::app {
 
 inline constexpr const char* kRunConfigFile = "run-config.json";
 /// Bumped whenever what the tiler stores or what a tile result means changes.
-inline constexpr int kTileStoreVersion = 3;  // 2: one folder per acquisition; 3: XXH3 checksums
+inline constexpr int kTileStoreVersion = 4;  // 2: one folder per acquisition; 3: XXH3 checksums;
+                                             // 4: zero-area triangles dropped as whole-mesh reading drops them
 inline constexpr int kTileResultVersion = 3;  // 3: XXH3 checksum
 
 /// A hash of the result-affecting keys (tiling_only: those that change the tile store).

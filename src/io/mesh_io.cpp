@@ -2,6 +2,7 @@
 #include "citymesh/io/mesh_io.h"
 
 #include <cmath>
+#include <span>
 
 #include <fmt/format.h>
 
@@ -27,14 +28,13 @@ void append_faces(Mesh& mesh, const PlyFaceChunk& chunk, std::uint32_t acquisiti
   }
 }
 
-/// Removes triangles whose area is (numerically) zero; returns how many.
-std::uint64_t drop_zero_area(Mesh& mesh, double min_doubled_area) {
+/// Removes triangles whose area is (numerically) zero, measured on the file's coordinates
+/// `absolute` (as the tiler measures it); returns how many.
+std::uint64_t drop_zero_area(Mesh& mesh, std::span<const Vec3d> absolute, double min_doubled_area) {
   std::size_t kept = 0;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const Triangle& tri = mesh.triangles[t];
-    const double area2 = doubled_area(Vec3d(mesh.positions[tri[0]]), Vec3d(mesh.positions[tri[1]]),
-                                      Vec3d(mesh.positions[tri[2]]));
-    if (area2 < min_doubled_area) continue;
+    if (degenerate_input_triangle(absolute[tri[0]], absolute[tri[1]], absolute[tri[2]], min_doubled_area)) continue;
     mesh.triangles[kept] = tri;
     mesh.triangle_ids[kept] = mesh.triangle_ids[t];
     ++kept;
@@ -74,6 +74,8 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
   MeshReadResult result;
   Mesh& mesh = result.mesh;
   mesh.positions.reserve(reader.vertex_count());
+  std::vector<Vec3d> absolute;  // the file's coordinates, until the degenerate triangles are found
+  absolute.reserve(reader.vertex_count());
   bool origin_set = params.origin.has_value();
   if (origin_set) mesh.origin = *params.origin;
   PlyVertexChunk vertices;
@@ -86,13 +88,14 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
         origin_set = true;
       }
       append_vertices(mesh, vertices);
+      absolute.insert(absolute.end(), vertices.positions.begin(), vertices.positions.end());
     } else {
       append_faces(mesh, faces, params.acquisition);
     }
   }
   result.stats = reader.stats();
   check_faces(path, mesh);
-  result.zero_area_dropped = drop_zero_area(mesh, params.min_doubled_area);
+  result.zero_area_dropped = drop_zero_area(mesh, absolute, params.min_doubled_area);
   if (result.zero_area_dropped > 0) {
     log::info("{}: dropped {} zero-area triangles", path.string(), result.zero_area_dropped);
   }

@@ -295,6 +295,32 @@ TEST(Tiler, AFaceWhoseBoxDiagonalPassesTheMaximumReachButNoEdgeDoesIsTiled) {
   EXPECT_THROW((void)tile_acquisitions(f.acquisitions, f.params), InputError);
 }
 
+TEST(Tiler, ZeroAreaTrianglesAreDroppedAndTheRestNumberedAsWholeMeshReadingNumbersThem) {
+  // A tiled run reads each acquisition again for its labelled PLY; the tiler and whole-mesh
+  // reading must drop the same triangles, or every label after a degenerate face is shifted
+  // (the run used to stop there, "N triangles now, N + 1 labelled").
+  Fixture f;
+  move_vertex(f, 3, 1, {0, 0, 0});  // face 1 = {0, 1, 3} collapses onto its edge {0, 1}
+  const MeshReadResult whole = read_mesh(f.acquisitions[1].path);
+  ASSERT_EQ(whole.zero_area_dropped, 1u);
+  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  ASSERT_EQ(store.triangles[1], whole.mesh.triangle_count());
+  std::set<std::uint32_t> owned;
+  for (const TileContents& tile : store.tiles) {
+    const TilePiece p = read_tile(store, tile.key)[1];
+    for (std::size_t t = 0; t < p.triangle_count(); ++t) {
+      const std::uint32_t index = p.triangle_index[t];
+      ASSERT_LT(index, whole.mesh.triangle_count());
+      EXPECT_EQ(p.mesh.triangle_ids[t].face, whole.mesh.triangle_ids[index].face) << "triangle " << index;
+      EXPECT_NE(p.mesh.triangle_ids[t].face, 1u);
+      if (p.roles[t] == TileRole::owned) {
+        EXPECT_TRUE(owned.insert(index).second) << "owned twice: " << index;
+      }
+    }
+  }
+  EXPECT_EQ(owned.size(), whole.mesh.triangle_count());
+}
+
 /// Every file under `dir` by relative path, with its bytes.
 std::map<std::string, std::string> folder_bytes(const std::filesystem::path& dir) {
   std::map<std::string, std::string> files;

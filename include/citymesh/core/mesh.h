@@ -102,4 +102,15 @@ inline Vec3d whole_metre_origin(const Vec3d& first) {
 /// Twice the area of the triangle (a, b, c); 0 for degenerate triangles.
 double doubled_area(const Vec3d& a, const Vec3d& b, const Vec3d& c);
 
+/// Below this doubled area (m^2) a triangle of the input is degenerate: its normal is noise.
+/// Every reader of acquisitions drops such triangles (whole-mesh reading and the tiler alike,
+/// from the file's double coordinates) so that both number the remaining triangles the same.
+inline constexpr double kMinDoubledArea = 1e-12;
+
+/// Whether the input triangle (a, b, c), in the file's coordinates, is dropped as degenerate.
+inline bool degenerate_input_triangle(const Vec3d& a, const Vec3d& b, const Vec3d& c,
+                                      double min_doubled_area = kMinDoubledArea) {
+  return !(doubled_area(a, b, c) >= min_doubled_area);
+}
+
 }  // namespace citymesh

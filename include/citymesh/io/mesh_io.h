@@ -21,8 +21,9 @@ struct MeshReadParams {
   std::uint32_t acquisition = 0;  ///< written into every TriangleId
   /// Local frame origin; by default the first vertex rounded down to whole metres.
   std::optional<Vec3d> origin;
-  /// Triangles with less than this doubled area (m^2) are degenerate: dropped and counted.
-  double min_doubled_area = 1e-12;
+  /// Triangles with less than this doubled area (m^2), measured on the file's double
+  /// coordinates, are degenerate: dropped and counted.
+  double min_doubled_area = kMinDoubledArea;
 };
 
 struct MeshReadResult {
