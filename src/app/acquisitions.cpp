@@ -15,16 +15,19 @@ std::vector<std::int32_t> source_faces(const Mesh& m) {
   return faces;
 }
 
+void check_provenance_ids(const std::filesystem::path& file, std::uint64_t faces) {
+  if (faces > std::uint64_t{INT32_MAX}) {
+    throw InputError(fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", file.string(), faces));
+  }
+}
+
 Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin) {
   MeshReadParams params;
   params.ply = config.ply_read_params();
   params.acquisition = a.index;
   params.origin = origin;
   MeshReadResult r = read_mesh(a.path, params);
-  if (r.stats.faces > std::uint64_t{INT32_MAX}) {
-    throw InputError(
-        fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", a.path.string(), r.stats.faces));
-  }
+  check_provenance_ids(a.path, r.stats.faces);
   log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());
   return std::move(r.mesh);
 }

@@ -17,6 +17,9 @@ struct LoadedAcquisitions {
   std::vector<TimePoint> dates;
 };
 
+/// Throws InputError naming `file` when its `faces` do not fit the provenance ids (int32).
+void check_provenance_ids(const std::filesystem::path& file, std::uint64_t faces);
+
 /// Per triangle of an acquisition's mesh: the face index in the file (the provenance id).
 std::vector<std::int32_t> source_faces(const Mesh& acquisition);
 

@@ -3,7 +3,6 @@
 
 #include <fmt/format.h>
 
-#include <array>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
@@ -11,8 +10,6 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
-#include "citymesh/io/ply_writer.h"
-#include "citymesh/render/render.h"
 
 namespace citymesh::app {
 
@@ -25,41 +22,8 @@ Rgb8 detect_color(TriangleState state, bool kept, bool refutes) {
 
 namespace {
 
-double unix_seconds(TimePoint t) { return static_cast<double>(t.time_since_epoch().count()) / 1000.0; }
-
 std::string file_stem(const Config& config, std::size_t k) {
   return fmt::format("{}_{}", k, config.acquisitions[k].name);
-}
-
-void write_labelled_ply(const std::filesystem::path& path, const Mesh& mesh, std::span<const std::int32_t> source_face,
-                        const LabelView& labels) {
-  const std::size_t n = mesh.triangle_count();
-  std::vector<std::uint8_t> state(n);
-  std::vector<double> first(n), last(n);
-  for (std::size_t t = 0; t < n; ++t) {
-    state[t] = static_cast<std::uint8_t>(labels.state[t]);
-    first[t] = unix_seconds(labels.first_seen[t]);
-    last[t] = unix_seconds(labels.last_seen[t]);
-  }
-  write_mesh_ply(path, mesh,
-                 {{kSourceFaceProperty, source_face},
-                  {kStateProperty, std::span<const std::uint8_t>(state)},
-                  {"first_seen", std::span<const double>(first)},
-                  {"last_seen", std::span<const double>(last)},
-                  {"sustainable", labels.sustainable},
-                  {kKeptProperty, labels.kept},
-                  {"refutes", labels.refutes}});
-}
-
-void write_picture(const std::filesystem::path& path, const Mesh& mesh, const LabelView& labels, double pixel_size) {
-  RenderLayer layer{&mesh, {}};
-  layer.face_colors.resize(mesh.triangle_count());
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    layer.face_colors[t] = detect_color(labels.state[t], labels.kept[t] != 0, labels.refutes[t] != 0);
-  }
-  ViewParams view;
-  view.pixel_size = pixel_size;
-  write_png(path, render_orthographic(std::span<const RenderLayer>(&layer, 1), view));
 }
 
 nlohmann::json counts_json(const StateCounts& c) {
@@ -69,8 +33,21 @@ nlohmann::json counts_json(const StateCounts& c) {
 
 }  // namespace
 
-LabelView InMemoryDetectOutput::labels(std::size_t k) {
-  return label_view(result_, result_.index.offsets[k], result_.index.offsets[k + 1]);
+LabelledOutputParams InMemoryDetectOutput::layout(std::size_t k) {
+  const Mesh& mesh = input_.meshes[k];
+  LabelledOutputParams p;
+  p.has = {.sensors = mesh.has_sensor_positions(), .times = !mesh.times.empty(),
+           .intensities = !mesh.intensities.empty(), .colors = !mesh.colors.empty()};
+  p.vertices = mesh.vertex_count();
+  p.triangles = mesh.triangle_count();
+  return p;
+}
+
+void InMemoryDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
+  const Mesh& mesh = input_.meshes[k];
+  out.add_vertices(mesh, 0, mesh.vertex_count());
+  out.add_triangles(mesh.triangles, source_faces(mesh),
+                    label_view(result_, result_.index.offsets[k], result_.index.offsets[k + 1]));
 }
 
 std::uint64_t InMemoryDetectOutput::write_pairs(const std::filesystem::path& path) {
@@ -94,22 +71,20 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
   std::uint64_t triangles = 0;
   for (std::size_t k = 0; k < described.acquisitions.size(); ++k) {
     const std::string stem = file_stem(config, k);
-    const Mesh& mesh = source.mesh(k);
-    const LabelView labels = source.labels(k);
-    if (labels.size() != mesh.triangle_count()) {
-      throw InputError(fmt::format("{}: {} triangles now, {} labelled (run with --force)",
-                                   described.acquisitions[k].path.string(), mesh.triangle_count(), labels.size()));
-    }
-    write_labelled_ply(params.dir / (stem + ".ply"), mesh, source_faces(mesh), labels);
-    if (params.pictures) write_picture(params.dir / (stem + ".png"), mesh, labels, params.pixel_size);
+    LabelledOutputParams files = source.layout(k);
+    files.ply = params.dir / (stem + ".ply");
+    if (params.pictures) files.png = params.dir / (stem + ".png");
+    files.pixel_size = params.pixel_size;
+    LabelledAcquisitionWriter out(files);
+    source.feed(k, out);
+    const StateCounts counts = out.finish();
     nlohmann::json entry = acquisition_json(config, described, k);
     entry["ply"] = stem + ".ply";
     entry["png"] = params.pictures ? stem + ".png" : "";
-    entry["triangles"] = mesh.triangle_count();
-    const StateCounts counts = count_states(labels);
+    entry["triangles"] = files.triangles;
     entry["counts"] = counts_json(counts);
     totals += counts;
-    triangles += mesh.triangle_count();
+    triangles += files.triangles;
     summary["acquisitions"].push_back(std::move(entry));
   }
   const std::uint64_t pairs = source.write_pairs(params.dir / kPairsFile);

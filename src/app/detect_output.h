@@ -8,6 +8,7 @@
 
 #include "acquisitions.h"
 #include "citymesh/change/detect.h"
+#include "labelled_output.h"
 
 namespace citymesh::app {
 
@@ -26,16 +27,18 @@ struct DetectOutputParams {
   double read_seconds = 0;
 };
 
-/// What the change step's outputs are written from, one acquisition at a time: `citymesh
-/// detect` has every mesh and label in memory; a tiled run reads each acquisition again when
-/// its turn comes and keeps its labels compact (a city's inputs do not fit in memory together).
+/// What the change step's outputs are written from, one acquisition at a time and in order:
+/// `citymesh detect` has every mesh and label in memory; a tiled run reads each acquisition's
+/// file again, front to back, with its labels from the tiles (a city's inputs and labels do
+/// not fit in memory; one acquisition with its labels need not either).
 class DetectOutputSource {
  public:
   virtual ~DetectOutputSource() = default;
-  /// Acquisition k's mesh (all in one local frame), valid until the next call.
-  virtual const Mesh& mesh(std::size_t k) = 0;
-  /// Acquisition k's labels, valid until the next call.
-  virtual LabelView labels(std::size_t k) = 0;
+  /// Acquisition k's vertex attributes and row counts, asked before feed(k).
+  virtual LabelledOutputParams layout(std::size_t k) = 0;
+  /// Gives acquisition k's vertices, then its triangles with their labels, to `out` (every
+  /// mesh in the first one's frame, as `detect` reads them).
+  virtual void feed(std::size_t k, LabelledAcquisitionWriter& out) = 0;
   /// Writes the consistent pairs, sorted and unique, to `path` (kPairsMagic records);
   /// returns how many.
   virtual std::uint64_t write_pairs(const std::filesystem::path& path) = 0;
@@ -53,8 +56,8 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
 class InMemoryDetectOutput final : public DetectOutputSource {
  public:
   InMemoryDetectOutput(const LoadedAcquisitions& input, const ChangeResult& result) : input_(input), result_(result) {}
-  const Mesh& mesh(std::size_t k) override { return input_.meshes[k]; }
-  LabelView labels(std::size_t k) override;
+  LabelledOutputParams layout(std::size_t k) override;
+  void feed(std::size_t k, LabelledAcquisitionWriter& out) override;
   std::uint64_t write_pairs(const std::filesystem::path& path) override;
   [[nodiscard]] ChangeStats stats() const override { return result_.stats; }
 

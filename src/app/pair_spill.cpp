@@ -83,6 +83,8 @@ namespace {
 
 /// A label on disk: index (4 bytes), flags (1), first and last (2 each), little-endian.
 constexpr std::size_t kLabelBytes = 9;
+/// Labels read from the file at a time.
+constexpr std::size_t kLabelsPerRead = 1 << 16;
 
 }  // namespace
 
@@ -106,35 +108,51 @@ void LabelSpill::add(std::uint32_t acquisition, std::span<const Label> labels) {
   }
 }
 
-std::vector<LabelSpill::Label> LabelSpill::read(std::uint32_t acquisition, std::uint64_t count) const {
+std::vector<LabelSpill::Label> LabelSpill::read(std::uint32_t acquisition, std::uint64_t count, std::uint64_t begin,
+                                                std::uint64_t end) const {
   const std::filesystem::path spilled = file(acquisition);
   std::error_code ec;
   const std::uintmax_t size = std::filesystem::exists(spilled, ec) ? std::filesystem::file_size(spilled, ec) : 0;
-  if (ec || size != count * kLabelBytes) {
+  if (ec || size != count * kLabelBytes || begin > end || end > count) {
     throw ProcessingError(fmt::format("tile assembly: {} labels of acquisition {} from the tiles, its file has {} "
                                       "triangles (a tile is missing or labelled twice)",
                                       size / kLabelBytes, acquisition, count));
   }
-  std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
   std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(spilled.c_str(), "rb"), &std::fclose);
-  if (!f || std::fread(bytes.data(), 1, bytes.size(), f.get()) != bytes.size()) {
-    throw InputError(fmt::format("{}: cannot read the spilled labels back whole", spilled.string()));
-  }
-  std::vector<Label> out(static_cast<std::size_t>(count));
+  if (!f) throw InputError(fmt::format("{}: cannot read the spilled labels back: {}", spilled.string(), std::strerror(errno)));
+  std::vector<Label> out(static_cast<std::size_t>(end - begin));
   std::vector<std::uint8_t> seen(out.size(), 0);
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    const unsigned char* at = bytes.data() + i * kLabelBytes;
-    Label l;
-    std::memcpy(&l.index, at, 4);
-    l.flags = at[4];
-    std::memcpy(&l.first, at + 5, 2);
-    std::memcpy(&l.last, at + 7, 2);
-    if (l.index >= out.size() || seen[l.index] != 0) {
-      throw ProcessingError(fmt::format("tile assembly: triangle {} of acquisition {} labelled {} (its file has {})",
-                                        l.index, acquisition, l.index >= out.size() ? "but not in it" : "twice", count));
+  std::vector<unsigned char> bytes(kLabelsPerRead * kLabelBytes);
+  for (std::uint64_t done = 0; done < count;) {
+    const auto n = static_cast<std::size_t>(std::min<std::uint64_t>(kLabelsPerRead, count - done));
+    if (std::fread(bytes.data(), kLabelBytes, n, f.get()) != n) {
+      throw InputError(fmt::format("{}: cannot read the spilled labels back whole", spilled.string()));
     }
-    seen[l.index] = 1;
-    out[l.index] = l;
+    for (std::size_t i = 0; i < n; ++i) {
+      const unsigned char* at = bytes.data() + i * kLabelBytes;
+      Label l;
+      std::memcpy(&l.index, at, 4);
+      if (l.index >= count) {
+        throw ProcessingError(fmt::format("tile assembly: triangle {} of acquisition {} labelled but not in it (its "
+                                          "file has {})", l.index, acquisition, count));
+      }
+      if (l.index < begin || l.index >= end) continue;
+      l.flags = at[4];
+      std::memcpy(&l.first, at + 5, 2);
+      std::memcpy(&l.last, at + 7, 2);
+      if (seen[l.index - begin] != 0) {
+        throw ProcessingError(fmt::format("tile assembly: triangle {} of acquisition {} labelled twice (its file has {})",
+                                          l.index, acquisition, count));
+      }
+      seen[l.index - begin] = 1;
+      out[l.index - begin] = l;
+    }
+    done += n;
+  }
+  const auto missing = std::find(seen.begin(), seen.end(), std::uint8_t{0});
+  if (missing != seen.end()) {
+    throw ProcessingError(fmt::format("tile assembly: triangle {} of acquisition {} not labelled (a tile is missing)",
+                                      begin + static_cast<std::uint64_t>(missing - seen.begin()), acquisition));
   }
   return out;
 }

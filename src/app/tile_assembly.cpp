@@ -166,10 +166,11 @@ void TileAssembly::check_labelled() const {
   }
 }
 
-ChangeResult TileAssembly::labels(std::size_t k) const {
+ChangeResult TileAssembly::labels(std::size_t k, std::uint64_t begin, std::uint64_t end) const {
   check_labelled();
-  const std::size_t begin = index_.offsets[k], n = index_.offsets[k + 1] - begin;
-  const std::vector<LabelSpill::Label> read = labels_->read(static_cast<std::uint32_t>(k), n);
+  const std::vector<LabelSpill::Label> read =
+      labels_->read(static_cast<std::uint32_t>(k), triangle_count(k), begin, end);
+  const std::size_t n = read.size();
   ChangeResult c;
   c.index.offsets = {0, n};
   c.state.resize(n);

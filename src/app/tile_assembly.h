@@ -33,7 +33,11 @@ class TileAssembly {
   /// Acquisition k's labels as the change step gives them (the result's index holds that
   /// acquisition only; no pairs). Only with labels; throws ProcessingError when the tiles did
   /// not label every input triangle.
-  [[nodiscard]] ChangeResult labels(std::size_t k) const;
+  [[nodiscard]] ChangeResult labels(std::size_t k) const { return labels(k, 0, triangle_count(k)); }
+  /// The labels of its triangles [begin, end) only (the result's triangle 0 is `begin`).
+  [[nodiscard]] ChangeResult labels(std::size_t k, std::uint64_t begin, std::uint64_t end) const;
+  /// Acquisition k's input triangles.
+  [[nodiscard]] std::uint64_t triangle_count(std::size_t k) const { return index_.offsets[k + 1] - index_.offsets[k]; }
 
   /// Writes the consistent pairs, sorted and unique, as `magic` records to `path`; returns
   /// how many. Only with labels.

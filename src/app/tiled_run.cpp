@@ -24,6 +24,7 @@
 #include "leaf_outputs.h"
 #include "seam_parts.h"
 #include "tile_job.h"
+#include "tiled_detect_output.h"
 #include "tileset_output.h"
 
 namespace citymesh::app {
@@ -36,41 +37,6 @@ LoadedAcquisitions describe_acquisitions(const Config& config) {
   for (const Acquisition& a : d.acquisitions) d.dates.push_back(a.date);
   return d;
 }
-
-/// The change step's outputs from the tiles' labels, one acquisition at a time: its file is
-/// read again, its labels expanded from the assembly's compact ones, both dropped before the
-/// next (a city's inputs and labels together are several times the budget).
-class TiledDetectOutput final : public DetectOutputSource {
- public:
-  TiledDetectOutput(const Config& config, const LoadedAcquisitions& described, const TileAssembly& assembly)
-      : config_(config), described_(described), assembly_(assembly) {}
-
-  const Mesh& mesh(std::size_t k) override {
-    mesh_ = Mesh{};  // the previous acquisition's memory goes first
-    mesh_ = read_acquisition(config_, described_.acquisitions[k], origin_);
-    if (!origin_) origin_ = mesh_.origin;  // every mesh in the first one's frame, as `detect` reads them
-    return mesh_;
-  }
-  LabelView labels(std::size_t k) override {
-    labels_ = ChangeResult{};
-    labels_ = assembly_.labels(k);
-    return label_view(labels_, 0, labels_.state.size());
-  }
-  std::uint64_t write_pairs(const std::filesystem::path& path) override {
-    mesh_ = Mesh{};
-    labels_ = ChangeResult{};
-    return assembly_.write_pairs(path, kPairsMagic);
-  }
-  [[nodiscard]] ChangeStats stats() const override { return assembly_.change_stats(); }
-
- private:
-  const Config& config_;
-  const LoadedAcquisitions& described_;
-  const TileAssembly& assembly_;
-  std::optional<Vec3d> origin_;
-  Mesh mesh_;
-  ChangeResult labels_;
-};
 
 void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {
   const LoadedAcquisitions described = describe_acquisitions(config);

@@ -11,15 +11,25 @@
 
 namespace citymesh {
 
-namespace {
-
-void append_vertices(Mesh& mesh, const PlyVertexChunk& chunk) {
+void append_vertex_chunk(Mesh& mesh, const PlyVertexChunk& chunk) {
   for (const Vec3d& p : chunk.positions) mesh.positions.push_back(to_local(p, mesh.origin));
   for (const Vec3d& s : chunk.sensor_positions) mesh.sensor_positions.push_back(to_local(s, mesh.origin));
   mesh.times.insert(mesh.times.end(), chunk.times.begin(), chunk.times.end());
   mesh.intensities.insert(mesh.intensities.end(), chunk.intensities.begin(), chunk.intensities.end());
   mesh.colors.insert(mesh.colors.end(), chunk.colors.begin(), chunk.colors.end());
 }
+
+void check_frame_reach(const std::filesystem::path& path, std::uint64_t face, std::uint64_t v, const Vec3f& local,
+                       const Vec3d& origin) {
+  const Vec3d at(local);
+  if (dot(at, at) <= kMaxFrameReach * kMaxFrameReach) return;
+  throw InputError(fmt::format(
+      "{}: face {}: vertex {} lies {:.0f} m from the frame origin ({:.3f}, {:.3f}, {:.3f}), beyond the {:.0f} m "
+      "one frame of floats holds (a corrupt first vertex, or acquisitions in different CRSs?)",
+      path.string(), face, v, norm(at), origin.x, origin.y, origin.z, kMaxFrameReach));
+}
+
+namespace {
 
 void append_faces(Mesh& mesh, const PlyFaceChunk& chunk, std::uint32_t acquisition) {
   for (std::size_t t = 0; t < chunk.triangles.size(); ++t) {
@@ -51,17 +61,9 @@ std::uint64_t drop_zero_area(Mesh& mesh, std::span<const Vec3d> absolute, double
 /// than the first), or has an edge longer than kMaxReach. Unused vertices are not checked:
 /// they never reach a result. The frame comes first: beyond it the corners are not the file's.
 void check_faces(const std::filesystem::path& path, const Mesh& mesh) {
-  constexpr double kFrameSq = kMaxFrameReach * kMaxFrameReach;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
     const std::uint64_t face = mesh.triangle_ids[t].face;
-    for (const std::uint32_t v : mesh.triangles[t]) {
-      const Vec3d local(mesh.positions[v]);
-      if (dot(local, local) <= kFrameSq) continue;
-      throw InputError(fmt::format(
-          "{}: face {}: vertex {} lies {:.0f} m from the frame origin ({:.3f}, {:.3f}, {:.3f}), beyond the {:.0f} m "
-          "one frame of floats holds (a corrupt first vertex, or acquisitions in different CRSs?)",
-          path.string(), face, v, norm(local), mesh.origin.x, mesh.origin.y, mesh.origin.z, kMaxFrameReach));
-    }
+    for (const std::uint32_t v : mesh.triangles[t]) check_frame_reach(path, face, v, mesh.positions[v], mesh.origin);
     const std::array<Vec3d, 3> c = mesh.corners(t);
     check_face_extent(path, face, c[0], c[1], c[2]);
   }
@@ -87,7 +89,7 @@ MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams
         mesh.origin = whole_metre_origin(vertices.positions.front());
         origin_set = true;
       }
-      append_vertices(mesh, vertices);
+      append_vertex_chunk(mesh, vertices);
       absolute.insert(absolute.end(), vertices.positions.begin(), vertices.positions.end());
     } else {
       append_faces(mesh, faces, params.acquisition);

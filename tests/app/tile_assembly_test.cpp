@@ -159,5 +159,35 @@ TEST(LabelSpill, LabelsAddedInPiecesComeBackByIndexAndGapsOrRepeatsAreRefused) {
   EXPECT_THROW((void)spill.read(4, 3), ProcessingError);
 }
 
+TEST(LabelSpill, WindowsOfTheLabelsAreSlicesOfTheWholeAndAGapInOneIsRefused) {
+  test::TempDir tmp;
+  std::filesystem::create_directories(tmp / "spill");
+  LabelSpill spill(tmp / "spill");
+  std::vector<LabelSpill::Label> all;
+  for (std::uint32_t t = 0; t < 200000; ++t) {  // more than one read of the file
+    all.push_back({t, static_cast<std::uint8_t>(t % 29), static_cast<std::uint16_t>(t % 5), static_cast<std::uint16_t>(t % 9)});
+  }
+  std::vector<LabelSpill::Label> shuffled = all;
+  std::shuffle(shuffled.begin(), shuffled.end(), std::minstd_rand(8));
+  spill.add(1, shuffled);
+  const std::vector<LabelSpill::Label> whole = spill.read(1, all.size());
+  for (const auto& [begin, end] : {std::pair{0u, 1u}, std::pair{1u, 70001u}, std::pair{70001u, 200000u},
+                                   std::pair{5u, 5u}}) {
+    const std::vector<LabelSpill::Label> window = spill.read(1, all.size(), begin, end);
+    ASSERT_EQ(window.size(), end - begin);
+    for (std::size_t i = 0; i < window.size(); ++i) {
+      EXPECT_EQ(window[i].index, begin + i);
+      EXPECT_EQ(window[i].flags, whole[begin + i].flags);
+      EXPECT_EQ(window[i].last, whole[begin + i].last);
+    }
+  }
+  EXPECT_THROW((void)spill.read(1, all.size(), 10, 200001), ProcessingError);  // past the end
+  // Triangle 1 twice and 2 never: a window holding 2 but not the repeat still sees the gap.
+  spill.add(4, std::span(all).subspan(0, 2));
+  spill.add(4, std::span(all).subspan(1, 1));
+  EXPECT_THROW((void)spill.read(4, 3, 2, 3), ProcessingError);
+  EXPECT_EQ(spill.read(4, 3, 0, 1).size(), 1u);  // triangle 0 alone is labelled once
+}
+
 }  // namespace
 }  // namespace citymesh::app

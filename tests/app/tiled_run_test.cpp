@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
+#include "citymesh/io/mesh_io.h"
+#include "citymesh/io/ply_writer.h"
 #include "mosaic_ply.h"
 #include "test_support.h"
 
@@ -85,6 +87,53 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   }
   EXPECT_GT(detect["seconds"]["consistency"].get<double>(), 0.0);
   EXPECT_GT(detect["seconds"]["detect_total"].get<double>(), detect["seconds"]["conflicts"].get<double>());
+}
+
+/// The source_face column of a labelled PLY.
+std::vector<double> source_faces_of(const std::filesystem::path& ply) {
+  PlyReadParams params;
+  params.extra_face_properties = {"source_face"};
+  PlyReader reader(ply, params);
+  PlyVertexChunk vertices;
+  PlyFaceChunk faces;
+  std::vector<double> out;
+  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end; kind = reader.next(vertices, faces)) {
+    if (kind == PlyReader::ChunkKind::faces) out.insert(out.end(), faces.extras[0].begin(), faces.extras[0].end());
+  }
+  return out;
+}
+
+TEST(TiledRun, AZeroAreaInputTriangleIsDroppedAlikeByTheTilerAndTheLabelledPlys) {
+  // The labelled PLYs read each file again: they must leave out the triangles the tiler left
+  // out, or the labels of every later triangle are shifted (the run used to stop there).
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const std::filesystem::path acquisition = dir / "sim/acq_2.ply";
+  Mesh m = read_mesh(acquisition).mesh;
+  const std::size_t triangles = m.triangle_count(), middle = triangles / 2;
+  // A copy of vertex 0 and, midway through the faces, a face on vertices 0, 1 and the copy.
+  const auto copy = static_cast<std::uint32_t>(m.vertex_count());
+  m.positions.push_back(m.positions[0]);
+  m.sensor_positions.push_back(m.sensor_positions[0]);
+  if (!m.times.empty()) m.times.push_back(m.times[0]);
+  if (!m.intensities.empty()) m.intensities.push_back(m.intensities[0]);
+  if (!m.colors.empty()) m.colors.push_back(m.colors[0]);
+  m.triangles.insert(m.triangles.begin() + static_cast<std::ptrdiff_t>(middle), Triangle{0, 1, copy});
+  m.triangle_ids.insert(m.triangle_ids.begin() + static_cast<std::ptrdiff_t>(middle), TriangleId{});
+  write_mesh_ply(acquisition, m);
+
+  const auto run = test::run_citymesh(run_args(sim, "z", "--set tiling.tile_size=10"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.err.find("acq_2.ply: dropped 1 zero-area triangles"), std::string::npos) << run.err;
+  const nlohmann::json summary = read_json(dir / "sim/z/detect/summary.json");
+  EXPECT_EQ(summary["acquisitions"][2]["triangles"].get<std::size_t>(), triangles);
+  // Face by face in file order, without the degenerate one.
+  const std::vector<double> faces = source_faces_of(dir / "sim/z/detect/2_epoch 2.ply");
+  ASSERT_EQ(faces.size(), triangles);
+  for (std::size_t t = 0; t < triangles; ++t) {
+    ASSERT_EQ(faces[t], static_cast<double>(t < middle ? t : t + 1)) << "triangle " << t;
+  }
 }
 
 TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {

@@ -32,6 +32,16 @@ struct MeshReadResult {
   std::uint64_t zero_area_dropped = 0;
 };
 
+/// Appends `chunk`'s vertices to `mesh`, moved into its frame (mesh.origin).
+void append_vertex_chunk(Mesh& mesh, const PlyVertexChunk& chunk);
+
+/// Throws InputError naming `file`, `face` and vertex `v` when `local`, its position in the
+/// frame whose origin is `origin`, lies beyond kMaxFrameReach (its float position has lost its
+/// millimetres, or is infinite: a corrupt first vertex, which sets the origin, or an
+/// acquisition in another CRS than the first).
+void check_frame_reach(const std::filesystem::path& file, std::uint64_t face, std::uint64_t v, const Vec3f& local,
+                       const Vec3d& origin);
+
 /// Reads every vertex and triangle of `path`. Throws InputError naming the file and row, also
 /// when a vertex a face uses lies beyond kMaxFrameReach of the origin.
 MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams& params = {});

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: MIT
+#include "tiled_detect_output.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
+#include "citymesh/core/log.h"
+#include "citymesh/io/mesh_io.h"
+#include "citymesh/io/ply_reader.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// Labels expanded from the spill at a time (about 32 bytes each while held).
+constexpr std::uint64_t kLabelWindow = std::uint64_t{1} << 20;
+/// Triangles handed to the writer at a time.
+constexpr std::size_t kTriangleBatch = std::size_t{1} << 16;
+
+/// An acquisition's triangles in file order (the degenerate ones left out, as the tiler left
+/// them out), handed to the writer in batches with their labels, which come from the spill a
+/// window at a time.
+class LabelledTriangles {
+ public:
+  LabelledTriangles(const TileAssembly& assembly, std::size_t k, std::filesystem::path file,
+                    LabelledAcquisitionWriter& out)
+      : assembly_(assembly), k_(k), labelled_(assembly.triangle_count(k)), file_(std::move(file)), out_(out) {}
+
+  void add(const Triangle& triangle, std::uint64_t face) {
+    ++seen_;
+    if (seen_ > labelled_) return;  // the file changed since its tiling: finish() says so
+    triangles_.push_back(triangle);
+    faces_.push_back(static_cast<std::int32_t>(face));
+    if (triangles_.size() >= kTriangleBatch) flush();
+  }
+
+  /// Throws InputError when the file no longer has the triangles the tiles labelled.
+  void finish() {
+    if (seen_ != labelled_) {
+      throw InputError(fmt::format("{}: {} triangles now, {} labelled (run with --force)", file_.string(), seen_,
+                                   labelled_));
+    }
+    flush();
+  }
+
+ private:
+  void flush() {
+    if (triangles_.empty()) return;
+    const std::uint64_t n = triangles_.size();
+    if (next_ + n > window_end_) {
+      window_begin_ = next_;
+      window_end_ = std::min(labelled_, next_ + std::max<std::uint64_t>(kLabelWindow, n));
+      window_ = ChangeResult{};  // the previous window's memory goes first
+      window_ = assembly_.labels(k_, window_begin_, window_end_);
+    }
+    out_.add_triangles(triangles_, faces_, label_view(window_, next_ - window_begin_, next_ - window_begin_ + n));
+    next_ += n;
+    triangles_.clear();
+    faces_.clear();
+  }
+
+  const TileAssembly& assembly_;
+  std::size_t k_;
+  std::uint64_t labelled_;
+  std::filesystem::path file_;
+  LabelledAcquisitionWriter& out_;
+  std::uint64_t seen_ = 0, next_ = 0;
+  std::vector<Triangle> triangles_;
+  std::vector<std::int32_t> faces_;
+  ChangeResult window_;
+  std::uint64_t window_begin_ = 0, window_end_ = 0;
+};
+
+/// Throws InputError naming the file and face when it uses a vertex not read yet.
+void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
+                         std::size_t read) {
+  for (const std::uint32_t v : triangle) {
+    if (v >= read) {
+      throw InputError(fmt::format("{}: face {} uses vertex {} before the vertices are read (put the vertex element "
+                                   "first)",
+                                   file.string(), face, v));
+    }
+  }
+}
+
+}  // namespace
+
+TiledDetectOutput::TiledDetectOutput(const Config& config, const LoadedAcquisitions& described,
+                                     const TileAssembly& assembly)
+    : config_(config), described_(described), assembly_(assembly) {}
+
+TiledDetectOutput::~TiledDetectOutput() = default;
+
+LabelledOutputParams TiledDetectOutput::layout(std::size_t k) {
+  const Acquisition& a = described_.acquisitions[k];
+  reader_.reset();
+  reader_ = std::make_unique<PlyReader>(a.path, config_.ply_read_params());
+  check_provenance_ids(a.path, reader_->face_count());
+  const PlyVertexLayout& has = reader_->vertex_layout();
+  LabelledOutputParams p;
+  p.has = {.sensors = has.has_sensor_origin, .times = has.has_time, .intensities = has.has_intensity,
+           .colors = has.has_color};
+  p.vertices = reader_->vertex_count();
+  p.triangles = assembly_.triangle_count(k);
+  return p;
+}
+
+void TiledDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
+  PlyReader& reader = *reader_;
+  const std::filesystem::path& file = reader.path();
+  std::vector<Vec3d> absolute;  // the file's coordinates, to find the degenerate triangles
+  absolute.reserve(reader.vertex_count());
+  LabelledTriangles triangles(assembly_, k, file, out);
+  std::uint64_t degenerate = 0;
+  PlyVertexChunk vertices;
+  PlyFaceChunk faces;
+  Mesh chunk;
+  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;
+       kind = reader.next(vertices, faces)) {
+    throw_if_interrupted("the labelled PLYs");
+    if (kind == PlyReader::ChunkKind::vertices) {
+      if (vertices.positions.empty()) continue;
+      if (!origin_) origin_ = whole_metre_origin(vertices.positions.front());
+      chunk = Mesh{};
+      chunk.origin = *origin_;
+      append_vertex_chunk(chunk, vertices);
+      out.add_vertices(chunk, 0, chunk.vertex_count());
+      absolute.insert(absolute.end(), vertices.positions.begin(), vertices.positions.end());
+      continue;
+    }
+    for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
+      const Triangle& tri = faces.triangles[t];
+      const std::uint64_t face = faces.faces[t];
+      check_vertices_read(file, face, tri, absolute.size());
+      const Vec3d &a = absolute[tri[0]], &b = absolute[tri[1]], &c = absolute[tri[2]];
+      for (const std::uint32_t v : tri) check_frame_reach(file, face, v, to_local(absolute[v], *origin_), *origin_);
+      check_face_extent(file, face, a, b, c);
+      if (degenerate_input_triangle(a, b, c)) {
+        ++degenerate;
+        continue;
+      }
+      triangles.add(tri, face);
+    }
+  }
+  triangles.finish();
+  if (degenerate > 0) log::info("{}: dropped {} zero-area triangles", file.string(), degenerate);
+  log::info("{}: {} triangles", file.string(), assembly_.triangle_count(k));
+  reader_.reset();
+}
+
+std::uint64_t TiledDetectOutput::write_pairs(const std::filesystem::path& path) {
+  reader_.reset();
+  return assembly_.write_pairs(path, kPairsMagic);
+}
+
+}  // namespace citymesh::app
