@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -159,12 +160,15 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   return out;
 }
 
-/// Parts cut out and stitched at a time: their memory is what a level adds.
-constexpr std::size_t kPartsInFlight = 8;
+/// At most this many parts are cut out and stitched at a time, whatever the threads: their
+/// memory is what a level adds (the city's largest part with its surroundings: ~30 MB).
+constexpr unsigned kMaxPartsInFlight = 16;
 
-/// Stitches the parts of one level, a few at a time, in parallel. Each sees the others of its
-/// level as they were before the level (never as stitched), so that the output is the same
-/// for any thread count and any number in flight.
+/// Stitches the parts of one level in parallel, one per worker thread at a time, each worker
+/// taking the next part as soon as it is done with one (no wait for the slowest of a batch).
+/// Each part sees the others of its level as they were before the level (never as stitched),
+/// and the outcomes are summed in part order, so that the output is the same for any thread
+/// count and any number in flight.
 void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, const PartStitchRun& run,
                   double context, BlockStitchStats& stats) {
   const PartFinder finder(parts, run.blocks, level);
@@ -172,20 +176,30 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (parts[i].key.level == level) of_level.push_back(i);
   }
-  for (std::size_t first = 0; first < of_level.size(); first += kPartsInFlight) {
-    throw_if_interrupted("the seam pass");
-    const std::size_t count = std::min(kPartsInFlight, of_level.size() - first);
-    std::vector<PartOutcome> outcomes(count);
-    parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        outcomes[i] = stitch_one(parts, of_level[first + i], level, finder, store, run, context);
+  std::vector<PartOutcome> outcomes(of_level.size());
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};  // one worker's error stops the others after their part
+  const auto workers = static_cast<unsigned>(
+      std::min<std::size_t>({of_level.size(), available_threads(), kMaxPartsInFlight}));
+  // Isolated workers: a thread waiting inside one part's parallel loops never starts another
+  // part, so the parts in flight stay at `workers`.
+  if (workers > 0) {
+    parallel_workers(workers, [&](unsigned /*worker*/) {
+      try {
+        for (std::size_t i = next++; i < of_level.size() && !failed; i = next++) {
+          throw_if_interrupted("the seam pass");
+          outcomes[i] = stitch_one(parts, of_level[i], level, finder, store, run, context);
+        }
+      } catch (...) {
+        failed = true;
+        throw;
       }
     });
-    for (std::size_t i = 0; i < count; ++i) {
-      parts[of_level[first + i]].stitched_box = outcomes[i].box;
-      stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);
-      add_counts(stats.stitch, outcomes[i].stats);
-    }
+  }
+  for (std::size_t i = 0; i < of_level.size(); ++i) {
+    parts[of_level[i]].stitched_box = outcomes[i].box;
+    stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);
+    add_counts(stats.stitch, outcomes[i].stats);
   }
   stats.parts[static_cast<std::size_t>(level)] = of_level.size();
 }
