@@ -112,13 +112,7 @@ class AcquisitionTiler {
       }
       for (std::size_t t = 0; t < faces.triangles.size(); ++t) {
         const Triangle& tri = faces.triangles[t];
-        for (const std::uint32_t v : tri) {
-          if (v >= vertices_.positions.size()) {
-            throw InputError(fmt::format("{}: face {} uses vertex {} before the vertices are read (put the vertex "
-                                         "element first)",
-                                         file.string(), faces.faces[t], v));
-          }
-        }
+        check_vertices_read(file, faces.faces[t], tri, vertices_.positions.size());
         if (!add_triangle({tri, faces.fans[t], faces.faces[t], next_index_}, file)) continue;
         ++next_index_;
         if (batch_bytes() > buffer_bytes_ || batch_.size() >= kMaxBatchTriangles) flush();

@@ -36,8 +36,7 @@ nlohmann::json counts_json(const StateCounts& c) {
 LabelledOutputParams InMemoryDetectOutput::layout(std::size_t k) {
   const Mesh& mesh = input_.meshes[k];
   LabelledOutputParams p;
-  p.has = {.sensors = mesh.has_sensor_positions(), .times = !mesh.times.empty(),
-           .intensities = !mesh.intensities.empty(), .colors = !mesh.colors.empty()};
+  p.has = vertex_attributes(mesh);
   p.vertices = mesh.vertex_count();
   p.triangles = mesh.triangle_count();
   return p;

@@ -114,16 +114,11 @@ LabelledAcquisitionWriter::~LabelledAcquisitionWriter() = default;
 
 void LabelledAcquisitionWriter::add_vertices(const Mesh& chunk, std::size_t begin, std::size_t end) {
   Impl& w = *impl_;
-  const MeshVertexAttributes& has = w.params.has;
   if (w.vertices == 0) w.origin = chunk.origin;
   if (chunk.origin != w.origin) throw ProcessingError(fmt::format("{}: vertices in two frames", w.params.ply.string()));
   for (std::size_t b = begin; b < end; b += kVertexRows) {
-    MeshVertexRows rows(has);
-    for (std::size_t v = b; v < std::min(end, b + kVertexRows); ++v) {
-      rows.add(chunk.world_position(v), has.sensors ? chunk.world_sensor_position(v) : Vec3d{},
-               has.times ? chunk.times[v] : 0.0, has.intensities ? chunk.intensities[v] : 0.0f,
-               has.colors ? chunk.colors[v] : Rgb8{});
-    }
+    // Rows of other attributes than the layout's are refused by the PLY writer.
+    const MeshVertexRows rows = mesh_vertex_rows(chunk, b, std::min(end, b + kVertexRows));
     w.ply.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
   }
   w.vertices += end - begin;

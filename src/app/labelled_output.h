@@ -33,7 +33,7 @@ class LabelledAcquisitionWriter {
   LabelledAcquisitionWriter& operator=(const LabelledAcquisitionWriter&) = delete;
 
   /// The next vertices: [begin, end) of `chunk` (its positions relative to its origin, which
-  /// is the same for every chunk, and the attributes `has` names).
+  /// is the same for every chunk, and the attributes `has` names: other ones are refused).
   void add_vertices(const Mesh& chunk, std::size_t begin, std::size_t end);
   /// The next triangles, on the vertices added so far, with the face index of each in its
   /// file and their labels. Throws ProcessingError when the sizes disagree.

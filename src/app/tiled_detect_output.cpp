@@ -15,8 +15,12 @@ namespace citymesh::app {
 
 namespace {
 
-/// Labels expanded from the spill at a time (about 32 bytes each while held).
+/// Labels expanded from the spill at a time (about 32 bytes each while held), at least.
 constexpr std::uint64_t kLabelWindow = std::uint64_t{1} << 20;
+/// Each window reads the whole spill file (its labels come in tile order): a window of at
+/// least this fraction of the acquisition keeps that to a few reads, not one per 2^20
+/// triangles (~4 bytes per triangle held on a large acquisition, where the tiler held ~30).
+constexpr std::uint64_t kMaxLabelReads = 8;
 /// Triangles handed to the writer at a time.
 constexpr std::size_t kTriangleBatch = std::size_t{1} << 16;
 
@@ -27,7 +31,12 @@ class LabelledTriangles {
  public:
   LabelledTriangles(const TileAssembly& assembly, std::size_t k, std::filesystem::path file,
                     LabelledAcquisitionWriter& out)
-      : assembly_(assembly), k_(k), labelled_(assembly.triangle_count(k)), file_(std::move(file)), out_(out) {}
+      : assembly_(assembly),
+        k_(k),
+        labelled_(assembly.triangle_count(k)),
+        window_size_(std::max(kLabelWindow, (labelled_ + kMaxLabelReads - 1) / kMaxLabelReads)),
+        file_(std::move(file)),
+        out_(out) {}
 
   void add(const Triangle& triangle, std::uint64_t face) {
     ++seen_;
@@ -52,7 +61,7 @@ class LabelledTriangles {
     const std::uint64_t n = triangles_.size();
     if (next_ + n > window_end_) {
       window_begin_ = next_;
-      window_end_ = std::min(labelled_, next_ + std::max<std::uint64_t>(kLabelWindow, n));
+      window_end_ = std::min(labelled_, next_ + std::max<std::uint64_t>(window_size_, n));
       window_ = ChangeResult{};  // the previous window's memory goes first
       window_ = assembly_.labels(k_, window_begin_, window_end_);
     }
@@ -65,6 +74,7 @@ class LabelledTriangles {
   const TileAssembly& assembly_;
   std::size_t k_;
   std::uint64_t labelled_;
+  std::uint64_t window_size_;  ///< labels read from the spill at a time
   std::filesystem::path file_;
   LabelledAcquisitionWriter& out_;
   std::uint64_t seen_ = 0, next_ = 0;
@@ -73,18 +83,6 @@ class LabelledTriangles {
   ChangeResult window_;
   std::uint64_t window_begin_ = 0, window_end_ = 0;
 };
-
-/// Throws InputError naming the file and face when it uses a vertex not read yet.
-void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
-                         std::size_t read) {
-  for (const std::uint32_t v : triangle) {
-    if (v >= read) {
-      throw InputError(fmt::format("{}: face {} uses vertex {} before the vertices are read (put the vertex element "
-                                   "first)",
-                                   file.string(), face, v));
-    }
-  }
-}
 
 }  // namespace
 

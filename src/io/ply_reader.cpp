@@ -509,4 +509,15 @@ void check_face_extent(const std::filesystem::path& file, std::uint64_t face, co
   }
 }
 
+void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
+                         std::uint64_t read) {
+  for (const std::uint32_t v : triangle) {
+    if (v >= read) {
+      throw InputError(fmt::format("{}: face {} uses vertex {} before the vertices are read (put the vertex element "
+                                   "first)",
+                                   file.string(), face, v));
+    }
+  }
+}
+
 }  // namespace citymesh

@@ -242,15 +242,25 @@ std::vector<PlyColumn> MeshVertexRows::columns() const {
   return c;
 }
 
+MeshVertexAttributes vertex_attributes(const Mesh& mesh) {
+  return {.sensors = mesh.has_sensor_positions(), .times = !mesh.times.empty(),
+          .intensities = !mesh.intensities.empty(), .colors = !mesh.colors.empty()};
+}
+
+MeshVertexRows mesh_vertex_rows(const Mesh& mesh, std::size_t begin, std::size_t end) {
+  const MeshVertexAttributes has = vertex_attributes(mesh);
+  MeshVertexRows rows(has);
+  for (std::size_t v = begin; v < end; ++v) {
+    rows.add(mesh.world_position(v), has.sensors ? mesh.world_sensor_position(v) : Vec3d{},
+             has.times ? mesh.times[v] : 0.0, has.intensities ? mesh.intensities[v] : 0.0f,
+             has.colors ? mesh.colors[v] : Rgb8{});
+  }
+  return rows;
+}
+
 void write_mesh_ply(const std::filesystem::path& path, const Mesh& mesh, std::vector<PlyColumn> face_columns) {
   mesh.check_invariants();
-  MeshVertexRows rows({.sensors = mesh.has_sensor_positions(), .times = !mesh.times.empty(),
-                       .intensities = !mesh.intensities.empty(), .colors = !mesh.colors.empty()});
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
-    rows.add(mesh.world_position(v), mesh.has_sensor_positions() ? mesh.world_sensor_position(v) : Vec3d{},
-             mesh.times.empty() ? 0.0 : mesh.times[v], mesh.intensities.empty() ? 0.0f : mesh.intensities[v],
-             mesh.colors.empty() ? Rgb8{} : mesh.colors[v]);
-  }
+  const MeshVertexRows rows = mesh_vertex_rows(mesh, 0, mesh.vertex_count());
   write_ply(path, {rows.positions, mesh.triangles, rows.columns(), std::move(face_columns), {std::string(kPlyComment)}});
 }
 

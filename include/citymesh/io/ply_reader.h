@@ -75,6 +75,11 @@ inline void check_face_extent(const std::filesystem::path& file, std::uint64_t f
   if (!(dot(diagonal, diagonal) <= kMaxReach * kMaxReach)) check_face_extent(file, face, a, b, c);
 }
 
+/// Throws InputError naming `file` and `face` when `triangle` uses a vertex beyond the first
+/// `read` (a reader that streams faces as they come needs the vertex element first).
+void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
+                         std::uint64_t read);
+
 /// Triangles from consecutive faces; polygons are fan-triangulated, faces that repeat a vertex
 /// are dropped (and counted). Each triangle keeps its face index and fan number.
 struct PlyFaceChunk {

@@ -89,6 +89,12 @@ class MeshVertexRows {
   std::vector<std::uint8_t> red_, green_, blue_;
 };
 
+/// The optional vertex attributes `mesh` carries.
+MeshVertexAttributes vertex_attributes(const Mesh& mesh);
+
+/// Rows of `mesh`'s vertices [begin, end), absolute, with the attributes it carries.
+MeshVertexRows mesh_vertex_rows(const Mesh& mesh, std::size_t begin, std::size_t end);
+
 /// Writes a mesh in the input format of citymesh (DESIGN §3): x, y, z and x_origin, y_origin,
 /// z_origin as double, gps_time, intensity and colour when present, plus `face_columns`.
 void write_mesh_ply(const std::filesystem::path& path, const Mesh& mesh,
