@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <atomic>
 #include <map>
 #include <span>
 
@@ -355,12 +354,8 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
   std::filesystem::create_directories(params.dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", params.dir.string(), ec.message()));
   std::vector<AcquisitionTiling> parts(acquisitions.size());
-  std::atomic<std::size_t> next{0};
-  parallel_workers(std::max(at_once, 1u), [&](unsigned) {
-    for (std::size_t k = next++; k < acquisitions.size(); k = next++) {
-      parts[k] = tile_acquisition(acquisitions[k], params, "");
-    }
-  });
+  parallel_jobs(acquisitions.size(), at_once,
+                [&](std::size_t k) { parts[k] = tile_acquisition(acquisitions[k], params, ""); });
   return assemble_tile_store(params.dir, params.grid, parts, "");
 }
 

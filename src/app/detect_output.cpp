@@ -5,11 +5,16 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/render/render.h"
 
 namespace citymesh::app {
 
@@ -57,6 +62,45 @@ std::uint64_t InMemoryDetectOutput::write_pairs(const std::filesystem::path& pat
   return result_.consistent_pairs.size();
 }
 
+namespace {
+
+/// One acquisition's labelled PLY and picture, and its entry in the summary.
+struct AcquisitionOutputs {
+  nlohmann::json entry;
+  StateCounts counts;
+};
+
+AcquisitionOutputs write_acquisition_outputs(const Config& config, const LoadedAcquisitions& described,
+                                             DetectOutputSource& source, const DetectOutputParams& params,
+                                             std::size_t k) {
+  const std::string stem = file_stem(config, k);
+  LabelledOutputParams files = source.layout(k);
+  files.ply = params.dir / (stem + ".ply");
+  if (params.pictures) files.png = params.dir / (stem + ".png");
+  files.pixel_size = params.pixel_size;
+  LabelledAcquisitionWriter out(files);
+  source.feed(k, out);
+  AcquisitionOutputs done{acquisition_json(config, described, k), out.finish()};
+  done.entry["ply"] = stem + ".ply";
+  done.entry["png"] = params.pictures ? stem + ".png" : "";
+  done.entry["triangles"] = files.triangles;
+  done.entry["counts"] = counts_json(done.counts);
+  return done;
+}
+
+}  // namespace
+
+std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_per_vertex, bool pictures) {
+  const std::uint64_t side = ViewParams{}.max_side;
+  constexpr std::uint64_t kPixelBytes = sizeof(Rgb8) + sizeof(float);  // the picture and its depth
+  return vertices * bytes_per_vertex + (pictures ? side * side * kPixelBytes : 0);
+}
+
+unsigned labelled_output_workers(std::uint64_t largest, std::uint64_t memory) {
+  const std::uint64_t fits = memory / std::max<std::uint64_t>(largest, 1);
+  return static_cast<unsigned>(std::clamp<std::uint64_t>(fits, 1, available_threads()));
+}
+
 void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,
                           const DetectOutputParams& params) {
   Stopwatch clock;
@@ -66,27 +110,30 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
   summary["policy"] = unconfirmed_policy_name(config.change.unconfirmed);
   summary["empty_space"] = empty_space_reach_name(config.change.empty_space);
   summary["sustainability"] = format_duration(config.change.sustainability);
+  // Job 0 writes the pairs, job k + 1 acquisition k's files: each job its own files, so the
+  // bytes depend neither on the order nor on how many run at once. The pairs come first, as
+  // the longest job.
+  const std::size_t n = described.acquisitions.size();
+  std::vector<AcquisitionOutputs> written(n);
+  std::uint64_t pairs = 0;
+  parallel_jobs(n + 1, params.at_once, [&](std::size_t job) {
+    throw_if_interrupted("the change step's outputs");
+    Stopwatch job_clock;
+    if (job == 0) {
+      pairs = source.write_pairs(params.dir / kPairsFile);
+      log::debug("{}: {} pairs in {:.2f} s", kPairsFile, pairs, job_clock.seconds());
+    } else {
+      written[job - 1] = write_acquisition_outputs(config, described, source, params, job - 1);
+      log::debug("labelled outputs of {} in {:.2f} s", file_stem(config, job - 1), job_clock.seconds());
+    }
+  });
   StateCounts totals;
   std::uint64_t triangles = 0;
-  for (std::size_t k = 0; k < described.acquisitions.size(); ++k) {
-    const std::string stem = file_stem(config, k);
-    LabelledOutputParams files = source.layout(k);
-    files.ply = params.dir / (stem + ".ply");
-    if (params.pictures) files.png = params.dir / (stem + ".png");
-    files.pixel_size = params.pixel_size;
-    LabelledAcquisitionWriter out(files);
-    source.feed(k, out);
-    const StateCounts counts = out.finish();
-    nlohmann::json entry = acquisition_json(config, described, k);
-    entry["ply"] = stem + ".ply";
-    entry["png"] = params.pictures ? stem + ".png" : "";
-    entry["triangles"] = files.triangles;
-    entry["counts"] = counts_json(counts);
-    totals += counts;
-    triangles += files.triangles;
-    summary["acquisitions"].push_back(std::move(entry));
+  for (AcquisitionOutputs& w : written) {
+    totals += w.counts;
+    triangles += w.entry["triangles"].get<std::uint64_t>();
+    summary["acquisitions"].push_back(std::move(w.entry));
   }
-  const std::uint64_t pairs = source.write_pairs(params.dir / kPairsFile);
   summary["pairs"] = kPairsFile;
   const ChangeStats s = source.stats();
   summary["totals"] = counts_json(totals);

@@ -25,12 +25,15 @@ struct DetectOutputParams {
   double pixel_size = 0.05;   ///< metres per pixel of the PNGs
   bool pictures = true;
   double read_seconds = 0;
+  unsigned at_once = 1;  ///< acquisitions written at once (see labelled_output_workers)
 };
 
-/// What the change step's outputs are written from, one acquisition at a time and in order:
-/// `citymesh detect` has every mesh and label in memory; a tiled run reads each acquisition's
-/// file again, front to back, with its labels from the tiles (a city's inputs and labels do
-/// not fit in memory; one acquisition with its labels need not either).
+/// What the change step's outputs are written from, acquisition by acquisition: `citymesh
+/// detect` has every mesh and label in memory; a tiled run reads each acquisition's file
+/// again, front to back, with its labels from the tiles (a city's inputs and labels do not
+/// fit in memory; one acquisition with its labels need not either). layout(k) then feed(k)
+/// are called once per acquisition, on one thread, but the calls for different acquisitions
+/// and write_pairs may run at the same time on other threads.
 class DetectOutputSource {
  public:
   virtual ~DetectOutputSource() = default;
@@ -46,15 +49,28 @@ class DetectOutputSource {
   [[nodiscard]] virtual ChangeStats stats() const = 0;
 };
 
+/// Bytes one acquisition's labelled outputs hold while they are written: `bytes_per_vertex`
+/// per vertex (the source's and the writer's) and, with pictures, the largest picture with
+/// its depth (ViewParams::max_side squared, 7 bytes per pixel: 470 MB).
+std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_per_vertex, bool pictures);
+
+/// How many acquisitions write_detect_outputs may write at once: one per thread while each,
+/// at `largest` bytes, fits in `memory` (what the budget leaves), and at least one.
+unsigned labelled_output_workers(std::uint64_t largest, std::uint64_t memory);
+
 /// Writes <dir>/<k>_<name>.ply and .png per acquisition, <dir>/pairs.bin and
-/// <dir>/summary.json (last), each atomically. `described`: the acquisitions and dates (its
-/// meshes are not used).
+/// <dir>/summary.json (last), each atomically; `params.at_once` of the files at a time (the
+/// same bytes for any number). `described`: the acquisitions and dates (its meshes are not
+/// used).
 void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,
                           const DetectOutputParams& params);
 
 /// `citymesh detect`'s source: the meshes and the result it has in memory.
 class InMemoryDetectOutput final : public DetectOutputSource {
  public:
+  /// Bytes the writer holds per vertex while an acquisition is fed (its positions, a slot).
+  static constexpr std::uint64_t kBytesPerVertex = 16;
+
   InMemoryDetectOutput(const LoadedAcquisitions& input, const ChangeResult& result) : input_(input), result_(result) {}
   LabelledOutputParams layout(std::size_t k) override;
   void feed(std::size_t k, LabelledAcquisitionWriter& out) override;

@@ -86,28 +86,53 @@ class LabelledTriangles {
 
 }  // namespace
 
+namespace {
+
+/// The frame whole-mesh reading puts every acquisition in: that of the first vertex of the
+/// first acquisition that has one (none: the origin).
+Vec3d shared_frame(const Config& config, const LoadedAcquisitions& described) {
+  PlyVertexChunk vertices;
+  PlyFaceChunk faces;
+  for (const Acquisition& a : described.acquisitions) {
+    PlyReader reader(a.path, config.ply_read_params());
+    for (auto kind = reader.next(vertices, faces); kind == PlyReader::ChunkKind::vertices;
+         kind = reader.next(vertices, faces)) {
+      if (!vertices.positions.empty()) return whole_metre_origin(vertices.positions.front());
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
 TiledDetectOutput::TiledDetectOutput(const Config& config, const LoadedAcquisitions& described,
                                      const TileAssembly& assembly)
-    : config_(config), described_(described), assembly_(assembly) {}
+    : config_(config),
+      described_(described),
+      assembly_(assembly),
+      origin_(shared_frame(config, described)),
+      readers_(described.acquisitions.size()) {}
 
 TiledDetectOutput::~TiledDetectOutput() = default;
 
 LabelledOutputParams TiledDetectOutput::layout(std::size_t k) {
   const Acquisition& a = described_.acquisitions[k];
-  reader_.reset();
-  reader_ = std::make_unique<PlyReader>(a.path, config_.ply_read_params());
-  check_provenance_ids(a.path, reader_->face_count());
-  const PlyVertexLayout& has = reader_->vertex_layout();
+  std::unique_ptr<PlyReader>& reader = readers_[k];
+  reader = std::make_unique<PlyReader>(a.path, config_.ply_read_params());
+  check_provenance_ids(a.path, reader->face_count());
+  const PlyVertexLayout& has = reader->vertex_layout();
   LabelledOutputParams p;
   p.has = {.sensors = has.has_sensor_origin, .times = has.has_time, .intensities = has.has_intensity,
            .colors = has.has_color};
-  p.vertices = reader_->vertex_count();
+  p.vertices = reader->vertex_count();
   p.triangles = assembly_.triangle_count(k);
   return p;
 }
 
 void TiledDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
-  PlyReader& reader = *reader_;
+  if (!readers_[k]) throw ProcessingError(fmt::format("labelled outputs: acquisition {} fed before its layout", k));
+  const std::unique_ptr<PlyReader> owned = std::move(readers_[k]);
+  PlyReader& reader = *owned;
   const std::filesystem::path& file = reader.path();
   std::vector<Vec3d> absolute;  // the file's coordinates, to find the degenerate triangles
   absolute.reserve(reader.vertex_count());
@@ -121,9 +146,8 @@ void TiledDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
     throw_if_interrupted("the labelled PLYs");
     if (kind == PlyReader::ChunkKind::vertices) {
       if (vertices.positions.empty()) continue;
-      if (!origin_) origin_ = whole_metre_origin(vertices.positions.front());
       chunk = Mesh{};
-      chunk.origin = *origin_;
+      chunk.origin = origin_;
       append_vertex_chunk(chunk, vertices);
       out.add_vertices(chunk, 0, chunk.vertex_count());
       absolute.insert(absolute.end(), vertices.positions.begin(), vertices.positions.end());
@@ -134,7 +158,7 @@ void TiledDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
       const std::uint64_t face = faces.faces[t];
       check_vertices_read(file, face, tri, absolute.size());
       const Vec3d &a = absolute[tri[0]], &b = absolute[tri[1]], &c = absolute[tri[2]];
-      for (const std::uint32_t v : tri) check_frame_reach(file, face, v, to_local(absolute[v], *origin_), *origin_);
+      for (const std::uint32_t v : tri) check_frame_reach(file, face, v, to_local(absolute[v], origin_), origin_);
       check_face_extent(file, face, a, b, c);
       if (degenerate_input_triangle(a, b, c)) {
         ++degenerate;
@@ -146,11 +170,9 @@ void TiledDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
   triangles.finish();
   if (degenerate > 0) log::info("{}: dropped {} zero-area triangles", file.string(), degenerate);
   log::info("{}: {} triangles", file.string(), assembly_.triangle_count(k));
-  reader_.reset();
 }
 
 std::uint64_t TiledDetectOutput::write_pairs(const std::filesystem::path& path) {
-  reader_.reset();
   return assembly_.write_pairs(path, kPairsMagic);
 }
 

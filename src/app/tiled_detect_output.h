@@ -4,7 +4,7 @@
 #pragma once
 
 #include <memory>
-#include <optional>
+#include <vector>
 
 #include "acquisitions.h"
 #include "detect_output.h"
@@ -14,9 +14,15 @@ namespace citymesh::app {
 
 /// Holds an acquisition's vertex positions (24 bytes each, to drop the degenerate triangles
 /// as the tiler did) and a window of its labels, never its triangles: what the labelled PLY
-/// and picture of an acquisition far larger than memory need.
+/// and picture of an acquisition far larger than memory need. Acquisitions may be fed on
+/// several threads at once (one reader each).
 class TiledDetectOutput final : public DetectOutputSource {
  public:
+  /// Bytes held per vertex while an acquisition is fed, with the writer's.
+  static constexpr std::uint64_t kBytesPerVertex = 48;
+
+  /// Reads the first vertices of the first acquisition that has any: every mesh shares their
+  /// frame, as whole-mesh reading gives it.
   TiledDetectOutput(const Config& config, const LoadedAcquisitions& described, const TileAssembly& assembly);
   ~TiledDetectOutput() override;
 
@@ -30,8 +36,8 @@ class TiledDetectOutput final : public DetectOutputSource {
   const Config& config_;
   const LoadedAcquisitions& described_;
   const TileAssembly& assembly_;
-  std::optional<Vec3d> origin_;  ///< the first acquisition's frame, which every mesh shares
-  std::unique_ptr<PlyReader> reader_;
+  Vec3d origin_;  ///< the first acquisition's frame, which every mesh shares
+  std::vector<std::unique_ptr<PlyReader>> readers_;  ///< per acquisition, from layout() to feed()
 };
 
 }  // namespace citymesh::app

@@ -14,6 +14,7 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/io/ply_reader.h"
 #include "detect_output.h"
 #include "leftovers.h"
 #include "mosaic_output.h"
@@ -38,11 +39,27 @@ LoadedAcquisitions describe_acquisitions(const Config& config) {
   return d;
 }
 
+/// How many acquisitions' labelled outputs are written at once: as many as the budget left
+/// holds, by their headers' vertex counts.
+unsigned labels_at_once(const Config& config, const LoadedAcquisitions& described, bool pictures) {
+  std::uint64_t largest = 0;
+  for (const Acquisition& a : described.acquisitions) {
+    const PlyReader header(a.path, config.ply_read_params());
+    largest = std::max(largest,
+                       labelled_output_bytes(header.vertex_count(), TiledDetectOutput::kBytesPerVertex, pictures));
+  }
+  const std::uint64_t resident = resident_bytes();
+  return labelled_output_workers(largest, config.run.memory > resident ? config.run.memory - resident : 0);
+}
+
 void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {
   const LoadedAcquisitions described = describe_acquisitions(config);
   TiledDetectOutput source(config, described, assembly);
   write_detect_outputs(config, described, source,
-                       {.dir = config.project.output / "detect", .pixel_size = pictures.pixel_size, .pictures = pictures.pictures});
+                       {.dir = config.project.output / "detect",
+                        .pixel_size = pictures.pixel_size,
+                        .pictures = pictures.pictures,
+                        .at_once = labels_at_once(config, described, pictures.pictures)});
 }
 
 

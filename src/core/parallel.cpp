@@ -11,6 +11,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <atomic>
 
 namespace citymesh {
 
@@ -62,6 +63,21 @@ void parallel_workers(unsigned workers, const std::function<void(unsigned)>& bod
         }
       },
       tbb::simple_partitioner());
+}
+
+void parallel_jobs(std::size_t count, unsigned workers, const std::function<void(std::size_t)>& job) {
+  const auto loops = static_cast<unsigned>(std::min<std::size_t>(count, std::max(workers, 1u)));
+  if (loops == 0) return;
+  std::atomic<std::size_t> next{0};
+  std::atomic<bool> failed{false};
+  parallel_workers(loops, [&](unsigned) {
+    try {
+      for (std::size_t i = next++; i < count && !failed; i = next++) job(i);
+    } catch (...) {
+      failed = true;
+      throw;
+    }
+  });
 }
 
 }  // namespace citymesh

@@ -177,25 +177,14 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
     if (parts[i].key.level == level) of_level.push_back(i);
   }
   std::vector<PartOutcome> outcomes(of_level.size());
-  std::atomic<std::size_t> next{0};
-  std::atomic<bool> failed{false};  // one worker's error stops the others after their part
-  const auto workers = static_cast<unsigned>(
-      std::min<std::size_t>({of_level.size(), available_threads(), kMaxPartsInFlight}));
   // Isolated workers: a thread waiting inside one part's parallel loops never starts another
-  // part, so the parts in flight stay at `workers`.
-  if (workers > 0) {
-    parallel_workers(workers, [&](unsigned /*worker*/) {
-      try {
-        for (std::size_t i = next++; i < of_level.size() && !failed; i = next++) {
-          throw_if_interrupted("the seam pass");
-          outcomes[i] = stitch_one(parts, of_level[i], level, finder, store, run, context);
-        }
-      } catch (...) {
-        failed = true;
-        throw;
-      }
-    });
-  }
+  // part, so the parts in flight stay at most one per thread. One part's error stops the
+  // others after their current part.
+  const unsigned workers = std::min(available_threads(), kMaxPartsInFlight);
+  parallel_jobs(of_level.size(), workers, [&](std::size_t i) {
+    throw_if_interrupted("the seam pass");
+    outcomes[i] = stitch_one(parts, of_level[i], level, finder, store, run, context);
+  });
   for (std::size_t i = 0; i < of_level.size(); ++i) {
     parts[of_level[i]].stitched_box = outcomes[i].box;
     stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);

@@ -2,9 +2,14 @@
 // The labelled PLY and picture written chunk by chunk are those of the whole mesh.
 #include <gtest/gtest.h>
 
+#include <fmt/format.h>
+
+#include <map>
+#include <nlohmann/json.hpp>
 #include <random>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/render/render.h"
 #include "detect_output.h"
@@ -129,6 +134,82 @@ TEST(LabelledAcquisitionWriter, RowsThatDoNotFitAreRefusedAndNothingIsLeft) {
   }
   EXPECT_FALSE(std::filesystem::exists(tmp / "labelled.ply"));
   EXPECT_FALSE(std::filesystem::exists(tmp / "labelled.png"));
+}
+
+
+/// Three random acquisitions with labels and pairs, as `citymesh detect` holds them.
+struct DetectFixture {
+  Config config;
+  LoadedAcquisitions input;
+  ChangeResult result;
+
+  DetectFixture() {
+    std::vector<ChangeResult> parts;
+    for (std::uint32_t k = 0; k < 3; ++k) {
+      const TimePoint date(Duration(std::int64_t{86400000} * (k + 1)));
+      config.acquisitions.push_back({fmt::format("/data/acq_{}.ply", k), date, fmt::format("epoch {}", k)});
+      input.acquisitions.push_back({k, date, config.acquisitions.back().path});
+      input.dates.push_back(date);
+      input.meshes.push_back(random_mesh(20 + k, 300 + 100 * k));
+      parts.push_back(random_labels(30 + k, input.meshes.back().triangle_count()));
+    }
+    result.index.offsets = {0};
+    for (const ChangeResult& p : parts) {
+      result.index.offsets.push_back(result.index.offsets.back() + p.state.size());
+      result.state.insert(result.state.end(), p.state.begin(), p.state.end());
+      result.first_seen.insert(result.first_seen.end(), p.first_seen.begin(), p.first_seen.end());
+      result.last_seen.insert(result.last_seen.end(), p.last_seen.begin(), p.last_seen.end());
+      result.sustainable.insert(result.sustainable.end(), p.sustainable.begin(), p.sustainable.end());
+      result.kept.insert(result.kept.end(), p.kept.begin(), p.kept.end());
+      result.refutes.insert(result.refutes.end(), p.refutes.begin(), p.refutes.end());
+    }
+    for (std::uint32_t t = 0; t + 700 < result.state.size(); t += 7) result.consistent_pairs.push_back({t, t + 700});
+  }
+};
+
+TEST(DetectOutputs, AcquisitionsWrittenAtOnceGiveTheBytesOfOneAtATime) {
+  const ThreadLimit limit(2);
+  const DetectFixture f;
+  test::TempDir tmp;
+  std::map<std::string, std::string> first;
+  for (const unsigned at_once : {1u, 2u, 8u}) {
+    const std::filesystem::path dir = tmp / fmt::format("at_once_{}", at_once);
+    InMemoryDetectOutput source(f.input, f.result);
+    write_detect_outputs(f.config, f.input, source, {.dir = dir, .pixel_size = 0.1, .at_once = at_once});
+    std::map<std::string, std::string> files;
+    for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+      nlohmann::json summary;
+      std::string bytes = test::read_text(entry.path());
+      if (entry.path().filename() == "summary.json") {  // without its timings
+        summary = nlohmann::json::parse(bytes);
+        summary.erase("seconds");
+        bytes = summary.dump();
+      }
+      files[entry.path().filename().string()] = std::move(bytes);
+    }
+    ASSERT_EQ(files.size(), 8u);  // three PLYs and PNGs, pairs, summary
+    if (first.empty()) {
+      first = files;
+    } else {
+      EXPECT_TRUE(files == first) << at_once << " at once differ from one at a time";
+    }
+  }
+  const nlohmann::json summary = nlohmann::json::parse(first["summary.json"]);
+  EXPECT_EQ(summary["consistent_pairs"].get<std::size_t>(), f.result.consistent_pairs.size());
+  EXPECT_EQ(summary["totals"]["triangles"].get<std::size_t>(), f.result.state.size());
+  EXPECT_EQ(summary["acquisitions"][2]["name"], "epoch 2");
+}
+
+TEST(DetectOutputs, AsManyAtOnceAsTheBudgetHolds) {
+  const ThreadLimit limit(2);
+  // With pictures, the largest picture with its depth is held whatever the vertices.
+  const std::uint64_t picture = labelled_output_bytes(0, 48, true);
+  EXPECT_EQ(picture, 8192ull * 8192 * 7);
+  EXPECT_EQ(labelled_output_bytes(1000, 48, false), 48000u);
+  EXPECT_EQ(labelled_output_workers(picture + 48000, 2 * picture), 1u);
+  EXPECT_EQ(labelled_output_workers(picture + 48000, 3 * picture), 2u);
+  EXPECT_EQ(labelled_output_workers(48000, 1 << 30), 2u);  // never more than the threads
+  EXPECT_EQ(labelled_output_workers(48000, 0), 1u);        // never none
 }
 
 }  // namespace

@@ -75,6 +75,47 @@ TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
   }
 }
 
+TEST(ParallelJobs, RunsEveryJobOnceWithAtMostWorkersInFlight) {
+  ThreadLimit limit(2);
+  constexpr std::size_t kJobs = 40;
+  std::vector<std::atomic<int>> runs(kJobs);
+  std::atomic<int> in_flight{0}, most{0};
+  parallel_jobs(kJobs, 2, [&](std::size_t i) {
+    const int now = ++in_flight;
+    for (int seen = most.load(); now > seen && !most.compare_exchange_weak(seen, now);) {
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ++runs[i];
+    --in_flight;
+  });
+  for (std::size_t i = 0; i < kJobs; ++i) EXPECT_EQ(runs[i].load(), 1) << i;
+  EXPECT_LE(most.load(), 2);
+  EXPECT_GE(most.load(), 1);
+}
+
+TEST(ParallelJobs, NoJobIsTakenAfterOneThrows) {
+  ThreadLimit limit(2);
+  std::atomic<std::size_t> started{0};
+  EXPECT_THROW(parallel_jobs(1000, 2,
+                             [&](std::size_t i) {
+                               ++started;
+                               std::this_thread::sleep_for(std::chrono::milliseconds(1));
+                               if (i == 3) throw std::runtime_error("job 3 fails");
+                             }),
+               std::runtime_error);
+  // Jobs 0 to 3 and the few the other worker started before it saw the failure (a loaded
+  // machine may delay the throwing thread), never the thousand.
+  EXPECT_LE(started.load(), 20u);
+}
+
+TEST(ParallelJobs, NoJobsAndNoWorkersAreFine) {
+  int calls = 0;
+  parallel_jobs(0, 4, [&](std::size_t) { ++calls; });
+  EXPECT_EQ(calls, 0);
+  parallel_jobs(3, 0, [&](std::size_t) { ++calls; });  // 0 workers: one loop
+  EXPECT_EQ(calls, 3);
+}
+
 TEST(ThreadLimit, BoundsTheAvailableThreads) {
   ThreadLimit limit(1);
   EXPECT_EQ(available_threads(), 1u);

@@ -44,4 +44,10 @@ void parallel_sort(std::span<std::uint64_t> values);
 /// short the nested loops of the bodies still running: they finish whatever they started.
 void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body);
 
+/// Runs `job(i)` for every i in [0, count) on min(workers, count) isolated worker loops (as
+/// parallel_workers), each taking the next index as soon as it is done with one: at most
+/// `workers` jobs are in flight, whatever their lengths. The first job that throws ends the
+/// call with its exception once the jobs in flight are done; no worker takes another job.
+void parallel_jobs(std::size_t count, unsigned workers, const std::function<void(std::size_t)>& job);
+
 }  // namespace citymesh
