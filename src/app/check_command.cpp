@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <iostream>
 
 #include "citymesh/core/error.h"
@@ -36,6 +37,13 @@ class CheckCommand final : public Command {
                              tileset.string(), r.tiles, r.levels, r.glb_files,
                              static_cast<double>(r.glb_bytes) / (1 << 20), r.json_files,
                              static_cast<double>(r.json_bytes) / 1024, r.leaf_triangles, r.triangles);
+    std::cout << fmt::format("  cracks between levels of detail: {:.2f} m in {} tiles, against {:.1f} m of seams "
+                             "between leaves\n",
+                             r.crack_length, r.cracked_tiles.size(), r.seam_length);
+    constexpr std::size_t kListed = 5;
+    for (std::size_t i = 0; i < std::min(kListed, r.cracked_tiles.size()); ++i) {
+      std::cout << fmt::format("    {}: {:.2f} m\n", r.cracked_tiles[i].first, r.cracked_tiles[i].second);
+    }
     for (const std::string& e : r.errors) std::cout << "  problem: " << e << "\n";
     if (!r.ok()) throw InputError(fmt::format("{}: {} problems", tileset.string(), r.errors.size()));
     std::cout << "ok\n";

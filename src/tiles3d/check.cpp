@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <map>
 #include <optional>
 #include <set>
 #include <span>
@@ -14,6 +15,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
 #include "citymesh/encode/glb.h"
+#include "tile_cracks.h"
 
 namespace citymesh {
 
@@ -61,7 +63,9 @@ class Checker {
   Checker(std::filesystem::path root_dir, const TilesetCheckParams& params, TilesetCheckReport& report)
       : dir_(std::move(root_dir)), params_(params), report_(report) {}
 
-  void tileset_file(const std::string& name, double parent_error, int depth) {
+  /// Checks tileset file `name`, whose root tile goes under tile `parent` of the crack count.
+  void tileset_file(const std::string& name, double parent_error, int depth,
+                    std::uint32_t parent = tiles3d_detail::TileCrackCounter::kNoParent) {
     if (!visited_.insert(name).second) return error(name, "", "referenced twice (a cycle or a shared external tileset)");
     const std::filesystem::path path = dir_ / name;
     const std::optional<std::string> read = read_bytes(path);
@@ -84,7 +88,14 @@ class Checker {
     if (!tileset.contains("root") || !tileset["root"].is_object()) return error(name, "", "no root tile");
     const json& root = tileset["root"];
     if (!root.contains("refine")) error(name, "root", "no refine (required on the root tile)");
-    tile(name, "root", root, parent_error, depth);
+    tile(name, "root", root, parent_error, depth, parent);
+  }
+
+  [[nodiscard]] tiles3d_detail::TileCracks cracks() const { return cracks_.count(); }
+  /// The glb file of crack-count tile `id`.
+  [[nodiscard]] std::string content_name(std::uint32_t id) const {
+    const auto it = glb_names_.find(id);
+    return it == glb_names_.end() ? std::string() : it->second;
   }
 
  private:
@@ -92,7 +103,9 @@ class Checker {
     report_.errors.push_back(where.empty() ? fmt::format("{}: {}", file, what) : fmt::format("{}: {}: {}", file, where, what));
   }
 
-  void tile(const std::string& file, const std::string& where, const json& t, double parent_error, int depth) {
+  void tile(const std::string& file, const std::string& where, const json& t, double parent_error, int depth,
+            std::uint32_t parent) {
+    const std::uint32_t id = cracks_.add_tile(parent);
     ++report_.tiles;
     report_.levels = std::max(report_.levels, static_cast<std::size_t>(depth) + 1);
     if (depth > 64) return error(file, where, "tree deeper than 64 levels");
@@ -125,24 +138,24 @@ class Checker {
     const bool external = content_uri.size() > 5 && content_uri.ends_with(".json");
     if ((!children.empty() || external) && ge <= 0) error(file, where, "a parent tile has geometricError 0");
     if (external && !children.empty()) error(file, where, "a tile with an external tileset has children");
-    if (t.contains("content")) content(file, where, content_uri, ge, depth, bounds, children.empty());
+    if (t.contains("content")) content(file, where, content_uri, ge, depth, bounds, children.empty(), id);
     for (std::size_t c = 0; c < children.size(); ++c) {
-      tile(file, fmt::format("{}.children[{}]", where, c), children[c], ge, depth + 1);
+      tile(file, fmt::format("{}.children[{}]", where, c), children[c], ge, depth + 1, id);
     }
   }
 
   void content(const std::string& file, const std::string& where, const std::string& uri, double ge, int depth,
-               const std::optional<Bounds>& bounds, bool leaf) {
+               const std::optional<Bounds>& bounds, bool leaf, std::uint32_t id) {
     if (uri.empty()) return error(file, where, "content has no uri");
     if (uri.front() == '/' || uri.find("..") != std::string::npos || uri.find(':') != std::string::npos) {
       return error(file, where, fmt::format("content uri \"{}\" leaves the tileset folder", uri));
     }
-    if (uri.ends_with(".json")) return tileset_file(uri, ge, depth + 1);
+    if (uri.ends_with(".json")) return tileset_file(uri, ge, depth + 1, id);
     if (!uri.ends_with(".glb")) return error(file, where, fmt::format("content \"{}\" is neither glb nor json", uri));
-    glb(uri, bounds, leaf);
+    glb(uri, bounds, leaf, id);
   }
 
-  void glb(const std::string& name, const std::optional<Bounds>& bounds, bool leaf) {
+  void glb(const std::string& name, const std::optional<Bounds>& bounds, bool leaf, std::uint32_t id) {
     const std::optional<std::string> bytes = read_bytes(dir_ / name);
     if (!bytes) return error(name, "", "missing or unreadable");
     ++report_.glb_files;
@@ -152,6 +165,8 @@ class Checker {
       glb_json(name, g.json);
       const DecodedMesh m = read_glb_mesh(g, name);
       glb_mesh(name, g.json, m, bounds);
+      cracks_.set_content(id, m.positions, m.triangles);
+      glb_names_[id] = name;
       report_.triangles += m.triangles.size();
       if (leaf) report_.leaf_triangles += m.triangles.size();
     } catch (const InputError& e) {
@@ -223,6 +238,8 @@ class Checker {
   const TilesetCheckParams& params_;
   TilesetCheckReport& report_;
   std::set<std::string> visited_;
+  tiles3d_detail::TileCrackCounter cracks_;
+  std::map<std::uint32_t, std::string> glb_names_;  ///< by crack-count tile
 };
 
 }  // namespace
@@ -237,6 +254,12 @@ TilesetCheckReport check_tileset(const std::filesystem::path& path, const Tilese
   TilesetCheckReport report;
   Checker checker(file.parent_path(), params, report);
   checker.tileset_file(file.filename().string(), std::numeric_limits<double>::infinity(), 0);
+  const tiles3d_detail::TileCracks cracks = checker.cracks();
+  report.seam_length = cracks.seam_length;
+  report.crack_length = cracks.crack_length;
+  for (const auto& [tile, length] : cracks.by_tile) {
+    report.cracked_tiles.push_back({checker.content_name(tile), length});
+  }
   return report;
 }
 

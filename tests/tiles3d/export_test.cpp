@@ -95,6 +95,29 @@ TEST(TilesetExport, EveryTriangleIsInExactlyOneLeafAndTheTilesetChecksOut) {
   EXPECT_GT(tileset["root"]["geometricError"].get<double>(), 0.0);
   // Parents are simplified: the root holds far fewer triangles than the leaves together.
   EXPECT_LT(stats.all_triangles, 2 * stats.leaf_triangles);
+  // Simplified with their borders locked, parents meet their neighbours without cracks
+  // along the 25 m grid's inner lines (4 + 4 lines of 120 m).
+  EXPECT_NEAR(r.seam_length, 8 * 120.0, 1.0);
+  EXPECT_EQ(r.crack_length, 0.0);
+  EXPECT_TRUE(r.cracked_tiles.empty());
+}
+
+TEST(TilesetExport, ParentsPastTheCapCrackAndCheckMeasuresIt) {
+  test::TempDir tmp;
+  const Scene s = scene();
+  TilesetExportParams p = params(tmp / "tiles");
+  // Below what four leaves with locked borders simplify to: borders freed, then clustered.
+  p.tree.max_parent_triangles = 300;
+  (void)export_tileset({s.mesh, s.source, lambert93()}, p);
+  const TilesetCheckReport r = check_tileset(tmp / "tiles");
+  for (const std::string& e : r.errors) ADD_FAILURE() << e;
+  EXPECT_NEAR(r.seam_length, 8 * 120.0, 1.0);
+  EXPECT_GT(r.crack_length, 10.0);
+  ASSERT_FALSE(r.cracked_tiles.empty());
+  for (std::size_t i = 1; i < r.cracked_tiles.size(); ++i) {
+    EXPECT_GE(r.cracked_tiles[i - 1].second, r.cracked_tiles[i].second);  // longest first
+  }
+  EXPECT_FALSE(r.cracked_tiles[0].first.starts_with("t0_"));  // a parent, never a leaf
 }
 
 TEST(TilesetExport, AGridOriginInsideTheOutputGivesATreeAndAValidTileset) {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace citymesh {
@@ -20,6 +21,15 @@ struct TilesetCheckReport {
   std::uint64_t triangles = 0;       ///< in every content
   std::uint64_t leaf_triangles = 0;  ///< in the contents of tiles without children
   std::uint64_t glb_bytes = 0, json_bytes = 0;
+  /// Metres of edges two leaves share along their borders (each such edge once).
+  double seam_length = 0;
+  /// Metres of those seams missing from the border of a coarser tile drawn beside one of the
+  /// two leaves (summed over such tiles): gaps a viewer shows between levels of detail. The
+  /// export keeps tile borders when it simplifies, so only a parent past its triangle cap,
+  /// simplified with free borders, has any. Reported, not an error.
+  double crack_length = 0;
+  /// The tiles with some crack length (glb file, metres), longest first.
+  std::vector<std::pair<std::string, double>> cracked_tiles;
   [[nodiscard]] bool ok() const { return errors.empty(); }
 };
 
@@ -28,7 +38,8 @@ struct TilesetCheckReport {
 /// leaves, bounding volumes, refine, transform), content files present inside the folder,
 /// external tilesets (no cycles, bounded size), and every glb: header, glTF JSON, Draco
 /// required when used, accessor bounds, decoded mesh (triangle and vertex counts, positions
-/// within accessor bounds and the tile's box, feature ids within the acquisition table).
+/// within accessor bounds and the tile's box, feature ids within the acquisition table), and
+/// measures the cracks between levels of detail (TilesetCheckReport::crack_length).
 /// Problems are collected, not thrown; only an unreadable starting point throws InputError.
 TilesetCheckReport check_tileset(const std::filesystem::path& path, const TilesetCheckParams& params = {});
 
