@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 
 namespace citymesh {
@@ -101,9 +102,43 @@ Box3d mesh_box(const TileMesh& m) {
   return box;
 }
 
+/// What one build shares: the leaves and the caller's settings.
+struct TreeBuild {
+  std::vector<TileKey> leaves;  ///< ascending, less `offset`
+  TileKey offset;               ///< what was subtracted from the grid's keys (see key_offset)
+  const LeafSource& source;
+  const TileTreeParams& params;
+  const TileNodeSink& sink;
+};
+
+/// Which vertices of `whole`, the merged mesh of `parent`'s cell, the leaves around the cell
+/// use too: the cell's seams with its neighbours, which a parent must keep in place to meet
+/// them. Triangles are far smaller than a grid tile, so only the ring of leaves just outside
+/// the cell can share a vertex with it; they are read again here (only for capped parents).
+std::vector<std::uint8_t> shared_with_neighbours(const TreeBuild& b, const TileNode& parent, const TileMesh& whole) {
+  const std::int64_t side = std::int64_t{1} << parent.level;
+  const std::int64_t i0 = parent.key.i * side - 1, i1 = (parent.key.i + 1) * side;
+  const std::int64_t j0 = parent.key.j * side - 1, j1 = (parent.key.j + 1) * side;
+  std::vector<std::uint64_t> around;
+  for (const TileKey& leaf : b.leaves) {
+    const bool near = leaf.i >= i0 && leaf.i <= i1 && leaf.j >= j0 && leaf.j <= j1;
+    const bool inside = leaf.i > i0 && leaf.i < i1 && leaf.j > j0 && leaf.j < j1;
+    if (!near || inside) continue;
+    const TileMesh m = b.source({leaf.i + b.offset.i, leaf.j + b.offset.j});
+    for (const TileVertexKey& k : m.keys) around.push_back(k.vertex);
+  }
+  std::sort(around.begin(), around.end());
+  std::vector<std::uint8_t> shared(whole.vertex_count(), 0);
+  for (std::size_t v = 0; v < shared.size(); ++v) {
+    shared[v] = std::binary_search(around.begin(), around.end(), whole.keys[v].vertex) ? 1 : 0;
+  }
+  return shared;
+}
+
 /// Merges the children's meshes (children index `nodes`) and simplifies the result with
 /// locked borders.
-void build_parent(std::span<const TileNode> nodes, TileNode& parent, const TileTreeParams& params) {
+void build_parent(const TreeBuild& b, std::span<const TileNode> nodes, TileNode& parent) {
+  const TileTreeParams& params = b.params;
   std::vector<const TileMesh*> children;
   double child_error = 0.0;
   for (const std::uint32_t c : parent.children) {
@@ -113,17 +148,25 @@ void build_parent(std::span<const TileNode> nodes, TileNode& parent, const TileT
   }
   const TileMesh whole = merge(children);
   SimplifiedMesh simplified = simplify_mesh(whole.positions, whole.triangles, params.simplify);
-  // Past the cap: borders free, then vertices clustered whatever the error (non-manifold
+  // Past the cap: only the seams with the neighbouring tiles locked (hole rims and the
+  // borders of fragments free), then vertices clustered whatever the error (non-manifold
   // pieces and errors beyond the bound stop edge collapses; the cap is what bounds a tile's
   // memory, and the tile's geometric error tells viewers what it cost), each aiming at the cap.
   SimplifyParams looser = params.simplify;
   looser.target_ratio = static_cast<double>(params.max_parent_triangles) / static_cast<double>(whole.triangles.size());
   looser.lock_border = false;
+  looser.weld = true;
   for (const bool sloppy : {false, true}) {
     if (simplified.triangles.size() <= params.max_parent_triangles) break;
     looser.sloppy = sloppy;
     if (sloppy) looser.max_error_fraction = 1.0;
-    simplified = simplify_mesh(whole.positions, whole.triangles, looser);
+    const std::vector<std::uint8_t> seams = sloppy ? std::vector<std::uint8_t>{} : shared_with_neighbours(b, parent, whole);
+    const std::size_t before = simplified.triangles.size();
+    simplified = simplify_mesh(whole.positions, whole.triangles, looser, seams);
+    log::debug("3D Tiles: {} of {} triangles past the cap of {}: {} -> {} triangles {}", parent.name(),
+               whole.triangles.size(), params.max_parent_triangles, before, simplified.triangles.size(),
+               sloppy ? std::string("by clustering (its seams may crack)")
+                      : fmt::format("with {} seam vertices locked", std::count(seams.begin(), seams.end(), 1)));
   }
   parent.mesh = subset(whole, simplified.triangles);
   parent.triangle_count = parent.mesh.triangles.size();
@@ -149,14 +192,6 @@ constexpr double kMaxSingleChildShare = 0.5;
 /// mesh simplifies the same way).
 bool settled_alone(const Group& g) { return g.size() == 1 && g[0].alone_is_final; }
 
-/// What one build shares: the leaves and the caller's settings.
-struct TreeBuild {
-  std::vector<TileKey> leaves;  ///< ascending, less `offset`
-  TileKey offset;               ///< what was subtracted from the grid's keys (see key_offset)
-  const LeafSource& source;
-  const TileTreeParams& params;
-  const TileNodeSink& sink;
-};
 
 /// What the tree subtracts from the leaf keys. Halving never brings a negative key and a
 /// non-negative one together (-1 stays -1, 0 stays 0), so an axis whose keys have both signs
@@ -204,7 +239,7 @@ std::optional<TileNode> parent_of(const TreeBuild& b, std::span<TileNode> nodes,
   parent.level = level;
   parent.key = key;
   for (const OpenNode& o : g) parent.children.push_back(o.node);
-  build_parent(nodes, parent, b.params);
+  build_parent(b, nodes, parent);
   const auto child_triangles = static_cast<double>(nodes[g[0].node].triangle_count);
   if (g.size() == 1 && static_cast<double>(parent.triangle_count) > kMaxSingleChildShare * child_triangles) {
     return std::nullopt;

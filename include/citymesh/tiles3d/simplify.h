@@ -2,6 +2,7 @@
 // Mesh simplification for the coarser levels of detail (meshoptimizer behind this header).
 #pragma once
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -19,6 +20,11 @@ struct SimplifyParams {
   /// Cluster vertices instead of collapsing edges (meshopt_simplifySloppy): reaches its target
   /// on any mesh, fragments and loose triangles included, but keeps no border nor topology.
   bool sloppy = false;
+  /// Join the vertices of equal position first (their attribute seams, e.g. between source
+  /// acquisitions, then hold no collapse: meshoptimizer never moves a position three or more
+  /// vertices share); a surviving corner is then the first input vertex of its position, so a
+  /// corner on such a seam may take the other side's attributes.
+  bool weld = false;
 };
 
 struct SimplifiedMesh {
@@ -29,8 +35,9 @@ struct SimplifiedMesh {
 /// Edge-collapse simplification (meshopt_simplify). Vertices with equal positions but other
 /// attributes (e.g. a source acquisition seam) collapse together along their seam. The result
 /// only uses input vertices; the input order of the triangles that survive is kept by
-/// meshoptimizer.
+/// meshoptimizer. Vertices flagged in `locked` (empty, or one flag per position) never move,
+/// whatever `lock_border` says, except with `sloppy`, which keeps nothing in place.
 SimplifiedMesh simplify_mesh(std::span<const Vec3f> positions, std::span<const Triangle> triangles,
-                             const SimplifyParams& params = {});
+                             const SimplifyParams& params = {}, std::span<const std::uint8_t> locked = {});
 
 }  // namespace citymesh

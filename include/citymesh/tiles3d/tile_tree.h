@@ -76,11 +76,12 @@ struct TileTreeParams {
   /// first, SIZE_MAX level by level from every leaf at once.
   std::size_t depth_first_cells = 16;
   /// A parent whose simplification with locked borders keeps more triangles than this is
-  /// simplified again with its borders free, and if that still keeps more (fragments and
-  /// loose triangles), by clustering vertices, each aiming at this many: locked hole rims (MLS
+  /// simplified again with only its seams with the neighbouring tiles locked (the vertices the
+  /// leaves just outside its cell use too: hole rims and fragments' borders free), and if that
+  /// still keeps more, by clustering vertices, each aiming at this many: locked hole rims (MLS
   /// meshes are full of holes) stall the simplifier, and upper tiles then grew with the
-  /// output (a 112 M-triangle city's root held 1.06 M triangles). Such a tile may leave cracks
-  /// against its neighbours of the same level; only large outputs' upper tiles are concerned.
+  /// output (a 112 M-triangle city's root held 1.06 M triangles). Only a clustered tile may
+  /// leave cracks against its neighbours (`citymesh check` measures them).
   std::size_t max_parent_triangles = 262144;
 };
 
