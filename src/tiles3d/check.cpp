@@ -91,7 +91,22 @@ class Checker {
     tile(name, "root", root, parent_error, depth, parent);
   }
 
-  [[nodiscard]] tiles3d_detail::TileCracks cracks() const { return cracks_.count(); }
+  [[nodiscard]] tiles3d_detail::TileCracks cracks() const {
+    return cracks_.count([&](std::uint32_t tile) {
+      tiles3d_detail::TileContent content;
+      const std::string name = content_name(tile);
+      const std::optional<std::string> bytes = read_bytes(dir_ / name);
+      if (!bytes) return content;  // checked before: it was there
+      try {
+        DecodedMesh m = read_glb_mesh(parse_glb(as_bytes(*bytes), name), name);
+        content.positions = std::move(m.positions);
+        content.triangles = std::move(m.triangles);
+      } catch (const InputError&) {
+        // reported when it was first read
+      }
+      return content;
+    });
+  }
   /// The glb file of crack-count tile `id`.
   [[nodiscard]] std::string content_name(std::uint32_t id) const {
     const auto it = glb_names_.find(id);

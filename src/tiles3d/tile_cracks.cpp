@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <map>
 #include <utility>
 
 namespace citymesh::tiles3d_detail {
@@ -14,8 +15,8 @@ std::uint32_t TileCrackCounter::add_tile(std::uint32_t parent) {
   return static_cast<std::uint32_t>(tiles_.size() - 1);
 }
 
-void TileCrackCounter::set_content(std::uint32_t tile, std::span<const Vec3f> positions,
-                                   std::span<const Triangle> triangles) {
+std::vector<TileCrackCounter::EdgeKey> TileCrackCounter::edges_of(std::span<const Vec3f> positions,
+                                                                  std::span<const Triangle> triangles) {
   const auto corner = [&](std::uint32_t v) {
     const Vec3f& p = positions[v];
     return std::array<std::uint32_t, 3>{std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y),
@@ -32,6 +33,12 @@ void TileCrackCounter::set_content(std::uint32_t tile, std::span<const Vec3f> po
     }
   }
   std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+void TileCrackCounter::set_content(std::uint32_t tile, std::span<const Vec3f> positions,
+                                   std::span<const Triangle> triangles) {
+  const std::vector<EdgeKey> edges = edges_of(positions, triangles);
   Tile& out = tiles_.at(tile);
   out.has_content = true;
   out.open.clear();
@@ -58,7 +65,7 @@ double TileCrackCounter::length(const EdgeKey& e) {
   return std::sqrt(sum);
 }
 
-TileCracks TileCrackCounter::count() const {
+TileCracks TileCrackCounter::count(const TileContentSource& reload) const {
   // Every leaf's open edges, by edge: an edge open in exactly two leaves is a seam.
   std::vector<std::pair<EdgeKey, std::uint32_t>> leaf_edges;
   for (std::uint32_t t = 0; t < tiles_.size(); ++t) {
@@ -67,7 +74,7 @@ TileCracks TileCrackCounter::count() const {
   }
   std::sort(leaf_edges.begin(), leaf_edges.end());
   TileCracks out;
-  std::vector<double> cracked(tiles_.size(), 0.0);
+  std::map<std::uint32_t, std::vector<std::pair<EdgeKey, double>>> missing;  ///< from a tile's open edges
   for (std::size_t i = 0; i < leaf_edges.size();) {
     std::size_t j = i + 1;
     while (j < leaf_edges.size() && leaf_edges[j].first == leaf_edges[i].first) ++j;
@@ -83,17 +90,23 @@ TileCracks TileCrackCounter::count() const {
         for (std::size_t k = 1; k < own->size(); ++k) {
           const std::uint32_t t = (*own)[k];
           if (!tiles_[t].has_content || std::find(other->begin(), other->end(), t) != other->end()) continue;
-          if (std::binary_search(tiles_[t].open.begin(), tiles_[t].open.end(), edge)) continue;
-          ++out.crack_edges;
-          out.crack_length += len;
-          cracked[t] += len;
+          if (!std::binary_search(tiles_[t].open.begin(), tiles_[t].open.end(), edge)) missing[t].emplace_back(edge, len);
         }
       }
     }
     i = j;
   }
-  for (std::uint32_t t = 0; t < cracked.size(); ++t) {
-    if (cracked[t] > 0) out.by_tile.emplace_back(t, cracked[t]);
+  for (const auto& [t, edges] : missing) {
+    const TileContent content = reload(t);
+    const std::vector<EdgeKey> all = edges_of(content.positions, content.triangles);
+    double length_in_tile = 0;
+    for (const auto& [edge, len] : edges) {
+      if (std::binary_search(all.begin(), all.end(), edge)) continue;
+      ++out.crack_edges;
+      out.crack_length += len;
+      length_in_tile += len;
+    }
+    if (length_in_tile > 0) out.by_tile.emplace_back(t, length_in_tile);
   }
   std::stable_sort(out.by_tile.begin(), out.by_tile.end(),
                    [](const auto& a, const auto& b) { return a.second > b.second; });
