@@ -56,14 +56,12 @@ DetectStep run_detect_step(const Config& config, const PictureOptions& pictures)
     largest = std::max(largest, labelled_output_bytes(m.vertex_count(), InMemoryDetectOutput::kBytesPerVertex,
                                                       pictures.pictures));
   }
-  const std::uint64_t resident = resident_bytes();
   write_detect_outputs(config, step.input, source,
                        {.dir = dir,
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,
                         .read_seconds = step.read_seconds,
-                        .at_once = labelled_output_workers(
-                            largest, config.run.memory > resident ? config.run.memory - resident : 0)});
+                        .at_once = labelled_output_workers(largest, memory_left(config.run.memory))});
   step.write_seconds = clock.restart();
   report(step.result, dir);
   return step;

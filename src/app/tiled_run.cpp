@@ -48,8 +48,7 @@ unsigned labels_at_once(const Config& config, const LoadedAcquisitions& describe
     largest = std::max(largest,
                        labelled_output_bytes(header.vertex_count(), TiledDetectOutput::kBytesPerVertex, pictures));
   }
-  const std::uint64_t resident = resident_bytes();
-  return labelled_output_workers(largest, config.run.memory > resident ? config.run.memory - resident : 0);
+  return labelled_output_workers(largest, memory_left(config.run.memory));
 }
 
 void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {

@@ -33,6 +33,11 @@ std::uint64_t status_kib(const std::string& name) {
 std::uint64_t resident_bytes() { return status_kib("VmRSS"); }
 std::uint64_t peak_resident_bytes() { return status_kib("VmHWM"); }
 
+std::uint64_t memory_left(std::uint64_t budget) {
+  const std::uint64_t resident = resident_bytes();
+  return budget > resident ? budget - resident : 0;
+}
+
 std::string memory_note() {
   return fmt::format("resident {} MiB (peak {} MiB)", resident_bytes() >> 20, peak_resident_bytes() >> 20);
 }

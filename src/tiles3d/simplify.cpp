@@ -6,8 +6,6 @@
 #include <meshoptimizer.h>
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
 #include <cstring>
 #include <numeric>
@@ -43,11 +41,7 @@ struct Welded {
 
 Welded weld(std::span<const Vec3f> positions, std::span<const Triangle> triangles,
             std::span<const std::uint8_t> locked) {
-  const auto bits = [&](std::uint32_t v) {
-    const Vec3f& p = positions[v];
-    return std::array<std::uint32_t, 3>{std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y),
-                                        std::bit_cast<std::uint32_t>(p.z)};
-  };
+  const auto bits = [&](std::uint32_t v) { return position_bits(positions[v]); };
   std::vector<std::uint32_t> order(positions.size());
   std::iota(order.begin(), order.end(), 0u);
   std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return bits(a) < bits(b); });

@@ -17,11 +17,7 @@ std::uint32_t TileCrackCounter::add_tile(std::uint32_t parent) {
 
 std::vector<TileCrackCounter::EdgeKey> TileCrackCounter::edges_of(std::span<const Vec3f> positions,
                                                                   std::span<const Triangle> triangles) {
-  const auto corner = [&](std::uint32_t v) {
-    const Vec3f& p = positions[v];
-    return std::array<std::uint32_t, 3>{std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y),
-                                        std::bit_cast<std::uint32_t>(p.z)};
-  };
+  const auto corner = [&](std::uint32_t v) { return position_bits(positions[v]); };
   std::vector<EdgeKey> edges;
   edges.reserve(3 * triangles.size());
   for (const Triangle& t : triangles) {

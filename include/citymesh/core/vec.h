@@ -3,7 +3,10 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 
 namespace citymesh {
@@ -41,6 +44,12 @@ template <class T>
 T norm(const Vec3<T>& a) { return std::sqrt(dot(a, a)); }
 template <class T>
 bool is_finite(const Vec3<T>& a) { return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z); }
+
+/// A float point's coordinate bits: a key under which exactly equal positions meet (lattice-
+/// quantized vertices of different tiles, copies of a vertex per source).
+constexpr std::array<std::uint32_t, 3> position_bits(const Vec3f& p) {
+  return {std::bit_cast<std::uint32_t>(p.x), std::bit_cast<std::uint32_t>(p.y), std::bit_cast<std::uint32_t>(p.z)};
+}
 
 /// Axis-aligned box; empty until the first extend().
 struct Box3d {
