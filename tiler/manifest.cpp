@@ -17,10 +17,10 @@
 namespace citymesh {
 
 namespace {
-constexpr int kManifestVersion = 1;
+constexpr int kManifestVersion = 2;  // 2: one block file per acquisition
 constexpr const char* kManifestFile = "manifest.json";
 constexpr const char* kSummaryFile = "summary.json";
-constexpr int kSummaryVersion = 1;
+constexpr int kSummaryVersion = 2;
 
 nlohmann::json stats_json(const TilingStats& s) {
   return {{"input_bytes", s.input_bytes}, {"halo_copies", s.halo_copies}, {"empty_space_copies", s.empty_space_copies},
@@ -31,6 +31,24 @@ TilingStats stats_from_json(const nlohmann::json& s) {
   return {s.at("input_bytes").get<std::uint64_t>(),  s.at("halo_copies").get<std::uint64_t>(),
           s.at("empty_space_copies").get<std::uint64_t>(), s.at("blocks").get<std::uint64_t>(),
           s.at("bytes_written").get<std::uint64_t>(), s.at("seconds").get<double>()};
+}
+
+/// Byte ranges as a flat list: offset, bytes, offset, bytes...
+nlohmann::json ranges_json(const std::vector<ByteRange>& ranges) {
+  nlohmann::json flat = nlohmann::json::array();
+  for (const ByteRange& r : ranges) {
+    flat.push_back(r.offset);
+    flat.push_back(r.bytes);
+  }
+  return flat;
+}
+
+std::vector<ByteRange> ranges_from_json(const nlohmann::json& flat) {
+  const auto numbers = flat.get<std::vector<std::uint64_t>>();
+  if (numbers.size() % 2 != 0) throw std::invalid_argument("a block list of odd length");
+  std::vector<ByteRange> ranges;
+  for (std::size_t k = 0; k < numbers.size(); k += 2) ranges.push_back({numbers[k], numbers[k + 1]});
+  return ranges;
 }
 
 /// The summary in `folder` when it is finished and made with `fingerprint`.
@@ -47,12 +65,12 @@ std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folde
     t.triangles = j.at("triangles").get<std::uint64_t>();
     t.stats = stats_from_json(j.at("stats"));
     for (const auto& row : j.at("tiles")) {
-      const auto v = row.get<std::array<std::int64_t, 5>>();
-      t.counts[{static_cast<std::int32_t>(v[0]), static_cast<std::int32_t>(v[1])}] = {
-          static_cast<std::uint64_t>(v[2]), static_cast<std::uint64_t>(v[3]), static_cast<std::uint64_t>(v[4])};
+      const TileKey key{row.at("i").get<std::int32_t>(), row.at("j").get<std::int32_t>()};
+      t.counts[key] = row.at("triangles").get<std::array<std::uint64_t, 3>>();
+      t.blocks[key] = ranges_from_json(row.at("blocks"));
     }
     return t;
-  } catch (const nlohmann::json::exception& e) {
+  } catch (const std::exception& e) {
     // Written atomically, so only a damaged file gets here: the acquisition is tiled again.
     log::warn("{}: unreadable ({}): tiled again", (folder / kSummaryFile).string(), e.what());
     return std::nullopt;
@@ -84,7 +102,13 @@ bool manifest_made_with(const std::filesystem::path& dir, const std::string& fin
 
 void write_acquisition_tiling(const std::filesystem::path& dir, const AcquisitionTiling& tiling) {
   nlohmann::json tiles = nlohmann::json::array();
-  for (const auto& [key, c] : tiling.counts) tiles.push_back({key.i, key.j, c[0], c[1], c[2]});
+  for (const auto& [key, c] : tiling.counts) {
+    const auto blocks = tiling.blocks.find(key);
+    tiles.push_back({{"i", key.i},
+                     {"j", key.j},
+                     {"triangles", c},
+                     {"blocks", ranges_json(blocks == tiling.blocks.end() ? std::vector<ByteRange>{} : blocks->second)}});
+  }
   const nlohmann::json j{{"version", kSummaryVersion}, {"fingerprint", tiling.fingerprint},
                          {"triangles", tiling.triangles}, {"stats", stats_json(tiling.stats)},
                          {"tiles", std::move(tiles)}};
@@ -148,7 +172,11 @@ void write_tile_manifest(const TileStore& store) {
   j["triangles"] = store.triangles;
   j["stats"] = stats_json(store.stats);
   nlohmann::json tiles = nlohmann::json::array();
-  for (const TileContents& t : store.tiles) tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}});
+  for (const TileContents& t : store.tiles) {
+    nlohmann::json blocks = nlohmann::json::array();
+    for (const std::vector<ByteRange>& ranges : t.blocks) blocks.push_back(ranges_json(ranges));
+    tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}, {"blocks", std::move(blocks)}});
+  }
   j["tiles"] = std::move(tiles);
   write_file_atomically(store.dir / kManifestFile, j.dump(1) + "\n");
 }
@@ -174,15 +202,23 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
     store.stats = stats_from_json(j.at("stats"));
     for (const auto& t : j.at("tiles")) {
       TileContents c{{t.at("i").get<std::int32_t>(), t.at("j").get<std::int32_t>()},
-                     t.at("triangles").get<std::vector<std::array<std::uint64_t, 3>>>()};
-      if (c.triangles.size() != store.triangles.size()) {
-        throw InputError(fmt::format("{}: tile {} lists {} acquisitions, the store {}", file.string(), c.key.name(),
-                                     c.triangles.size(), store.triangles.size()));
+                     t.at("triangles").get<std::vector<std::array<std::uint64_t, 3>>>(),
+                     {}};
+      for (const auto& ranges : t.at("blocks")) c.blocks.push_back(ranges_from_json(ranges));
+      if (c.triangles.size() != store.triangles.size() || c.blocks.size() != store.triangles.size()) {
+        throw InputError(fmt::format("{}: tile {} lists {} acquisitions and {} block lists, the store {} acquisitions",
+                                     file.string(), c.key.name(), c.triangles.size(), c.blocks.size(),
+                                     store.triangles.size()));
+      }
+      if (!store.tiles.empty() && !(store.tiles.back().key < c.key)) {
+        throw InputError(fmt::format("{}: tile {} is out of order", file.string(), c.key.name()));
       }
       store.tiles.push_back(std::move(c));
     }
     return store;
   } catch (const nlohmann::json::exception& e) {
+    throw InputError(fmt::format("{}: malformed tile manifest: {}", file.string(), e.what()));
+  } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: malformed tile manifest: {}", file.string(), e.what()));
   }
 }

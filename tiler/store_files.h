@@ -11,6 +11,9 @@
 
 namespace citymesh {
 
+/// An acquisition's block file in its folder of the store.
+inline constexpr const char* kBlocksFile = "blocks.bin";
+
 /// Writes <dir>/summary.json (atomically).
 void write_acquisition_tiling(const std::filesystem::path& dir, const AcquisitionTiling& tiling);
 

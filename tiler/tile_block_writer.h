@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The tile store's block encoder, private to the tiler: the tiler feeds it each tile's
-// vertices and triangles as it finds them, and encode_tile_block / append_tile_block feed it a
-// whole TilePiece, so that a block is encoded in one place.
+// vertices and triangles as it finds them, and encode_tile_block feeds it a whole TilePiece, so
+// that a block is encoded in one place.
 #pragma once
 
 #include <array>
@@ -96,8 +96,23 @@ class TileBlockWriter {
   std::uint64_t triangles_ = 0;
 };
 
-/// Appends the byte ranges `parts` to `file` as one write, creating it (not synced); returns
-/// the bytes written. Throws OutputError naming the file.
-std::uint64_t append_block(const std::filesystem::path& file, const std::vector<std::string_view>& parts);
+/// An acquisition's block file, created empty and kept open while the tiler appends to it.
+class BlockAppender {
+ public:
+  /// Throws OutputError naming `file` when it cannot be created.
+  explicit BlockAppender(std::filesystem::path file);
+  ~BlockAppender();
+  BlockAppender(const BlockAppender&) = delete;
+  BlockAppender& operator=(const BlockAppender&) = delete;
+
+  /// Appends the byte ranges `parts` as one write (not synced: see sync_tile_files) and
+  /// returns where they lie. Throws OutputError naming the file.
+  ByteRange append(const std::vector<std::string_view>& parts);
+
+ private:
+  std::filesystem::path file_;
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
 
 }  // namespace citymesh::tiler_detail

@@ -88,26 +88,31 @@ std::vector<std::string_view> TileBlockWriter::finish() {
   return parts;
 }
 
-std::uint64_t append_block(const std::filesystem::path& file, const std::vector<std::string_view>& parts) {
+BlockAppender::BlockAppender(std::filesystem::path file) : file_(std::move(file)) {
+  fd_ = ::open(file_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd_ < 0) throw OutputError(fmt::format("{}: cannot create the block file: {}", file_.string(), std::strerror(errno)));
+}
+
+BlockAppender::~BlockAppender() { ::close(fd_); }
+
+ByteRange BlockAppender::append(const std::vector<std::string_view>& parts) {
   std::vector<iovec> io;
-  std::size_t total = 0;
+  std::uint64_t total = 0;
   for (const std::string_view part : parts) {
     io.push_back({const_cast<char*>(part.data()), part.size()});
     total += part.size();
   }
-  // No fsync here: sync_tile_files() makes the store durable once, before the manifest names it.
-  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  bool ok = fd >= 0;
-  const off_t at = ok ? ::lseek(fd, 0, SEEK_END) : 0;
-  ok = ok && ::writev(fd, io.data(), static_cast<int>(io.size())) == static_cast<ssize_t>(total);
-  const int err = errno;
+  const ByteRange range{size_, total};
+  if (::pwritev(fd_, io.data(), static_cast<int>(io.size()), static_cast<off_t>(size_)) != static_cast<ssize_t>(total)) {
+    const int err = errno;
+    throw OutputError(fmt::format("{}: cannot append a tile block: {}", file_.string(), std::strerror(err)));
+  }
+  size_ += total;
   // Start writing the block back now, without waiting: the tiler goes on while the disk
   // works, and the fsync before the store is published then finds little left to wait for
   // (it was a fifth of the tiler's time). Only a hint: a failure here changes nothing.
-  if (ok) (void)::sync_file_range(fd, at, static_cast<off_t>(total), SYNC_FILE_RANGE_WRITE);
-  if (fd >= 0) ::close(fd);
-  if (!ok) throw OutputError(fmt::format("{}: cannot append a tile block: {}", file.string(), std::strerror(err)));
-  return total;
+  (void)::sync_file_range(fd_, static_cast<off_t>(range.offset), static_cast<off_t>(total), SYNC_FILE_RANGE_WRITE);
+  return range;
 }
 
 }  // namespace tiler_detail
@@ -131,11 +136,6 @@ std::string encode_tile_block(const TilePiece& piece) {
   return out;
 }
 
-std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePiece& piece) {
-  TileBlockWriter writer;
-  return append_block(file, write_piece(piece, writer));
-}
-
 void sync_tile_files(const std::filesystem::path& dir) {
   std::error_code ec;
   for (const auto& entry : std::filesystem::recursive_directory_iterator(dir, ec)) {
@@ -148,10 +148,10 @@ void sync_tile_files(const std::filesystem::path& dir) {
   if (ec) throw OutputError(fmt::format("{}: cannot list the tile store: {}", dir.string(), ec.message()));
 }
 
-TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin, std::uint32_t acquisition) {
-  const std::optional<std::string> bytes = read_file_bytes(file);
-  if (!bytes) throw InputError(fmt::format("{}: cannot open the tile chunk", file.string()));
-  return decode_tile_blocks(*bytes, origin, acquisition, file.string());
+TilePiece read_tile_piece(const std::filesystem::path& file, std::span<const ByteRange> blocks, const Vec3d& origin,
+                          std::uint32_t acquisition, std::string_view tile) {
+  const std::string source = fmt::format("{} (tile {})", file.string(), tile);
+  return decode_tile_blocks(read_file_ranges(file, blocks, source), origin, acquisition, source);
 }
 
 }  // namespace citymesh

@@ -60,8 +60,6 @@ struct BatchTile {
   std::uint32_t copies = 0;               ///< in all
 };
 
-std::string chunk_name(TileKey key);
-
 /// Memory one copy takes in the block of its tile while that tile is written: its varints up
 /// to 52 bytes and a new vertex up to 42 more (a tile's copies bring fewer new vertices than
 /// that on average: a mesh has about half as many vertices as triangles). Only the largest
@@ -81,13 +79,10 @@ constexpr std::size_t kMaxBatchTriangles = (std::size_t{1} << 30) - 1;
 /// of first use, so the blocks do not depend on how the work is done.
 class AcquisitionTiler {
  public:
-  AcquisitionTiler(const TileGrid& grid, std::filesystem::path dir, AcquisitionTiling& out, std::uint32_t acquisition,
+  /// Appends to `blocks_file`, created empty.
+  AcquisitionTiler(const TileGrid& grid, const std::filesystem::path& blocks_file, AcquisitionTiling& out,
                    std::uint64_t buffer_bytes)
-      : grid_(grid),
-        dir_(std::move(dir)),
-        out_(out),
-        acquisition_(acquisition),
-        buffer_bytes_(std::min(buffer_bytes, kMaxBatchBytes)) {}
+      : grid_(grid), out_(out), buffer_bytes_(std::min(buffer_bytes, kMaxBatchBytes)), blocks_file_(blocks_file) {}
 
   void run(const std::filesystem::path& file, PlyReadParams ply) {
     // The tile store carries no per-vertex times, so they are not parsed.
@@ -167,7 +162,8 @@ class AcquisitionTiler {
       return true;
     }
     const TileKey owner = grid_.owner((c[0] + c[1] + c[2]) / 3.0);
-    last_interior_ = grid_.interior(owner);
+    // Most triangles that get here lie near a side of the same tile (98 % on the city).
+    if (owner != last_interior_.key) last_interior_ = grid_.interior(owner);
     add_copy(owner, t, TileRole::owned);
     grid_.copy_targets(c, viewpoint, owner, halo_, crossed_);
     for (const TileKey k : halo_) add_copy(k, t, TileRole::halo);
@@ -203,9 +199,9 @@ class AcquisitionTiler {
       for (std::size_t r = 0; r < 3; ++r) counts[r] += tiles_[s].counts[r];
       const std::vector<std::string_view> block =
           build_block(key, std::span(sorted_).subspan(start[s], start[s + 1] - start[s]));
-      const std::filesystem::path chunk = dir_ / chunk_name(key);
-      std::filesystem::create_directories(chunk.parent_path());
-      out_.stats.bytes_written += tiler_detail::append_block(chunk, block);
+      const ByteRange range = blocks_file_.append(block);
+      out_.blocks[key].push_back(range);
+      out_.stats.bytes_written += range.bytes;
       ++out_.stats.blocks;
     }
     batch_.clear();
@@ -244,10 +240,9 @@ class AcquisitionTiler {
   }
 
   const TileGrid& grid_;
-  std::filesystem::path dir_;
   AcquisitionTiling& out_;
-  std::uint32_t acquisition_;
   std::uint64_t buffer_bytes_;
+  tiler_detail::BlockAppender blocks_file_;
   AcquisitionVertices vertices_;
   std::uint32_t next_index_ = 0;
   std::uint64_t zero_area_dropped_ = 0;
@@ -258,7 +253,9 @@ class AcquisitionTiler {
   std::map<TileKey, std::uint32_t> slot_of_;
   std::uint32_t last_slot_ = 0;
   std::vector<TileKey> halo_, crossed_;  ///< the current triangle's other tiles
-  TileInterior last_interior_;           ///< of the last owner owner() found
+  /// Of the last owner owner() found; at first of no tile (owner() never gives INT32_MIN) and
+  /// holding nothing.
+  TileInterior last_interior_{.key = {INT32_MIN, INT32_MIN}};
   std::uint32_t largest_tile_ = 0;  ///< copies of the batch's largest tile
   // Reused by every flush.
   std::vector<std::uint32_t> sorted_;
@@ -267,8 +264,6 @@ class AcquisitionTiler {
   std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in the block
   std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };
-
-std::string chunk_name(TileKey key) { return key.name() + ".bin"; }
 
 }  // namespace
 
@@ -288,8 +283,8 @@ std::filesystem::path acquisition_tiles_path(const std::filesystem::path& dir, s
   return dir / fmt::format("a{}", acquisition);
 }
 
-std::filesystem::path tile_chunk_path(const std::filesystem::path& dir, TileKey key, std::uint32_t acquisition) {
-  return acquisition_tiles_path(dir, acquisition) / chunk_name(key);
+std::filesystem::path acquisition_blocks_path(const std::filesystem::path& dir, std::uint32_t acquisition) {
+  return acquisition_tiles_path(dir, acquisition) / kBlocksFile;
 }
 
 AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerParams& params,
@@ -306,8 +301,10 @@ AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerPa
   if (ec) throw OutputError(fmt::format("{}: cannot create a tiling folder: {}", staged.string(), ec.message()));
   AcquisitionTiling out;
   out.fingerprint = fingerprint;
-  AcquisitionTiler tiler(grid, staged, out, acquisition.index, params.buffer_bytes);
-  tiler.run(acquisition.path, params.ply);
+  {
+    AcquisitionTiler tiler(grid, staged / kBlocksFile, out, params.buffer_bytes);
+    tiler.run(acquisition.path, params.ply);
+  }  // the block file is closed
   out.stats.seconds = clock.seconds();
   write_acquisition_tiling(staged, out);
   sync_tile_files(staged);
@@ -322,7 +319,7 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
   store.dir = dir;
   store.grid = grid;
   store.fingerprint = std::move(fingerprint);
-  std::map<TileKey, std::vector<std::array<std::uint64_t, 3>>> counts;
+  std::map<TileKey, TileContents> tiles;
   for (std::size_t a = 0; a < parts.size(); ++a) {
     const AcquisitionTiling& part = parts[a];
     store.triangles.push_back(part.triangles);
@@ -334,14 +331,15 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
     store.stats.bytes_written += s.bytes_written;
     store.stats.seconds += s.seconds;
     for (const auto& [key, roles] : part.counts) {
-      auto& all = counts[key];
-      all.resize(parts.size());
-      all[a] = roles;
+      TileContents& t = tiles[key];
+      t.key = key;
+      t.triangles.resize(parts.size());
+      t.blocks.resize(parts.size());
+      t.triangles[a] = roles;
+      if (const auto it = part.blocks.find(key); it != part.blocks.end()) t.blocks[a] = it->second;
     }
   }
-  for (auto& [key, per_acquisition] : counts) {
-    TileContents t{key, std::move(per_acquisition)};
-    t.triangles.resize(parts.size());
+  for (auto& [key, t] : tiles) {
     if (t.owned() > 0) store.tiles.push_back(std::move(t));
   }
   return store;
@@ -360,15 +358,15 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
 }
 
 std::vector<TilePiece> read_tile(const TileStore& store, TileKey key) {
-  const TileGrid grid(store.grid);
+  const Vec3d origin = TileGrid(store.grid).corner(key);
   std::vector<TilePiece> pieces(store.triangles.size());
+  for (TilePiece& p : pieces) p.mesh.origin = origin;
+  const auto tile = std::lower_bound(store.tiles.begin(), store.tiles.end(), key,
+                                     [](const TileContents& t, TileKey k) { return t.key < k; });
+  if (tile == store.tiles.end() || tile->key != key) return pieces;  // the store holds nothing of it
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
-    const std::filesystem::path file = tile_chunk_path(store.dir, key, a);
-    if (std::filesystem::exists(file)) {
-      pieces[a] = read_tile_piece(file, grid.corner(key), a);
-    } else {
-      pieces[a].mesh.origin = grid.corner(key);
-    }
+    if (tile->blocks[a].empty()) continue;
+    pieces[a] = read_tile_piece(acquisition_blocks_path(store.dir, a), tile->blocks[a], origin, a, key.name());
   }
   return pieces;
 }

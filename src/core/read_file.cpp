@@ -41,4 +41,30 @@ std::optional<std::string> read_file_bytes(const std::filesystem::path& file) {
   return bytes;
 }
 
+std::string read_file_ranges(const std::filesystem::path& file, std::span<const ByteRange> ranges,
+                             std::string_view source) {
+  const std::unique_ptr<std::FILE, CloseFile> f(std::fopen(file.c_str(), "rb"));
+  if (!f) throw InputError(fmt::format("{}: cannot open: {}", source, std::strerror(errno)));
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(file, ec);
+  if (ec) throw InputError(fmt::format("{}: cannot tell the size: {}", source, ec.message()));
+  std::uint64_t total = 0;
+  for (const ByteRange& r : ranges) {
+    if (r.offset > size || r.bytes > size - r.offset) {
+      throw InputError(fmt::format("{}: {} bytes at byte {} pass the file's end ({} bytes)", source, r.bytes, r.offset,
+                                   size));
+    }
+    total += r.bytes;
+  }
+  std::string bytes(static_cast<std::size_t>(total), '\0');
+  std::size_t at = 0;
+  for (const ByteRange& r : ranges) {
+    const bool ok = fseeko(f.get(), static_cast<off_t>(r.offset), SEEK_SET) == 0 &&
+                    std::fread(bytes.data() + at, 1, r.bytes, f.get()) == r.bytes;
+    if (!ok) throw InputError(fmt::format("{}: cannot read {} bytes at byte {}", source, r.bytes, r.offset));
+    at += r.bytes;
+  }
+  return bytes;
+}
+
 }  // namespace citymesh

@@ -20,7 +20,7 @@ TileStore random_store(std::mt19937& rng, int w, int h) {
     for (int j = -2; j < h - 2; ++j) {
       if (rng() % 4 == 0) continue;
       const std::uint64_t owned = 1 + rng() % 1000, halo = rng() % 200;
-      store.tiles.push_back({{i, j}, {{owned, halo, 0}}});
+      store.tiles.push_back({{i, j}, {{owned, halo, 0}}, {}});
       store.triangles[0] += owned;
     }
   }

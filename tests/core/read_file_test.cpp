@@ -5,6 +5,7 @@
 #include <random>
 #include <string>
 
+#include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
 #include "test_support.h"
 
@@ -29,6 +30,38 @@ TEST(ReadFileBytes, MissingFilesAndFoldersAreNotOpened) {
   test::TempDir dir;
   EXPECT_FALSE(read_file_bytes(dir.path() / "missing.bin").has_value());
   EXPECT_FALSE(read_file_bytes(dir.path()).has_value());
+}
+
+TEST(ReadFileRanges, ConcatenatesRangesInTheOrderAsked) {
+  test::TempDir dir;
+  std::string bytes(100'000, '\0');
+  std::mt19937 rng(3);
+  for (char& c : bytes) c = static_cast<char>(rng() & 0xff);
+  const auto file = dir.path() / "blocks.bin";
+  test::write_text(file, bytes);
+  const std::vector<ByteRange> ranges{{90'000, 10'000}, {0, 7}, {500, 0}, {12'345, 54'321}};
+  std::string expected;
+  for (const ByteRange& r : ranges) expected += bytes.substr(r.offset, r.bytes);
+  EXPECT_EQ(read_file_ranges(file, ranges, "test"), expected);
+  EXPECT_EQ(read_file_ranges(file, {}, "test"), "");
+}
+
+TEST(ReadFileRanges, ARangePastTheEndOrAMissingFileIsAnInputErrorNamingTheSource) {
+  test::TempDir dir;
+  const auto file = dir.path() / "blocks.bin";
+  test::write_text(file, std::string(1000, 'x'));
+  const auto expect_error = [&](const std::filesystem::path& f, const std::vector<ByteRange>& ranges) {
+    try {
+      (void)read_file_ranges(f, ranges, "the source");
+      FAIL() << "no error";
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("the source: ", 0), 0u) << e.what();
+    }
+  };
+  expect_error(file, {{0, 10}, {995, 6}});
+  expect_error(file, {{1001, 0}});
+  expect_error(file, {{10, ~std::uint64_t{0}}});  // no allocation of that size is attempted
+  expect_error(dir.path() / "missing.bin", {{0, 1}});
 }
 
 }  // namespace

@@ -79,13 +79,14 @@ struct Fixture {
   }
 };
 
-/// The counts in a chunk's first block header (version 3: magic, version, flags, vertices,
+/// The counts in the header of the block at `at` of `file` (magic, version, flags, vertices,
 /// triangles, payload bytes, checksum) and the block's whole size.
 struct BlockCounts {
   std::uint64_t vertices = 0, triangles = 0, bytes = 0;
 };
-BlockCounts first_block_counts(const std::filesystem::path& file) {
+BlockCounts block_counts(const std::filesystem::path& file, const ByteRange& at) {
   std::ifstream in(file, std::ios::binary);
+  in.seekg(static_cast<std::streamoff>(at.offset));
   std::array<std::uint64_t, 6> header{};  // 8 + 4 + 4 bytes of magic, version, flags first
   in.read(reinterpret_cast<char*>(header.data()), sizeof header);
   return {header[2], header[3], 48 + header[4]};
@@ -145,17 +146,22 @@ void expect_brute_force_roles(const Fixture& f, const TileStore& store) {
       }
       EXPECT_EQ(per_role, tile.triangles[a]);
       owned += per_role[0];
-      // One block per chunk (large buffers) holding each vertex once: its header counts only
-      // the distinct vertices its triangles use, so a vertex written twice would show.
-      if (p.triangle_count() == 0) continue;
+      // One block per tile and acquisition (large buffers) holding each vertex once: its
+      // header counts only the distinct vertices its triangles use, so a vertex written twice
+      // would show.
+      if (p.triangle_count() == 0) {
+        EXPECT_TRUE(tile.blocks[a].empty());
+        continue;
+      }
       std::set<std::uint32_t> used;
       for (const Triangle& tri : p.mesh.triangles) {
         for (const std::uint32_t v : tri) used.insert(p.vertex_ids[v]);
       }
-      const BlockCounts counts = first_block_counts(tile_chunk_path(store.dir, tile.key, a));
+      ASSERT_EQ(tile.blocks[a].size(), 1u);
+      const BlockCounts counts = block_counts(acquisition_blocks_path(store.dir, a), tile.blocks[a][0]);
       EXPECT_EQ(counts.vertices, used.size());
       EXPECT_EQ(counts.triangles, p.triangle_count());
-      EXPECT_EQ(counts.bytes, std::filesystem::file_size(tile_chunk_path(store.dir, tile.key, a)));
+      EXPECT_EQ(counts.bytes, tile.blocks[a][0].bytes);
     }
   }
   EXPECT_EQ(owned, 6000u);
@@ -217,32 +223,39 @@ TEST(Tiler, ManifestRoundTrips) {
   for (std::size_t k = 0; k < store.tiles.size(); ++k) {
     EXPECT_EQ(back->tiles[k].key, store.tiles[k].key);
     EXPECT_EQ(back->tiles[k].triangles, store.tiles[k].triangles);
+    EXPECT_EQ(back->tiles[k].blocks, store.tiles[k].blocks);
   }
 }
 
-TEST(Tiler, DamagedChunksAreInputErrorsNamingTheFile) {
+TEST(Tiler, DamagedBlocksAreInputErrorsNamingTheFileAndTile) {
   Fixture f;
-  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
-  const auto file = tile_chunk_path(store.dir, store.tiles.front().key, 0);
-  const auto size = std::filesystem::file_size(file);
+  TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  const TileContents& tile = store.tiles.front();
+  const auto file = acquisition_blocks_path(store.dir, 0);
+  ASSERT_FALSE(tile.blocks[0].empty());
+  const ByteRange block = tile.blocks[0].front();
   const auto expect_error = [&](const std::string& what) {
     try {
-      (void)read_tile_piece(file, {0, 0, 0}, 0);
+      (void)read_tile(store, tile.key);
       FAIL() << "no error for " << what;
     } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find(file.string()), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(file.string() + " (tile " + tile.key.name() + ")"), std::string::npos)
+          << e.what();
     }
   };
   {
     std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-    io.seekp(static_cast<std::streamoff>(size / 2));
+    io.seekp(static_cast<std::streamoff>(block.offset + block.bytes / 2));
     io.put('\x7f');
   }
   expect_error("a flipped byte");
-  std::filesystem::resize_file(file, size - 7);
-  expect_error("a truncated file");
-  std::filesystem::resize_file(file, 20);
+  std::filesystem::resize_file(file, block.offset + block.bytes - 7);
+  expect_error("a truncated block");
+  std::filesystem::resize_file(file, block.offset + 20);
   expect_error("a truncated header");
+  // A damaged manifest naming a block far past the file's end: an error, not a huge allocation.
+  store.tiles.front().blocks[0] = {{0, 1ull << 50}};
+  expect_error("a block past the end");
 }
 
 /// Moves vertex `v` of acquisition 1 with its sensor position to vertex `from`'s position plus
@@ -357,22 +370,25 @@ TEST(Tiler, AcquisitionsTiledSeparatelyOrTwiceGiveTheSameStore) {
   auto files = folder_bytes(f.params.dir);
   auto expected = reference;
   for (auto* m : {&files, &expected}) std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
-  EXPECT_TRUE(files == expected) << "chunk files differ from a store tiled in one go";
+  EXPECT_TRUE(files == expected) << "block files differ from a store tiled in one go";
+  for (std::size_t k = 0; k < whole.tiles.size(); ++k) EXPECT_EQ(assembled.tiles[k].blocks, whole.tiles[k].blocks);
   EXPECT_EQ(b.triangles, 3000u);
 }
 
-TEST(Tiler, TwoAcquisitionsAtOnceGiveTheSameChunkBytes) {
+TEST(Tiler, TwoAcquisitionsAtOnceGiveTheSameBlockBytes) {
   // Small buffers: many flushes, so vertex cache slots move between buffers on the way.
   Fixture f(64 << 10);
-  (void)tile_acquisitions(f.acquisitions, f.params, 1);
+  const TileStore store_one = tile_acquisitions(f.acquisitions, f.params, 1);
   auto one = folder_bytes(f.params.dir);
   const ThreadLimit limit(2);
-  (void)tile_acquisitions(f.acquisitions, f.params, 2);
+  const TileStore store_two = tile_acquisitions(f.acquisitions, f.params, 2);
   auto two = folder_bytes(f.params.dir);
+  ASSERT_EQ(store_one.tiles.size(), store_two.tiles.size());
+  for (std::size_t k = 0; k < store_one.tiles.size(); ++k) EXPECT_EQ(store_one.tiles[k].blocks, store_two.tiles[k].blocks);
   // The summaries hold the tiling time; everything else must match byte for byte.
   for (auto* m : {&one, &two}) std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
-  EXPECT_GT(one.size(), 4u);
-  EXPECT_TRUE(one == two) << "chunk files differ between one and two acquisitions at once";
+  EXPECT_EQ(one.size(), 2u);
+  EXPECT_TRUE(one == two) << "block files differ between one and two acquisitions at once";
 }
 
 TEST(Tiler, PruneKeepsOnlyWhatTheFingerprintOwns) {

@@ -1,15 +1,18 @@
 // SPDX-License-Identifier: MIT
-// The tile store's chunk files: one acquisition's triangles in one tile, written by the tiler
-// in blocks (each flush of its buffers appends one) and read back whole by tile processing.
+// The tile store's blocks: one acquisition's triangles in one tile, as the tiler wrote them
+// (each flush of its buffers appends one block per tile to the acquisition's block file), read
+// back together by tile processing.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "citymesh/core/mesh.h"
+#include "citymesh/core/read_file.h"
 
 namespace citymesh {
 
@@ -44,18 +47,16 @@ std::string encode_tile_block(const TilePiece& piece);
 TilePiece decode_tile_blocks(std::string_view bytes, const Vec3d& origin, std::uint32_t acquisition,
                              std::string_view source);
 
-/// Appends `piece` as one checksummed block to `file`, creating it (not synced: see
-/// sync_tile_files); returns the bytes written. Throws OutputError naming the file.
-std::uint64_t append_tile_block(const std::filesystem::path& file, const TilePiece& piece);
-
 /// fsyncs every file under `dir` (and the folders): the tile store is durable once this returns.
 void sync_tile_files(const std::filesystem::path& dir);
 
-/// Reads every block of `file` into one piece in the frame `origin`: vertices of several blocks
-/// with the same id become one (the first block's copy), triangles keep the order in which
-/// they were written. Global ids get `acquisition`. Throws InputError naming the file and the
-/// block when it is truncated, has another magic or version, a count that does not fit the
-/// file, an index out of range or a checksum that does not match.
-TilePiece read_tile_piece(const std::filesystem::path& file, const Vec3d& origin, std::uint32_t acquisition);
+/// Reads the blocks at `blocks` of `file` (one acquisition's block file) into one piece in
+/// the frame `origin`: vertices of several blocks with the same id become one (the first
+/// block's copy), triangles keep the order in which they were written. Global ids get
+/// `acquisition`. Throws InputError naming the file, `tile` and the block when a block passes
+/// the file's end, is truncated, has another magic or version, a count that does not fit, an
+/// index out of range or a checksum that does not match.
+TilePiece read_tile_piece(const std::filesystem::path& file, std::span<const ByteRange> blocks, const Vec3d& origin,
+                          std::uint32_t acquisition, std::string_view tile);
 
 }  // namespace citymesh
