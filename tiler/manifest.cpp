@@ -187,7 +187,14 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
   if (!in) return std::nullopt;
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
-    if (j.at("version").get<int>() != kManifestVersion) {
+    const int version = j.at("version").get<int>();
+    if (version < kManifestVersion) {
+      // An older build's layout: not this build's finished store, so it is tiled again.
+      log::info("{}: a tile store of version {} (this build writes {}): tiled again", file.string(), version,
+                kManifestVersion);
+      return std::nullopt;
+    }
+    if (version != kManifestVersion) {
       throw InputError(fmt::format("{}: manifest version {} (this build writes {}); delete the work folder or run "
                                    "with --force",
                                    file.string(), j.at("version").dump(), kManifestVersion));

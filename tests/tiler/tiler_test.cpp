@@ -227,6 +227,25 @@ TEST(Tiler, ManifestRoundTrips) {
   }
 }
 
+TEST(Tiler, AManifestOfAnOlderLayoutIsNoFinishedStoreAndOneOfANewerIsAnError) {
+  Fixture f;
+  TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  write_tile_manifest(store);
+  const auto manifest = store.dir / "manifest.json";
+  const std::string text = test::read_text(manifest);
+  const auto with_version = [&](int version) {
+    std::string changed = text;
+    const std::size_t at = changed.find("\"version\": 2");
+    EXPECT_NE(at, std::string::npos);
+    changed.replace(at, 12, "\"version\": " + std::to_string(version));
+    test::write_text(manifest, changed);
+  };
+  with_version(1);  // a file per tile and acquisition: its acquisitions are tiled again
+  EXPECT_FALSE(read_tile_manifest(store.dir).has_value());
+  with_version(3);  // a newer build's: not ours to replace
+  EXPECT_THROW((void)read_tile_manifest(store.dir), InputError);
+}
+
 TEST(Tiler, DamagedBlocksAreInputErrorsNamingTheFileAndTile) {
   Fixture f;
   TileStore store = tile_acquisitions(f.acquisitions, f.params);
