@@ -1,4 +1,5 @@
 // SPDX-License-Identifier: MIT
+#include <array>
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -41,15 +42,14 @@ Box3f prism_box(const TriangleFrames& f, std::size_t u, double threshold) {
 }
 
 /// The pairs (min, max) found from triangle g's side: every U of another acquisition whose
-/// prism holds g's centroid, with compatible normals, that g overlaps. A pair that U also
-/// finds from its side (U overlaps g) is kept by the smaller index only, so that each pair is
-/// listed once.
-void pairs_of(const TriangleFrames& f, const BoxTree& prisms, std::size_t g, double threshold, float cos_min,
-              std::vector<std::uint32_t>& hits, std::vector<TrianglePair>& out) {
+/// prism holds g's centroid (`hits`), with compatible normals, that g overlaps. A pair that U
+/// also finds from its side (U overlaps g) is kept by the smaller index only, so that each
+/// pair is listed once.
+void pairs_of(const TriangleFrames& f, std::size_t g, std::span<const std::uint32_t> hits, double threshold,
+              float cos_min, std::vector<TrianglePair>& out) {
   const std::uint32_t acq = f.index.acquisition_of(g);
   const std::size_t own_begin = f.index.offsets[acq], own_end = f.index.offsets[acq + 1];
   const auto t = static_cast<std::uint32_t>(g);
-  prisms.containing(f.centroid[g], hits);
   for (const std::uint32_t u : hits) {
     if (u >= own_begin && u < own_end) continue;  // same acquisition
     if (dot(f.normal[g], f.normal[u]) < cos_min) continue;
@@ -71,13 +71,19 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
   });
   const BoxTree prisms(std::move(boxes));
 
-  constexpr std::size_t kGrain = 4096;
+  constexpr std::size_t kGrain = 4096;  // a multiple of the packet: packets stay in a block
   std::vector<std::vector<TrianglePair>> per_block((f.size() + kGrain - 1) / kGrain);
   parallel_for_blocks(f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    std::vector<std::uint32_t> hits;
-    // In the tree's order, a triangle's candidates are near the previous one's: warm caches.
-    for (std::size_t i = begin; i < end; ++i) {
-      pairs_of(f, prisms, prisms.storage_order()[i], threshold, cos_min, hits, per_block[begin / kGrain]);
+    std::array<std::vector<std::uint32_t>, BoxTree::kPacket> hits;
+    std::array<Vec3f, BoxTree::kPacket> centroids{};
+    // In the tree's order, a triangle's candidates are near the previous one's: warm caches,
+    // and packets of neighbouring centroids that share one walk down the tree.
+    const std::span<const std::uint32_t> order = prisms.storage_order();
+    for (std::size_t i = begin; i < end; i += BoxTree::kPacket) {
+      const std::size_t n = std::min(BoxTree::kPacket, end - i);
+      for (std::size_t k = 0; k < n; ++k) centroids[k] = f.centroid[order[i + k]];
+      prisms.containing_each(std::span(centroids).first(n), hits);
+      for (std::size_t k = 0; k < n; ++k) pairs_of(f, order[i + k], hits[k], threshold, cos_min, per_block[begin / kGrain]);
     }
   });
   std::size_t total = 0;

@@ -157,6 +157,39 @@ std::span<const std::uint32_t> BoxTree::storage_order() const { return impl_->or
 
 void BoxTree::containing(const Vec3f& p, std::vector<std::uint32_t>& out) const { overlapping({p, p}, out); }
 
+void BoxTree::containing_each(std::span<const Vec3f> points, std::span<std::vector<std::uint32_t>> out) const {
+  for (std::size_t i = 0; i < points.size(); ++i) out[i].clear();
+  const auto& levels = impl_->levels;
+  if (levels.empty() || points.empty()) return;
+  Box3f all{points[0], points[0]};
+  for (const Vec3f& p : points) all = united(all, {p, p});
+  struct Visit {
+    std::size_t level, node;
+  };
+  Visit stack[64 * kFanout];
+  std::size_t top = 0;
+  stack[top++] = {levels.size() - 1, 0};
+  // The same walk as overlapping() with the points' box, so each point meets its leaves in
+  // the order its own query would; only the leaves test the points one by one.
+  while (top > 0) {
+    const Visit v = stack[--top];
+    const Node& node = levels[v.level][v.node];
+    const unsigned mask = node.meeting(all);
+    if (mask == 0) continue;
+    if (v.level > 0) {
+      for (unsigned m = mask; m != 0; m &= m - 1) {
+        stack[top++] = {v.level - 1, v.node * kFanout + static_cast<std::size_t>(std::countr_zero(m))};
+      }
+      continue;
+    }
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      for (unsigned m = mask & node.meeting({points[i], points[i]}); m != 0; m &= m - 1) {
+        out[i].push_back(impl_->original[v.node * kFanout + static_cast<std::size_t>(std::countr_zero(m))]);
+      }
+    }
+  }
+}
+
 void BoxTree::overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const {
   out.clear();
   const auto& levels = impl_->levels;

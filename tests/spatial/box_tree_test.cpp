@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <random>
 #include <vector>
 
@@ -95,6 +96,32 @@ TEST(BoxTree, CoincidentBoxesAreAllFoundAndOrderedOnce) {
   std::sort(order.begin(), order.end());
   for (std::uint32_t i = 0; i < order.size(); ++i) EXPECT_EQ(order[i], i);
   EXPECT_EQ(order.size(), boxes.size());
+}
+
+TEST(BoxTree, ContainingEachGivesEachPointsOwnQueryInItsOrder) {
+  std::mt19937 rng(9);
+  const std::vector<Box3f> boxes = scene_boxes(rng);
+  const BoxTree tree(boxes);
+  // Packets as the consistency search makes them (centres of neighbouring boxes in the tree's
+  // order), then points anywhere, in packets of every size up to the largest.
+  std::vector<Vec3f> points;
+  for (const std::uint32_t i : tree.storage_order()) points.push_back((boxes[i].min + boxes[i].max) * 0.5f);
+  std::uniform_real_distribution<float> u(0, 10);
+  for (int k = 0; k < 400; ++k) points.push_back(Vec3f{u(rng), u(rng), u(rng)} + Vec3f{500, -300, 40});
+  std::array<std::vector<std::uint32_t>, BoxTree::kPacket> each;
+  std::vector<std::uint32_t> one;
+  std::size_t found = 0, size = 1;
+  for (std::size_t i = 0; i < points.size(); i += size, size = size % BoxTree::kPacket + 1) {
+    const std::size_t n = std::min(size, points.size() - i);
+    const std::span<const Vec3f> packet(points.data() + i, n);
+    tree.containing_each(packet, each);
+    for (std::size_t k = 0; k < n; ++k) {
+      tree.containing(packet[k], one);
+      ASSERT_EQ(each[k], one) << "point " << i + k;
+      found += one.size();
+    }
+  }
+  EXPECT_GT(found, 3000u);
 }
 
 TEST(BoxTree, EmptySetFindsNothing) {

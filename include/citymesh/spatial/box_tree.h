@@ -28,6 +28,12 @@ class BoxTree {
   /// Replaces `out` with the indices of the boxes containing p (closed boxes), in an order
   /// that depends on the boxes only. Thread-safe.
   void containing(const Vec3f& p, std::vector<std::uint32_t>& out) const;
+  /// The most points containing_each() takes at once.
+  static constexpr std::size_t kPacket = 8;
+  /// containing() for each of `points` (at most kPacket, best close together): out[i] gets
+  /// what containing(points[i], out[i]) gives, in the same order. One walk down the tree
+  /// serves them all, so that neighbouring queries share the upper levels. Thread-safe.
+  void containing_each(std::span<const Vec3f> points, std::span<std::vector<std::uint32_t>> out) const;
   /// Replaces `out` with the indices of the boxes overlapping the closed box b, in an order
   /// that depends on the boxes only. Fast for small query boxes. Thread-safe.
   void overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const;
