@@ -88,12 +88,14 @@ std::optional<std::size_t> acquisition_folder_index(const std::string& name) {
   return k;
 }
 
-/// Whether the manifest in `dir` is readable and made with `fingerprint`.
+/// Whether the manifest in `dir` is readable, of this build's version and made with
+/// `fingerprint` (read_tile_manifest() has said what it thinks of it already).
 bool manifest_made_with(const std::filesystem::path& dir, const std::string& fingerprint) {
+  std::ifstream in(dir / kManifestFile);
   try {
-    const std::optional<TileStore> store = read_tile_manifest(dir);
-    return store && store->fingerprint == fingerprint;
-  } catch (const InputError&) {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    return j.at("version").get<int>() == kManifestVersion && j.at("fingerprint").get<std::string>() == fingerprint;
+  } catch (const nlohmann::json::exception&) {
     return false;
   }
 }

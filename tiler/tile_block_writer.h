@@ -7,6 +7,8 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <future>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -97,22 +99,43 @@ class TileBlockWriter {
 };
 
 /// An acquisition's block file, created empty and kept open while the tiler appends to it.
+/// Blocks are gathered in page-aligned buffers, and each full buffer is written by a
+/// background task while the next one fills, with O_DIRECT where the file system allows it
+/// (not tmpfs): copying 1.2 GB of blocks into the page cache was a tenth of the tiler's time
+/// on the 112 M-triangle city, and tile processing reads them back much later.
 class BlockAppender {
  public:
   /// Throws OutputError naming `file` when it cannot be created.
   explicit BlockAppender(std::filesystem::path file);
+  /// Waits for the write in flight and closes the file; what is not written by then is lost
+  /// (the folder is never published).
   ~BlockAppender();
   BlockAppender(const BlockAppender&) = delete;
   BlockAppender& operator=(const BlockAppender&) = delete;
 
-  /// Appends the byte ranges `parts` as one write (not synced: see sync_tile_files) and
-  /// returns where they lie. Throws OutputError naming the file.
+  /// Appends the byte ranges `parts` as one block and returns where it lies. Throws
+  /// OutputError naming the file (also for an earlier buffer's write).
   ByteRange append(const std::vector<std::string_view>& parts);
+  /// Writes what is left and closes the file (not synced: see sync_tile_files). Throws
+  /// OutputError naming the file.
+  void close();
 
  private:
+  using Buffer = std::unique_ptr<char, void (*)(void*)>;
+  /// Hands the whole pages gathered so far, or with `all` everything (the last page padded, cut
+  /// off again in close()), to a background write, and goes on in the other buffer.
+  void write_gathered(bool all);
+  /// Waits for the write in flight, if any; rethrows its error.
+  void wait_for_write();
+
   std::filesystem::path file_;
   int fd_ = -1;
-  std::uint64_t size_ = 0;
+  std::uint64_t size_ = 0;     ///< bytes appended
+  std::uint64_t written_ = 0;  ///< bytes handed to writes: whole pages until close()
+  std::array<Buffer, 2> buffers_;
+  std::size_t current_ = 0;   ///< the buffer gathering what follows written_
+  std::size_t gathered_ = 0;  ///< bytes in it
+  std::future<void> write_;   ///< of the other buffer
 };
 
 }  // namespace citymesh::tiler_detail

@@ -113,6 +113,7 @@ class AcquisitionTiler {
       }
     }
     flush();
+    blocks_file_.close();
     if (zero_area_dropped_ > 0) log::info("{}: dropped {} zero-area triangles", file.string(), zero_area_dropped_);
     out_.triangles = next_index_;
     out_.stats.input_bytes += reader.stats().bytes;
@@ -301,10 +302,7 @@ AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerPa
   if (ec) throw OutputError(fmt::format("{}: cannot create a tiling folder: {}", staged.string(), ec.message()));
   AcquisitionTiling out;
   out.fingerprint = fingerprint;
-  {
-    AcquisitionTiler tiler(grid, staged / kBlocksFile, out, params.buffer_bytes);
-    tiler.run(acquisition.path, params.ply);
-  }  // the block file is closed
+  AcquisitionTiler(grid, staged / kBlocksFile, out, params.buffer_bytes).run(acquisition.path, params.ply);
   out.stats.seconds = clock.seconds();
   write_acquisition_tiling(staged, out);
   sync_tile_files(staged);
