@@ -98,8 +98,9 @@ constexpr std::size_t kGatherBytes = std::size_t{4} << 20;
 int open_block_file(const std::filesystem::path& file) {
   constexpr int flags = O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC;
   const int fd = ::open(file.c_str(), flags | O_DIRECT, 0644);
-  // tmpfs and a few others refuse O_DIRECT: write through the page cache there.
-  return fd >= 0 || errno != EINVAL ? fd : ::open(file.c_str(), flags, 0644);
+  // tmpfs and some network or FUSE file systems refuse O_DIRECT: write through the page cache
+  // there (an error of this second open is the one reported).
+  return fd >= 0 ? fd : ::open(file.c_str(), flags, 0644);
 }
 
 std::unique_ptr<char, void (*)(void*)> aligned_buffer() {
