@@ -349,9 +349,20 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
   std::filesystem::remove_all(params.dir, ec);
   std::filesystem::create_directories(params.dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", params.dir.string(), ec.message()));
+  // Largest file first, as `citymesh run` hands them out: the last acquisitions to start are
+  // the shortest, so the threads finish together.
+  std::vector<std::size_t> order(acquisitions.size());
+  std::vector<std::uintmax_t> sizes(acquisitions.size(), 0);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    order[k] = k;
+    sizes[k] = std::filesystem::file_size(acquisitions[k].path, ec);  // 0 when unreadable: the tiler says why
+  }
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
   std::vector<AcquisitionTiling> parts(acquisitions.size());
-  parallel_jobs(acquisitions.size(), at_once,
-                [&](std::size_t k) { parts[k] = tile_acquisition(acquisitions[k], params, ""); });
+  parallel_jobs(acquisitions.size(), at_once, [&](std::size_t i) {
+    const std::size_t k = order[i];
+    parts[k] = tile_acquisition(acquisitions[k], params, "");
+  });
   return assemble_tile_store(params.dir, params.grid, parts, "");
 }
 

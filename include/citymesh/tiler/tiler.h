@@ -95,9 +95,9 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
 void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions, const std::string& fingerprint,
                       bool staging);
 
-/// Empties `params.dir`, tiles every acquisition, `at_once` at a time (each alone, with its
-/// own buffers: the store's bytes do not depend on it), and assembles the store (without a
-/// fingerprint or manifest).
+/// Empties `params.dir`, tiles every acquisition, largest file first and `at_once` at a time
+/// (each alone, with its own buffers: the store's bytes do not depend on it), and assembles
+/// the store (without a fingerprint or manifest).
 TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params,
                             unsigned at_once = 1);
 
