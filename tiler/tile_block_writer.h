@@ -122,6 +122,10 @@ class BlockAppender {
 
  private:
   using Buffer = std::unique_ptr<char, void (*)(void*)>;
+  /// One gathering buffer, page-aligned as O_DIRECT needs.
+  static Buffer page_aligned_buffer();
+  /// Bytes appended so far.
+  [[nodiscard]] std::uint64_t appended() const { return written_ + gathered_; }
   /// Hands the whole pages gathered so far, or with `all` everything (the last page padded, cut
   /// off again in close()), to a background write, and goes on in the other buffer.
   void write_gathered(bool all);
@@ -130,7 +134,6 @@ class BlockAppender {
 
   std::filesystem::path file_;
   int fd_ = -1;
-  std::uint64_t size_ = 0;     ///< bytes appended
   std::uint64_t written_ = 0;  ///< bytes handed to writes: whole pages until close()
   std::array<Buffer, 2> buffers_;
   std::size_t current_ = 0;   ///< the buffer gathering what follows written_

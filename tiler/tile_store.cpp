@@ -103,12 +103,6 @@ int open_block_file(const std::filesystem::path& file) {
   return fd >= 0 ? fd : ::open(file.c_str(), flags, 0644);
 }
 
-std::unique_ptr<char, void (*)(void*)> aligned_buffer() {
-  std::unique_ptr<char, void (*)(void*)> b(static_cast<char*>(std::aligned_alloc(kPage, kGatherBytes)), std::free);
-  if (!b) throw std::bad_alloc();
-  return b;
-}
-
 /// Writes `bytes` of `data` at `offset` of `fd` (`file` names it in errors), then asks for
 /// write-back to start (without O_DIRECT, the fsync before the store is published then finds
 /// little left to wait for; only a hint).
@@ -127,8 +121,14 @@ void write_pages(int fd, const char* data, std::size_t bytes, std::uint64_t offs
 
 }  // namespace
 
+BlockAppender::Buffer BlockAppender::page_aligned_buffer() {
+  Buffer b(static_cast<char*>(std::aligned_alloc(kPage, kGatherBytes)), std::free);
+  if (!b) throw std::bad_alloc();
+  return b;
+}
+
 BlockAppender::BlockAppender(std::filesystem::path file)
-    : file_(std::move(file)), buffers_{aligned_buffer(), aligned_buffer()} {
+    : file_(std::move(file)), buffers_{page_aligned_buffer(), page_aligned_buffer()} {
   fd_ = open_block_file(file_);
   if (fd_ < 0) throw OutputError(fmt::format("{}: cannot create the block file: {}", file_.string(), std::strerror(errno)));
 }
@@ -139,7 +139,7 @@ BlockAppender::~BlockAppender() {
 }
 
 ByteRange BlockAppender::append(const std::vector<std::string_view>& parts) {
-  const std::uint64_t offset = size_;
+  const std::uint64_t offset = appended();
   for (std::string_view part : parts) {
     while (!part.empty()) {
       const std::size_t n = std::min(part.size(), kGatherBytes - gathered_);
@@ -149,8 +149,7 @@ ByteRange BlockAppender::append(const std::vector<std::string_view>& parts) {
       if (gathered_ == kGatherBytes) write_gathered(false);
     }
   }
-  size_ = written_ + gathered_;
-  return {offset, size_ - offset};
+  return {offset, appended() - offset};
 }
 
 void BlockAppender::wait_for_write() {
@@ -173,10 +172,11 @@ void BlockAppender::write_gathered(bool all) {
 }
 
 void BlockAppender::close() {
+  const std::uint64_t size = appended();
   write_gathered(true);
   wait_for_write();
   // The last page was padded: cut the file back to what was appended.
-  const bool ok = ::ftruncate(fd_, static_cast<off_t>(size_)) == 0;
+  const bool ok = ::ftruncate(fd_, static_cast<off_t>(size)) == 0;
   const int err = errno;
   ::close(fd_);
   fd_ = -1;

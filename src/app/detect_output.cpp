@@ -12,6 +12,7 @@
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/process_memory.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/render/render.h"
@@ -99,6 +100,13 @@ std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_
 unsigned labelled_output_workers(std::uint64_t largest, std::uint64_t memory) {
   const std::uint64_t fits = memory / std::max<std::uint64_t>(largest, 1);
   return static_cast<unsigned>(std::clamp<std::uint64_t>(fits, 1, available_threads()));
+}
+
+unsigned labelled_outputs_at_once(std::span<const std::uint64_t> vertex_counts, std::uint64_t bytes_per_vertex,
+                                  bool pictures, std::uint64_t budget) {
+  std::uint64_t largest = 0;
+  for (const std::uint64_t v : vertex_counts) largest = std::max(largest, labelled_output_bytes(v, bytes_per_vertex, pictures));
+  return labelled_output_workers(largest, memory_left(budget));
 }
 
 void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,

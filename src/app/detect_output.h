@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <span>
 #include <string_view>
 
 #include "acquisitions.h"
@@ -57,6 +58,11 @@ std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_
 /// How many acquisitions write_detect_outputs may write at once: one per thread while each,
 /// at `largest` bytes, fits in `memory` (what the budget leaves), and at least one.
 unsigned labelled_output_workers(std::uint64_t largest, std::uint64_t memory);
+
+/// labelled_output_workers() for acquisitions of `vertex_counts` vertices, against what the
+/// memory `budget` leaves beside the resident set now.
+unsigned labelled_outputs_at_once(std::span<const std::uint64_t> vertex_counts, std::uint64_t bytes_per_vertex,
+                                  bool pictures, std::uint64_t budget);
 
 /// Writes <dir>/<k>_<name>.ply and .png per acquisition, <dir>/pairs.bin and
 /// <dir>/summary.json (last), each atomically; `params.at_once` of the files at a time (the

@@ -4,10 +4,8 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
-#include <algorithm>
 #include <iostream>
 
-#include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "detect_output.h"
 #include "leftovers.h"
@@ -51,17 +49,15 @@ DetectStep run_detect_step(const Config& config, const PictureOptions& pictures)
   step.detect_seconds = clock.restart();
   const std::filesystem::path dir = config.project.output / "detect";
   InMemoryDetectOutput source(step.input, step.result);
-  std::uint64_t largest = 0;
-  for (const Mesh& m : step.input.meshes) {
-    largest = std::max(largest, labelled_output_bytes(m.vertex_count(), InMemoryDetectOutput::kBytesPerVertex,
-                                                      pictures.pictures));
-  }
+  std::vector<std::uint64_t> vertices;
+  for (const Mesh& m : step.input.meshes) vertices.push_back(m.vertex_count());
   write_detect_outputs(config, step.input, source,
                        {.dir = dir,
                         .pixel_size = pictures.pixel_size,
                         .pictures = pictures.pictures,
                         .read_seconds = step.read_seconds,
-                        .at_once = labelled_output_workers(largest, memory_left(config.run.memory))});
+                        .at_once = labelled_outputs_at_once(vertices, InMemoryDetectOutput::kBytesPerVertex,
+                                                            pictures.pictures, config.run.memory)});
   step.write_seconds = clock.restart();
   report(step.result, dir);
   return step;

@@ -84,10 +84,6 @@ class LabelledTriangles {
   std::uint64_t window_begin_ = 0, window_end_ = 0;
 };
 
-}  // namespace
-
-namespace {
-
 /// The frame whole-mesh reading puts every acquisition in: that of the first vertex of the
 /// first acquisition that has one (none: the origin).
 Vec3d shared_frame(const Config& config, const LoadedAcquisitions& described) {

@@ -42,13 +42,11 @@ LoadedAcquisitions describe_acquisitions(const Config& config) {
 /// How many acquisitions' labelled outputs are written at once: as many as the budget left
 /// holds, by their headers' vertex counts.
 unsigned labels_at_once(const Config& config, const LoadedAcquisitions& described, bool pictures) {
-  std::uint64_t largest = 0;
+  std::vector<std::uint64_t> vertices;
   for (const Acquisition& a : described.acquisitions) {
-    const PlyReader header(a.path, config.ply_read_params());
-    largest = std::max(largest,
-                       labelled_output_bytes(header.vertex_count(), TiledDetectOutput::kBytesPerVertex, pictures));
+    vertices.push_back(PlyReader(a.path, config.ply_read_params()).vertex_count());
   }
-  return labelled_output_workers(largest, memory_left(config.run.memory));
+  return labelled_outputs_at_once(vertices, TiledDetectOutput::kBytesPerVertex, pictures, config.run.memory);
 }
 
 void write_labels(const Config& config, const TileAssembly& assembly, const PictureOptions& pictures) {
