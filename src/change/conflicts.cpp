@@ -11,22 +11,60 @@ namespace citymesh::change_detail {
 
 namespace {
 
-/// Marks every voxel the empty space of triangle g crosses: the tetrahedron is cut into slabs
-/// about one voxel long and each slab's box is marked.
-void mark_empty_space(const TriangleFrames& f, std::size_t g, OccupancyGrid& grid) {
+/// Slabs whose joint box is asked of the mask before any of their own: most of an empty space
+/// crosses open air, where no triangle asks, and one question then spares four slabs (on the
+/// change benchmark 4 did better than 2, 8 or 16, and than groups within groups).
+constexpr int kSlabsPerGroup = 4;
+
+/// Marks the voxels the empty space of triangle g crosses, where `asked` holds them: the
+/// tetrahedron is cut into slabs about one voxel long and each slab's box that touches
+/// `asked` is marked whole. Each cut's fraction k / n is divided once and used by the slabs on
+/// both sides of it (the divisions were a fifth of the slabs' time).
+void mark_empty_space(const TriangleFrames& f, std::size_t g, const VoxelMask& asked, OccupancyGrid& grid) {
   const TetrahedronCorners q = f.empty_space(g);
   const EmptySpaceSlabs slabs(q);
   const int n = slab_count(q, grid.voxel_size());
-  for (int k = 0; k < n; ++k) {
-    const Box3f box = slabs.slab(k, n);
-    grid.mark_box(box.min, box.max);
+  const double inverse = grid.inverse_voxel_size();
+  const auto cut = [n](int k) { return double(k) / n; };
+  double group_start = 0.0;
+  for (int first = 0; first < n; first += kSlabsPerGroup) {
+    const int last = std::min(n, first + kSlabsPerGroup);
+    const double group_end = cut(last);
+    const Box3f group = slabs.between(group_start, group_end);
+    if (last - first > 1 && !asked.any_in(voxel_box(group.min, group.max, inverse))) {
+      group_start = group_end;
+      continue;
+    }
+    double s0 = group_start;
+    for (int k = first; k < last; ++k) {
+      const double s1 = k + 1 == last ? group_end : cut(k + 1);
+      const Box3f box = slabs.between(s0, s1);
+      const VoxelBox voxels = voxel_box(box.min, box.max, inverse);
+      if (asked.any_in(voxels)) grid.mark_voxels(voxels);
+      s0 = s1;
+    }
+    group_start = group_end;
   }
 }
 
 }  // namespace
 
+VoxelMask asked_voxels(const TriangleFrames& f, double voxel_size) {
+  // Every question is about the box of a triangle older than some acquisition.
+  const TimePoint newest = *std::max_element(f.dates.begin(), f.dates.end());
+  const double inverse = OccupancyGrid::inverse_of(voxel_size);
+  std::vector<VoxelBox> boxes;
+  for (std::size_t a = 0; a < f.acquisitions(); ++a) {
+    if (!(f.dates[a] < newest)) continue;
+    for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
+      boxes.push_back(voxel_box(f.bounds(g).min, f.bounds(g).max, inverse));
+    }
+  }
+  return VoxelMask(boxes);
+}
+
 std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, const ChangeParams& params,
-                                                   ChangeStats& stats) {
+                                                   const VoxelMask& asked, ChangeStats& stats) {
   // Only empty space newer than something is ever asked about: the oldest acquisitions'
   // grids stay empty. The others are marked in chunks of triangles, one grid each for an even
   // load whatever the acquisition sizes, then merged (a union: the order does not matter).
@@ -47,7 +85,7 @@ std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, cons
   parallel_for_blocks(chunks.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) {
       for (std::size_t g = chunks[c].begin; g < chunks[c].end; ++g) {
-        if (f.empty_scale[g] > 0) mark_empty_space(f, g, chunk_grids[c]);
+        if (f.empty_scale[g] > 0) mark_empty_space(f, g, asked, chunk_grids[c]);
       }
     }
   });

@@ -116,7 +116,7 @@ ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params
 
   const bool need_grids = params.prefilter || params.unconfirmed == UnconfirmedPolicy::keep_unobserved;
   std::vector<OccupancyGrid> grids;
-  if (need_grids) grids = build_empty_space_grids(frames, params, r.stats);
+  if (need_grids) grids = build_empty_space_grids(frames, params, asked_voxels(frames, params.voxel_size), r.stats);
   r.stats.seconds_grids = clock.restart();
 
   const PartnerBits partners = partner_bits(frames, r.consistent_pairs);

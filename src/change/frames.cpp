@@ -118,8 +118,7 @@ EmptySpaceSlabs::EmptySpaceSlabs(const TetrahedronCorners& q) : apex_(q[0]), low
   }
 }
 
-Box3f EmptySpaceSlabs::slab(int k, int n) const {
-  const double s0 = double(k) / n, s1 = double(k + 1) / n;
+Box3f EmptySpaceSlabs::between(double s0, double s1) const {
   Box3d b;
   for (int a = 0; a < 3; ++a) {
     b.min[a] = std::min(apex_[a] + low_[a] * s0, apex_[a] + low_[a] * s1);

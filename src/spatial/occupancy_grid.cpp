@@ -20,19 +20,14 @@ void initialise_openvdb() {
   std::call_once(once, [] { openvdb::initialize(); });
 }
 
-/// floor(v) as an integer, without the libm call std::floor makes on plain x86-64 (the grids
-/// spend a tenth of their time there otherwise).
-openvdb::Int32 floor_to_int(double v) {
-  const auto i = static_cast<openvdb::Int32>(v);
-  return static_cast<double>(i) > v ? i - 1 : i;
+/// The voxel holding p: the rounding of voxel_box, which marks and queries share.
+openvdb::Coord voxel_of(const Vec3f& p, double inverse_size) {
+  const VoxelBox v = voxel_box(p, p, inverse_size);
+  return {v.lo[0], v.lo[1], v.lo[2]};
 }
 
-/// The voxel holding p, for voxels of 1 / `inverse_size` metres. Marking and queries both use
-/// it, so that a box overlapping a marked box always meets one of its voxels. Always inlined:
-/// returned from a call, the three ints are stored as two halves and reloaded as one (a
-/// store-forwarding stall that took 8 % of the change step).
-[[gnu::always_inline]] inline openvdb::Coord voxel_of(const Vec3f& p, double inverse_size) {
-  return {floor_to_int(p.x * inverse_size), floor_to_int(p.y * inverse_size), floor_to_int(p.z * inverse_size)};
+openvdb::CoordBBox coord_box(const VoxelBox& v) {
+  return {openvdb::Coord(v.lo[0], v.lo[1], v.lo[2]), openvdb::Coord(v.hi[0], v.hi[1], v.hi[2])};
 }
 
 /// Above this many voxels a box query walks the active voxels instead of the box.
@@ -60,7 +55,7 @@ struct OccupancyGrid::Impl {
   openvdb::BoolGrid::Accessor accessor;  ///< caches the last nodes marked (not thread-safe, like marking)
   std::array<openvdb::CoordBBox, kRecentBoxes> recent;  ///< boxes marked lately, by box_slot
   Impl(double voxel_size, openvdb::BoolGrid::Ptr g)
-      : size(voxel_size), inverse_size(1.0 / voxel_size), grid(std::move(g)), accessor(grid->getAccessor()) {}
+      : size(voxel_size), inverse_size(inverse_of(voxel_size)), grid(std::move(g)), accessor(grid->getAccessor()) {}
 };
 
 namespace {
@@ -84,8 +79,10 @@ double OccupancyGrid::voxel_size() const { return impl_->size; }
 
 void OccupancyGrid::mark_point(const Vec3f& p) { impl_->accessor.setValueOn(voxel_of(p, impl_->inverse_size), true); }
 
-void OccupancyGrid::mark_box(const Vec3f& lo, const Vec3f& hi) {
-  const openvdb::CoordBBox box(voxel_of(lo, impl_->inverse_size), voxel_of(hi, impl_->inverse_size));
+void OccupancyGrid::mark_box(const Vec3f& lo, const Vec3f& hi) { mark_voxels(voxel_box(lo, hi, impl_->inverse_size)); }
+
+void OccupancyGrid::mark_voxels(const VoxelBox& voxels) {
+  const openvdb::CoordBBox box = coord_box(voxels);
   // Neighbouring triangles seen from nearby viewpoints mark the same voxel boxes over and
   // over: remember recent boxes and skip repeats.
   openvdb::CoordBBox& recent = impl_->recent[box_slot(box)];
@@ -104,7 +101,7 @@ bool OccupancyGrid::occupied(const Vec3f& p) const {
 }
 
 bool OccupancyGrid::any_in_box(const Vec3f& lo, const Vec3f& hi) const {
-  const openvdb::CoordBBox box(voxel_of(lo, impl_->inverse_size), voxel_of(hi, impl_->inverse_size));
+  const openvdb::CoordBBox box = coord_box(voxel_box(lo, hi, impl_->inverse_size));
   const auto& tree = impl_->grid->tree();
   if (static_cast<std::int64_t>(box.volume()) <= kDenseQueryLimit) {
     openvdb::BoolGrid::ConstAccessor access = impl_->grid->getConstAccessor();

@@ -14,6 +14,7 @@
 #include "citymesh/scan/sensor_grid.h"
 #include "citymesh/sim/scanner.h"
 #include "citymesh/sim/scene.h"
+#include "frames.h"
 
 namespace citymesh {
 namespace {
@@ -314,6 +315,33 @@ TEST(DetectChanges, PrefilterAndThreadCountNeverChangeTheResult) {
                                                                a.kept.begin() + (to - a.state.begin()), 1)));
   const ThreadLimit one(1);
   expect_same(a, detect(meshes, dates, with));
+}
+
+TEST(EmptySpaceGrids, MarkedOnlyWhereAskedTheyAnswerEveryQuestionAsIfMarkedEverywhere) {
+  std::vector<TimePoint> dates;
+  const std::vector<Mesh> meshes = simulated_street(dates);
+  const ChangeParams params;
+  const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
+  ChangeStats everywhere_stats, asked_stats;
+  const std::vector<OccupancyGrid> everywhere =
+      change_detail::build_empty_space_grids(f, params, VoxelMask(), everywhere_stats);
+  const std::vector<OccupancyGrid> asked = change_detail::build_empty_space_grids(
+      f, params, change_detail::asked_voxels(f, params.voxel_size), asked_stats);
+  EXPECT_LT(asked_stats.marked_voxels * 2, everywhere_stats.marked_voxels);  // the mask spares most marks
+  // The questions the pre-filter and the unconfirmed policy ask: a triangle's box, of a grid newer.
+  std::size_t questions = 0, yes = 0;
+  for (std::size_t g = 0; g < f.size(); ++g) {
+    for (std::size_t j = 0; j < f.acquisitions(); ++j) {
+      if (!(f.date_of(g) < f.dates[j])) continue;
+      const Box3f& b = f.bounds(g);
+      const bool answer = everywhere[j].any_in_box(b.min, b.max);
+      ASSERT_EQ(asked[j].any_in_box(b.min, b.max), answer) << "triangle " << g << ", grid " << j;
+      ++questions;
+      yes += answer ? 1 : 0;
+    }
+  }
+  EXPECT_GT(yes, questions / 10);
+  EXPECT_LT(yes, questions);
 }
 
 TEST(DetectChanges, RejectsMeshesInDifferentFramesOrWithoutSensors) {

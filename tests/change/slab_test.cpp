@@ -44,6 +44,29 @@ TEST(EmptySpaceSlabs, EqualTheSixPointBoxToTheBit) {
   }
 }
 
+TEST(EmptySpaceSlabs, TheBoxOfAStretchHoldsEachOfItsSlabsBoxesToTheBit) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coordinate(-3000.0, 3000.0), jitter(-0.5, 0.5);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3d viewpoint{coordinate(rng), coordinate(rng), 2.0 + jitter(rng)};
+    const Vec3d corner = viewpoint + Vec3d{jitter(rng) * 80, jitter(rng) * 80, jitter(rng) * 30};
+    const TetrahedronCorners q{viewpoint, corner, corner + Vec3d{jitter(rng), jitter(rng), jitter(rng)},
+                               corner + Vec3d{jitter(rng), jitter(rng), jitter(rng)}};
+    const EmptySpaceSlabs slabs(q);
+    const int n = slab_count(q, 0.5);
+    std::uniform_int_distribution<int> pick(0, n - 1);
+    const int first = pick(rng), last = std::min(n, first + 1 + pick(rng) % 9);
+    const Box3f stretch = slabs.between(double(first) / n, double(last) / n);
+    for (int k = first; k < last; ++k) {
+      const Box3f box = slabs.slab(k, n);
+      for (int a = 0; a < 3; ++a) {
+        ASSERT_LE(stretch.min[a], box.min[a]) << "trial " << trial << " slab " << k << " of " << n;
+        ASSERT_GE(stretch.max[a], box.max[a]) << "trial " << trial << " slab " << k << " of " << n;
+      }
+    }
+  }
+}
+
 TEST(EmptySpaceSlabs, CoverEveryPointOfTheEmptySpace) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> coordinate(-30.0, 30.0), unit(0.0, 1.0);

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "citymesh/core/vec.h"
+#include "citymesh/spatial/voxel_box.h"
 
 namespace citymesh {
 
@@ -19,10 +20,16 @@ class OccupancyGrid {
   OccupancyGrid& operator=(OccupancyGrid&&) noexcept;
 
   [[nodiscard]] double voxel_size() const;
+  /// 1 / voxel_size(): what voxel_box takes to give this grid's voxels.
+  [[nodiscard]] double inverse_voxel_size() const { return inverse_of(voxel_size()); }
+  /// What inverse_voxel_size() is for a grid of voxels of `voxel_size` metres.
+  [[nodiscard]] static double inverse_of(double voxel_size) { return 1.0 / voxel_size; }
   /// Marks the voxel containing `p`.
   void mark_point(const Vec3f& p);
   /// Marks every voxel that overlaps the closed box [lo, hi].
   void mark_box(const Vec3f& lo, const Vec3f& hi);
+  /// Marks voxels.lo..voxels.hi (see voxel_box, with 1 / voxel_size()).
+  void mark_voxels(const VoxelBox& voxels);
   [[nodiscard]] bool occupied(const Vec3f& p) const;
   /// True when any voxel overlapping the closed box [lo, hi] is marked.
   [[nodiscard]] bool any_in_box(const Vec3f& lo, const Vec3f& hi) const;
