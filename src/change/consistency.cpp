@@ -15,8 +15,9 @@ namespace {
 /// T (centroid c) overlaps U: c lies within `threshold` of U's plane and its projection on
 /// that plane falls inside U (edges included), i.e. the point-to-triangle distance is at most
 /// the threshold and is reached inside U.
-bool overlaps(const Vec3d& c, const TriangleFrames& f, std::uint32_t u, double threshold) {
-  const TriangleCorners q = f.corners(u);
+[[gnu::always_inline]] inline bool overlaps(const Vec3d& c, const TriangleFrames& f, std::uint32_t u, double threshold) {
+  const std::array<Vec3f, 3>& qf = f.corner[u];
+  const TriangleCorners q{Vec3d(qf[0]), Vec3d(qf[1]), Vec3d(qf[2])};
   const Vec3d n(f.normal[u]);
   const double h = dot(c - q[0], n);
   if (std::abs(h) > threshold) return false;

@@ -19,6 +19,19 @@ double BinaryEnergy::evaluate(std::span<const std::int8_t> x) const {
   return e;
 }
 
+std::array<double, 2> BinaryEnergy::evaluate(std::span<const std::int8_t> x, std::span<const std::int8_t> y) const {
+  double ex = 0, ey = 0;
+  for (std::size_t i = 0; i < unary.size(); ++i) {
+    ex += unary[i][static_cast<std::size_t>(x[i])];
+    ey += unary[i][static_cast<std::size_t>(y[i])];
+  }
+  for (const Pair& p : pairs) {
+    ex += p.value(x[p.i] != 0, x[p.j] != 0);
+    ey += p.value(y[p.i] != 0, y[p.j] != 0);
+  }
+  return {ex, ey};
+}
+
 namespace {
 
 /// The interaction strength of a pair: e01 + e10 - e00 - e11, > 0 for submodular terms.
@@ -39,32 +52,18 @@ BinaryEnergy::Pair flip_pair(BinaryEnergy::Pair p, bool flip_i, bool flip_j) {
   return p;
 }
 
-/// Loads a cut graph into our max-flow.
-MaxFlow max_flow_of(const CutGraph& c) {
-  MaxFlow g(c.nodes);
-  g.reserve_edges(c.arcs.size());
-  for (std::size_t i = 0; i < c.nodes; ++i) {
-    if (c.terminal[i][0] > 0 || c.terminal[i][1] > 0) {
-      g.add_terminal(static_cast<MaxFlow::Node>(i), c.terminal[i][0], c.terminal[i][1]);
-    }
-  }
-  for (const CutGraph::Arc& a : c.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
-  return g;
-}
-
 }  // namespace
 
-CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips) {
+namespace {
+
+/// The terms of the s-t graph of cut_graph(), handed out as they are made: add_edge(from, to,
+/// capacity, reverse capacity) in the order of the energy's pairs, then add_terminal(node,
+/// from the source, to the sink) for every node with one, in node order.
+template <class AddEdge, class AddTerminal>
+void make_cut(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips, AddEdge add_edge,
+              AddTerminal add_terminal) {
   const auto flipped_at = [&flips](std::uint32_t i) { return !flips.empty() && flips[i] != 0; };
   const std::size_t n = e.size();
-  CutGraph g;
-  g.nodes = doubled ? 2 * n : n;
-  g.terminal.assign(g.nodes, {0.0, 0.0});
-  g.arcs.reserve(doubled ? 2 * e.pairs.size() : e.pairs.size());
-  // Both directions of a pair of nodes go into one arc pair: half the arcs to scan.
-  const auto add_edge = [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse = 0) {
-    g.arcs.push_back({from, to, capacity, reverse});
-  };
   std::vector<double> cost_of_one(n, 0.0);  // unary cost of x_i = 1 over x_i = 0 (constants dropped)
   for (std::size_t i = 0; i < n; ++i) {
     const auto v = static_cast<std::uint32_t>(i);
@@ -96,29 +95,55 @@ CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uin
       cost_of_one[p.i] += p.e11 - p.e01 - beta;
       cost_of_one[p.j] += p.e11 - p.e10 - beta;
       if (alpha > 0) {
-        add_edge(i, bar(j), alpha);  // x_i = 0 (i source side), x_j = 0 (bar j sink side)
-        add_edge(j, bar(i), alpha);
+        add_edge(i, bar(j), alpha, 0.0);  // x_i = 0 (i source side), x_j = 0 (bar j sink side)
+        add_edge(j, bar(i), alpha, 0.0);
       }
       if (beta > 0) {
-        add_edge(bar(i), j, beta);  // x_i = 1 (bar i source side), x_j = 1 (j sink side)
-        add_edge(bar(j), i, beta);
+        add_edge(bar(i), j, beta, 0.0);  // x_i = 1 (bar i source side), x_j = 1 (j sink side)
+        add_edge(bar(j), i, beta, 0.0);
       }
     }
   }
+  // x_i = 1 puts node i on the sink side, cutting source -> i: a positive cost goes there.
   for (std::size_t i = 0; i < n; ++i) {
     const double d = cost_of_one[i];
-    const auto v = static_cast<std::uint32_t>(i);
-    if (d > 0) {
-      g.terminal[v][0] += d;  // x_i = 1: node on the sink side, cutting source -> i
-      if (doubled) g.terminal[bar(v)][1] += d;
-    } else if (d < 0) {
-      g.terminal[v][1] -= d;
-      if (doubled) g.terminal[bar(v)][0] -= d;
-    }
+    if (d != 0) add_terminal(static_cast<std::uint32_t>(i), d > 0 ? d : 0.0, d < 0 ? -d : 0.0);
   }
+  if (!doubled) return;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double d = cost_of_one[i];
+    if (d != 0) add_terminal(bar(static_cast<std::uint32_t>(i)), d < 0 ? -d : 0.0, d > 0 ? d : 0.0);
+  }
+}
+
+/// The graph of cut_graph() loaded straight into our max-flow.
+MaxFlow max_flow_of(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips = {}) {
+  MaxFlow g(doubled ? 2 * e.size() : e.size());
+  g.reserve_edges(doubled ? 2 * e.pairs.size() : e.pairs.size());
+  make_cut(
+      e, doubled, flips,
+      [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse) {
+        g.add_edge(from, to, capacity, reverse);
+      },
+      [&g](std::uint32_t node, double from_source, double to_sink) { g.add_terminal(node, from_source, to_sink); });
   return g;
 }
 
+}  // namespace
+
+CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uint8_t> flips) {
+  CutGraph g;
+  g.nodes = doubled ? 2 * e.size() : e.size();
+  g.terminal.assign(g.nodes, {0.0, 0.0});
+  g.arcs.reserve(doubled ? 2 * e.pairs.size() : e.pairs.size());
+  make_cut(
+      e, doubled, flips,
+      [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse) {
+        g.arcs.push_back({from, to, capacity, reverse});
+      },
+      [&g](std::uint32_t node, double from_source, double to_sink) { g.terminal[node] = {from_source, to_sink}; });
+  return g;
+}
 
 bool flips_make_submodular(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
   return std::all_of(e.pairs.begin(), e.pairs.end(), [&](const BinaryEnergy::Pair& p) {
@@ -169,7 +194,7 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
 }
 
 std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {
-  MaxFlow g = max_flow_of(cut_graph(e, /*doubled=*/false, flips));
+  MaxFlow g = max_flow_of(e, /*doubled=*/false, flips);
   g.solve();
   const std::vector<std::uint8_t> source = g.source_side();
   std::vector<std::int8_t> x(e.size());
@@ -179,7 +204,7 @@ std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::spa
 
 std::vector<std::int8_t> qpbo(const BinaryEnergy& e) {
   const std::size_t n = e.size();
-  MaxFlow g = max_flow_of(cut_graph(e, /*doubled=*/true));
+  MaxFlow g = max_flow_of(e, /*doubled=*/true);
   g.solve();
   // Nodes reachable from the source lie on the source side of every minimum cut: x_i = 0 when
   // i is, x_i = 1 when its negation is; both never happen (that would be an s-t path).

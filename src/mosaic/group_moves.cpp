@@ -53,7 +53,7 @@ SolveOutcome solve_subset(const BinaryEnergy& e, const PairIndex& index, std::sp
   // The restricted energy differs from the whole one by a constant: compare there.
   std::vector<std::int8_t> now(open.size());
   for (std::size_t l = 0; l < open.size(); ++l) now[l] = x[open[l]];
-  const double before = sub.evaluate(now), after = sub.evaluate(y);
+  const auto [before, after] = sub.evaluate(now, y);
   if (after < before - 1e-9 * (1 + std::abs(before))) {
     for (std::size_t l = 0; l < open.size(); ++l) x[open[l]] = y[l];
     out.improved = true;

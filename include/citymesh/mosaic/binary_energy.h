@@ -27,6 +27,8 @@ struct BinaryEnergy {
   [[nodiscard]] std::size_t size() const { return unary.size(); }
   /// E(x) for a complete labelling (every entry 0 or 1).
   [[nodiscard]] double evaluate(std::span<const std::int8_t> x) const;
+  /// The energies of x and of y in one pass over the terms, each summed as evaluate() would.
+  [[nodiscard]] std::array<double, 2> evaluate(std::span<const std::int8_t> x, std::span<const std::int8_t> y) const;
 };
 
 /// Label of a variable: 0, 1, or unlabelled.
