@@ -90,32 +90,42 @@ double MeshTopology::boundary_length() const {
   return edges_length(merged_.mesh, boundary_edges());
 }
 
+namespace {
+
+constexpr std::size_t kVertexGrain = 1 << 15;
+
+}  // namespace
+
 std::vector<EdgeUse> MeshTopology::boundary_edges() const {
-  const auto& triangles = merged_.mesh.triangles;
-  // Per block of triangles, its edges that no other use shares; blocks joined in order.
-  constexpr std::size_t kGrain = 1 << 16;
-  std::vector<std::vector<EdgeUse>> per_block((triangles.size() + kGrain - 1) / kGrain);
-  parallel_for_blocks(triangles.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    std::vector<EdgeUse>& out = per_block[begin / kGrain];
-    for (std::size_t t = begin; t < end; ++t) {
-      const Triangle& tri = triangles[t];
-      for (int k = 0; k < 3; ++k) {
-        const std::uint32_t lo = std::min(tri[k], tri[(k + 1) % 3]), hi = std::max(tri[k], tri[(k + 1) % 3]);
-        // The uses of {lo, hi}, by the triangles around lo (each counted once).
-        std::size_t uses = 0;
-        const std::span<const std::uint32_t> around = triangles_of(lo);
-        for (std::size_t i = 0; i < around.size() && uses < 2; ++i) {
-          if (std::find(around.begin(), around.begin() + static_cast<std::ptrdiff_t>(i), around[i]) !=
-              around.begin() + static_cast<std::ptrdiff_t>(i)) {
-            continue;
-          }
-          const Triangle& other = triangle(around[i]);
-          for (int j = 0; j < 3; ++j) {
-            const std::uint32_t a = other[j], b = other[(j + 1) % 3];
-            if (std::min(a, b) == lo && std::max(a, b) == hi) ++uses;
-          }
+  // Each edge {lo, hi} is looked at from lo only: the uses of every edge at lo come from one
+  // pass over the triangles around lo (each triangle read three times in all, where a look
+  // around lo for each of a triangle's edges read it eighteen times).
+  const std::size_t vertices = edited_.size();  // the vertices the lists know
+  std::vector<std::vector<EdgeUse>> per_block((vertices + kVertexGrain - 1) / kVertexGrain);
+  parallel_for_blocks(vertices, kVertexGrain, [&](std::size_t begin, std::size_t end) {
+    std::vector<EdgeUse>& out = per_block[begin / kVertexGrain];
+    std::vector<EdgeUse> at;  // the uses of the edges whose smaller end is v
+    for (auto v = static_cast<std::uint32_t>(begin); v < end; ++v) {
+      at.clear();
+      const std::span<const std::uint32_t> around = triangles_of(v);
+      for (std::size_t i = 0; i < around.size(); ++i) {
+        const Triangle& tri = triangle(around[i]);
+        // A triangle is listed once per corner at v: one with two there is counted once.
+        const int corners_at_v = (tri[0] == v) + (tri[1] == v) + (tri[2] == v);
+        const auto seen = around.begin() + static_cast<std::ptrdiff_t>(i);
+        if (corners_at_v > 1 && std::find(around.begin(), seen, around[i]) != seen) continue;
+        const std::uint32_t t = around[i];
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t a = tri[k], b = tri[(k + 1) % 3];
+          if (std::min(a, b) == v) at.push_back({v, std::max(a, b), t});
         }
-        if (uses == 1) out.push_back({lo, hi, static_cast<std::uint32_t>(t)});
+      }
+      std::sort(at.begin(), at.end());
+      for (std::size_t i = 0; i < at.size();) {
+        std::size_t j = i + 1;
+        while (j < at.size() && at[j].hi == at[i].hi) ++j;
+        if (j - i == 1) out.push_back(at[i]);
+        i = j;
       }
     }
   });
