@@ -30,11 +30,18 @@ std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const
     const Mesh& mesh = input.meshes[a];
     const std::size_t base = index.offsets[a];
     parallel_for_blocks(mesh.triangle_count(), 4096, [&](std::size_t begin, std::size_t end) {
+      // The block's candidates in mesh order (neighbours in a scan): asked in packets.
+      std::vector<std::uint32_t> asked;
+      std::vector<Vec3d> centroids;
       for (std::size_t t = begin; t < end; ++t) {
         if (change.kept[base + t] == 0 || selected[base + t] != 0) continue;
         const auto [p, q, r] = mesh.corners(t);
-        open[base + t] = near_initial.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
+        asked.push_back(static_cast<std::uint32_t>(t));
+        centroids.push_back((p + q + r) / 3.0);
       }
+      std::vector<std::uint8_t> covered(asked.size());
+      near_initial.any_within_each(centroids, reach, covered);
+      for (std::size_t i = 0; i < asked.size(); ++i) open[base + asked[i]] = covered[i] != 0 ? 0 : 1;
     });
   }
   return open;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 
 #include "citymesh/core/mesh.h"
 
@@ -26,6 +27,10 @@ class MeshProximity {
   /// in the mesh's local frame). Thread-safe.
   [[nodiscard]] bool any_within(const Vec3d& p, double reach,
                                 const std::function<bool(std::uint32_t)>& accept = {}) const;
+  /// any_within(points[i], reach) into within[i] for each point, in packets of neighbouring
+  /// points that share one walk down the index (pass points close together, such as a
+  /// mesh's triangles in order). Thread-safe.
+  void any_within_each(std::span<const Vec3d> points, double reach, std::span<std::uint8_t> within) const;
   /// True when p lies within `reach` of the plane of a triangle t with accept(t) and projects
   /// inside it (edges included): p is on that triangle, not merely beside it.
   [[nodiscard]] bool any_over(const Vec3d& p, double reach, const std::function<bool(std::uint32_t)>& accept = {}) const;
