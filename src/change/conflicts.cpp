@@ -51,6 +51,7 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, const VoxelMask& a
 
 VoxelMask asked_voxels(const TriangleFrames& f, double voxel_size) {
   // Every question is about the box of a triangle older than some acquisition.
+  if (f.dates.empty()) return VoxelMask(std::span<const VoxelBox>{});
   const TimePoint newest = *std::max_element(f.dates.begin(), f.dates.end());
   const double inverse = OccupancyGrid::inverse_of(voxel_size);
   std::vector<VoxelBox> boxes;
@@ -68,6 +69,7 @@ std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, cons
   // Only empty space newer than something is ever asked about: the oldest acquisitions'
   // grids stay empty. The others are marked in chunks of triangles, one grid each for an even
   // load whatever the acquisition sizes, then merged (a union: the order does not matter).
+  if (f.dates.empty()) return {};
   const TimePoint oldest = *std::min_element(f.dates.begin(), f.dates.end());
   struct Chunk {
     std::size_t acquisition, begin, end;

@@ -344,6 +344,13 @@ TEST(EmptySpaceGrids, MarkedOnlyWhereAskedTheyAnswerEveryQuestionAsIfMarkedEvery
   EXPECT_LT(yes, questions);
 }
 
+TEST(DetectChanges, NoMeshesGiveAnEmptyResult) {
+  const ChangeResult r = detect_changes({{}, {}}, ChangeParams{});
+  EXPECT_EQ(r.index.size(), 0u);
+  EXPECT_TRUE(r.kept.empty());
+  EXPECT_TRUE(r.consistent_pairs.empty());
+}
+
 TEST(DetectChanges, RejectsMeshesInDifferentFramesOrWithoutSensors) {
   std::vector<Mesh> m = wall_then_gone();
   m[1].origin = {1, 0, 0};
