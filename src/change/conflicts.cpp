@@ -26,6 +26,13 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, const VoxelMask& a
   const int n = slab_count(q, grid.voxel_size());
   const double inverse = grid.inverse_voxel_size();
   const auto cut = [n](int k) { return double(k) / n; };
+  if (asked.holds_everything()) {  // every slab marked: no question to ask
+    for (int k = 0; k < n; ++k) {
+      const Box3f box = slabs.slab(k, n);
+      grid.mark_box(box.min, box.max);
+    }
+    return;
+  }
   double group_start = 0.0;
   for (int first = 0; first < n; first += kSlabsPerGroup) {
     const int last = std::min(n, first + kSlabsPerGroup);
