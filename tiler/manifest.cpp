@@ -66,8 +66,7 @@ std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folde
     t.stats = stats_from_json(j.at("stats"));
     for (const auto& row : j.at("tiles")) {
       const TileKey key{row.at("i").get<std::int32_t>(), row.at("j").get<std::int32_t>()};
-      t.counts[key] = row.at("triangles").get<std::array<std::uint64_t, 3>>();
-      t.blocks[key] = ranges_from_json(row.at("blocks"));
+      t.tiles[key] = {row.at("triangles").get<std::array<std::uint64_t, 3>>(), ranges_from_json(row.at("blocks"))};
     }
     return t;
   } catch (const std::exception& e) {
@@ -104,12 +103,8 @@ bool manifest_made_with(const std::filesystem::path& dir, const std::string& fin
 
 void write_acquisition_tiling(const std::filesystem::path& dir, const AcquisitionTiling& tiling) {
   nlohmann::json tiles = nlohmann::json::array();
-  for (const auto& [key, c] : tiling.counts) {
-    const auto blocks = tiling.blocks.find(key);
-    tiles.push_back({{"i", key.i},
-                     {"j", key.j},
-                     {"triangles", c},
-                     {"blocks", ranges_json(blocks == tiling.blocks.end() ? std::vector<ByteRange>{} : blocks->second)}});
+  for (const auto& [key, t] : tiling.tiles) {
+    tiles.push_back({{"i", key.i}, {"j", key.j}, {"triangles", t.counts}, {"blocks", ranges_json(t.blocks)}});
   }
   const nlohmann::json j{{"version", kSummaryVersion}, {"fingerprint", tiling.fingerprint},
                          {"triangles", tiling.triangles}, {"stats", stats_json(tiling.stats)},

@@ -196,12 +196,12 @@ class AcquisitionTiler {
     std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
     for (const TileCopy& c : copies_) sorted_[at[c.slot_role >> 2]++] = c.triangle << 2 | (c.slot_role & 3u);
     for (const auto& [key, s] : slot_of_) {
-      auto& counts = out_.counts[key];
-      for (std::size_t r = 0; r < 3; ++r) counts[r] += tiles_[s].counts[r];
+      AcquisitionTile& tile = out_.tiles[key];
+      for (std::size_t r = 0; r < 3; ++r) tile.counts[r] += tiles_[s].counts[r];
       const std::vector<std::string_view> block =
           build_block(key, std::span(sorted_).subspan(start[s], start[s + 1] - start[s]));
       const ByteRange range = blocks_file_.append(block);
-      out_.blocks[key].push_back(range);
+      tile.blocks.push_back(range);
       out_.stats.bytes_written += range.bytes;
       ++out_.stats.blocks;
     }
@@ -328,13 +328,13 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
     store.stats.blocks += s.blocks;
     store.stats.bytes_written += s.bytes_written;
     store.stats.seconds += s.seconds;
-    for (const auto& [key, roles] : part.counts) {
+    for (const auto& [key, here] : part.tiles) {
       TileContents& t = tiles[key];
       t.key = key;
       t.triangles.resize(parts.size());
       t.blocks.resize(parts.size());
-      t.triangles[a] = roles;
-      if (const auto it = part.blocks.find(key); it != part.blocks.end()) t.blocks[a] = it->second;
+      t.triangles[a] = here.counts;
+      t.blocks[a] = here.blocks;
     }
   }
   for (auto& [key, t] : tiles) {

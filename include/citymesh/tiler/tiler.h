@@ -52,11 +52,17 @@ struct TileStore {
   std::string fingerprint;  ///< what the caller says the store was made from
 };
 
+/// What one acquisition holds in one tile.
+struct AcquisitionTile {
+  std::array<std::uint64_t, 3> counts{};  ///< triangles per role
+  std::vector<ByteRange> blocks;          ///< its blocks in the block file, in the order written
+  friend bool operator==(const AcquisitionTile&, const AcquisitionTile&) = default;
+};
+
 /// What tiling one acquisition gave (its <dir>/a<k>/summary.json).
 struct AcquisitionTiling {
-  std::uint64_t triangles = 0;                             ///< the acquisition's triangles
-  std::map<TileKey, std::array<std::uint64_t, 3>> counts;  ///< per tile: triangles per role
-  std::map<TileKey, std::vector<ByteRange>> blocks;        ///< per tile: its blocks in the block file
+  std::uint64_t triangles = 0;              ///< the acquisition's triangles
+  std::map<TileKey, AcquisitionTile> tiles;  ///< the tiles it has triangles in
   TilingStats stats;
   std::string fingerprint;  ///< what the caller says the tiling was made from
 };
