@@ -75,17 +75,14 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
   constexpr std::size_t kGrain = 4096;  // a multiple of the packet: packets stay in a block
   std::vector<std::vector<TrianglePair>> per_block((f.size() + kGrain - 1) / kGrain);
   parallel_for_blocks(f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
-    std::array<std::vector<std::uint32_t>, BoxTree::kPacket> hits;
-    std::array<Vec3f, BoxTree::kPacket> centroids{};
     // In the tree's order, a triangle's candidates are near the previous one's: warm caches,
     // and packets of neighbouring centroids that share one walk down the tree.
-    const std::span<const std::uint32_t> order = prisms.storage_order();
-    for (std::size_t i = begin; i < end; i += BoxTree::kPacket) {
-      const std::size_t n = std::min(BoxTree::kPacket, end - i);
-      for (std::size_t k = 0; k < n; ++k) centroids[k] = f.centroid[order[i + k]];
-      prisms.containing_each(std::span(centroids).first(n), hits);
-      for (std::size_t k = 0; k < n; ++k) pairs_of(f, order[i + k], hits[k], threshold, cos_min, per_block[begin / kGrain]);
-    }
+    const std::span<const std::uint32_t> order = prisms.storage_order().subspan(begin, end - begin);
+    prisms.containing_in_packets(
+        order.size(), [&](std::size_t i) { return f.centroid[order[i]]; },
+        [&](std::size_t i, std::span<const std::uint32_t> hits) {
+          pairs_of(f, order[i], hits, threshold, cos_min, per_block[begin / kGrain]);
+        });
   });
   std::size_t total = 0;
   for (const auto& b : per_block) total += b.size();

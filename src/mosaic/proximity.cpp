@@ -2,7 +2,6 @@
 #include "citymesh/mosaic/proximity.h"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
@@ -56,20 +55,14 @@ bool MeshProximity::any_within(const Vec3d& p, double reach, const std::function
 }
 
 void MeshProximity::any_within_each(std::span<const Vec3d> points, double reach, std::span<std::uint8_t> within) const {
-  std::array<std::vector<std::uint32_t>, BoxTree::kPacket> hits;
-  std::array<Vec3f, BoxTree::kPacket> packet{};
   const double reach_sq = reach * reach;
-  for (std::size_t first = 0; first < points.size(); first += BoxTree::kPacket) {
-    const std::size_t n = std::min(BoxTree::kPacket, points.size() - first);
-    for (std::size_t k = 0; k < n; ++k) packet[k] = Vec3f(points[first + k]);
-    tree_->containing_each(std::span(packet).first(n), hits);
-    for (std::size_t k = 0; k < n; ++k) {
-      const Vec3d& p = points[first + k];
-      within[first + k] = std::any_of(hits[k].begin(), hits[k].end(), [&](std::uint32_t t) {
-        return point_triangle_distance_sq(p, mesh_.corners(t)) <= reach_sq;
-      }) ? 1 : 0;
-    }
-  }
+  tree_->containing_in_packets(
+      points.size(), [&](std::size_t i) { return Vec3f(points[i]); },
+      [&](std::size_t i, std::span<const std::uint32_t> hits) {
+        within[i] = std::any_of(hits.begin(), hits.end(), [&](std::uint32_t t) {
+          return point_triangle_distance_sq(points[i], mesh_.corners(t)) <= reach_sq;
+        }) ? 1 : 0;
+      });
 }
 
 }  // namespace citymesh

@@ -3,6 +3,8 @@
 // Morton order behind this header): the candidate searches of the change detection.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -34,6 +36,20 @@ class BoxTree {
   /// what containing(points[i], out[i]) gives, in the same order. One walk down the tree
   /// serves them all, so that neighbouring queries share the upper levels. Thread-safe.
   void containing_each(std::span<const Vec3f> points, std::span<std::vector<std::uint32_t>> out) const;
+  /// containing() for `count` points (point_of(i) gives point i, best in an order that keeps
+  /// neighbours together), kPacket at a time through containing_each(): calls on_hits(i, the
+  /// boxes containing point i) for each, in order.
+  template <class PointOf, class OnHits>
+  void containing_in_packets(std::size_t count, PointOf point_of, OnHits on_hits) const {
+    std::array<std::vector<std::uint32_t>, kPacket> hits;
+    std::array<Vec3f, kPacket> packet{};
+    for (std::size_t first = 0; first < count; first += kPacket) {
+      const std::size_t n = std::min(kPacket, count - first);
+      for (std::size_t k = 0; k < n; ++k) packet[k] = point_of(first + k);
+      containing_each(std::span(packet).first(n), hits);
+      for (std::size_t k = 0; k < n; ++k) on_hits(first + k, std::span<const std::uint32_t>(hits[k]));
+    }
+  }
   /// Replaces `out` with the indices of the boxes overlapping the closed box b, in an order
   /// that depends on the boxes only. Fast for small query boxes. Thread-safe.
   void overlapping(const Box3f& b, std::vector<std::uint32_t>& out) const;
