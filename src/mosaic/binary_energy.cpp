@@ -52,10 +52,6 @@ BinaryEnergy::Pair flip_pair(BinaryEnergy::Pair p, bool flip_i, bool flip_j) {
   return p;
 }
 
-}  // namespace
-
-namespace {
-
 /// The terms of the s-t graph of cut_graph(), handed out as they are made: add_edge(from, to,
 /// capacity, reverse capacity) in the order of the energy's pairs, then add_terminal(node,
 /// from the source, to the sink) for every node with one, in node order.

@@ -90,17 +90,12 @@ double MeshTopology::boundary_length() const {
   return edges_length(merged_.mesh, boundary_edges());
 }
 
-namespace {
-
-constexpr std::size_t kVertexGrain = 1 << 15;
-
-}  // namespace
-
 std::vector<EdgeUse> MeshTopology::boundary_edges() const {
   // Each edge {lo, hi} is looked at from lo only: the uses of every edge at lo come from one
   // pass over the triangles around lo (each triangle read three times in all, where a look
   // around lo for each of a triangle's edges read it eighteen times).
   const std::size_t vertices = edited_.size();  // the vertices the lists know
+  constexpr std::size_t kVertexGrain = 1 << 15;
   std::vector<std::vector<EdgeUse>> per_block((vertices + kVertexGrain - 1) / kVertexGrain);
   parallel_for_blocks(vertices, kVertexGrain, [&](std::size_t begin, std::size_t end) {
     std::vector<EdgeUse>& out = per_block[begin / kVertexGrain];
