@@ -6,7 +6,8 @@
 // on a shared VM the same read has taken from 0.46 to 1.77 s within minutes, so a ratio of
 // two single measurements says more about the host than about the tiler.
 // Usage: tile_bench CONFIG [tile_size (default: the config's)] [work folder (default: temp)]
-//                          [rounds (default 3)]
+//                          [rounds (default 3)] [keep: leave the last round's store, e.g. to
+//                          compare its bytes with another build's]
 #include <fmt/format.h>
 #include <sys/resource.h>
 
@@ -91,7 +92,7 @@ std::string wall_list(const std::vector<Timing>& rounds) {
 int main(int argc, char** argv) {
   keep_freed_memory_for_reuse();  // as the citymesh binary does
   if (argc < 2) {
-    fmt::print(stderr, "usage: tile_bench CONFIG [tile_size] [work folder] [rounds]\n");
+    fmt::print(stderr, "usage: tile_bench CONFIG [tile_size] [work folder] [rounds] [keep]\n");
     return 1;
   }
   const Config config = load_config(argv[1]);
@@ -102,6 +103,7 @@ int main(int argc, char** argv) {
   params.dir = argc > 3 ? std::filesystem::path(argv[3]) : std::filesystem::temp_directory_path() / "citymesh_tile_bench";
   params.buffer_bytes = config.run.memory / 4;
   const int rounds = argc > 4 ? std::max(1, std::stoi(argv[4])) : 3;
+  const bool keep = argc > 5 && std::string_view(argv[5]) == "keep";
   // As `citymesh run` tiles when the budget allows: one acquisition per thread.
   const unsigned at_once = available_threads();
 
@@ -148,6 +150,6 @@ int main(int argc, char** argv) {
              double(store.stats.empty_space_copies) / 1e6, store.stats.blocks, double(store.stats.bytes_written) / 1e6);
   fmt::print("peak RSS  : {:.0f} MiB (buffers flushed past {:.0f} MiB)\n", double(peak_resident_bytes()) / (1 << 20),
              double(params.buffer_bytes) / (1 << 20));
-  std::filesystem::remove_all(params.dir);
+  if (!keep) std::filesystem::remove_all(params.dir);
   return 0;
 }
