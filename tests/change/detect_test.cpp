@@ -218,6 +218,63 @@ TEST(Conflicts, NearestSampleReachClaimsNoEmptySpaceBeyondTheNearestCorner) {
   EXPECT_EQ(nearest.refutes[2], 1);
 }
 
+/// Older small facets scattered at random heights over a ground, and a newer ground seen from
+/// far off at a slant: its empty spaces are up to ~60 m long, so the conflict search cuts each
+/// into many slabs. Some facets stand inside the newer empty spaces, some beside or under them.
+std::vector<Mesh> facets_under_slanted_rays(std::mt19937& rng) {
+  std::vector<Mesh> m(3);
+  std::uniform_real_distribution<float> x(-4, 20), y(-6, 6), z(0.05f, 6), tilt(-0.3f, 0.3f);
+  for (std::uint32_t a = 0; a < 2; ++a) {
+    const Vec3f sensor{x(rng), y(rng), 2.5f};
+    for (int k = 0; k < 150; ++k) {
+      const Vec3f p{x(rng), y(rng), z(rng)};
+      const auto base = static_cast<std::uint32_t>(m[a].positions.size());
+      for (const Vec3f& d : {Vec3f{-0.15f, 0, tilt(rng)}, Vec3f{0.15f, 0.05f, 0}, Vec3f{0, 0.2f, tilt(rng)}}) {
+        m[a].positions.push_back(p + d);
+        m[a].sensor_positions.push_back(sensor);
+      }
+      m[a].triangles.push_back({base, base + 1, base + 2});
+    }
+  }
+  add_patch(m[0], -4, 20, -6, 6, 0.0, 0.6, {8, 0, 2.5f});
+  add_patch(m[2], -4, 20, -6, 6, 0.02, 0.4, {-45, 3, 12});
+  for (std::uint32_t a = 0; a < 3; ++a) finish(m[a], a);
+  return m;
+}
+
+TEST(Conflicts, FlagsEqualBruteForceUnderLongSlantedEmptySpaces) {
+  std::mt19937 rng(5);
+  const std::vector<Mesh> meshes = facets_under_slanted_rays(rng);
+  const std::vector<TimePoint> dates{day(0), day(10), day(40)};
+  for (const bool prefilter : {true, false}) {
+    ChangeParams params;
+    params.prefilter = prefilter;
+    const ChangeResult r = detect(meshes, dates, params);
+    const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
+    const change_detail::PartnerBits partners = change_detail::partner_bits(f, r.consistent_pairs);
+    std::vector<std::uint8_t> conflicting(f.size(), 0), refutes(f.size(), 0);
+    for (std::size_t t = 0; t < f.size(); ++t) {
+      for (std::size_t j = 0; j < f.acquisitions(); ++j) {
+        if (!(f.date_of(t) < f.dates[j]) || partners.has(t, j)) continue;
+        for (std::size_t u = f.index.offsets[j]; u < f.index.offsets[j + 1]; ++u) {
+          if (f.empty_scale[u] > 0 && triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
+            conflicting[t] = 1;
+            refutes[u] = 1;
+          }
+        }
+      }
+    }
+    std::vector<std::uint8_t> found(f.size(), 0);
+    for (std::size_t t = 0; t < f.size(); ++t) found[t] = r.state[t] == TriangleState::conflicting ? 1 : 0;
+    EXPECT_EQ(found, conflicting) << "prefilter " << prefilter;
+    EXPECT_EQ(r.refutes, refutes) << "prefilter " << prefilter;
+    // Enough of each kind that a search missing some would show.
+    EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
+    EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
+    EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 100);
+  }
+}
+
 // ---- time series and policies ----------------------------------------------------------
 
 TEST(TimeSeries, FirstAndLastSeenSpanPartnersAndDecideSustainability) {
