@@ -221,7 +221,7 @@ TEST(Conflicts, NearestSampleReachClaimsNoEmptySpaceBeyondTheNearestCorner) {
 /// Older small facets scattered at random heights over a ground, and a newer ground seen from
 /// far off at a slant: its empty spaces are up to ~60 m long, so the conflict search cuts each
 /// into many slabs. Some facets stand inside the newer empty spaces, some beside or under them.
-std::vector<Mesh> facets_under_slanted_rays(std::mt19937& rng) {
+std::vector<Mesh> facets_under_slanted_rays(std::mt19937& rng, double newer_cell) {
   std::vector<Mesh> m(3);
   std::uniform_real_distribution<float> x(-4, 20), y(-6, 6), z(0.05f, 6), tilt(-0.3f, 0.3f);
   for (std::uint32_t a = 0; a < 2; ++a) {
@@ -237,14 +237,17 @@ std::vector<Mesh> facets_under_slanted_rays(std::mt19937& rng) {
     }
   }
   add_patch(m[0], -4, 20, -6, 6, 0.0, 0.6, {8, 0, 2.5f});
-  add_patch(m[2], -4, 20, -6, 6, 0.02, 0.4, {-45, 3, 12});
+  add_patch(m[2], -4, 20, -6, 6, 0.02, newer_cell, {-45, 3, 12});
   for (std::uint32_t a = 0; a < 3; ++a) finish(m[a], a);
   return m;
 }
 
 TEST(Conflicts, FlagsEqualBruteForceUnderLongSlantedEmptySpaces) {
+  // A coarse newer ground gives many candidates per empty space (the search indexes slabs of
+  // the empty spaces), a fine one few (it indexes whole empty spaces).
+  for (const double newer_cell : {1.0, 0.4}) {
   std::mt19937 rng(5);
-  const std::vector<Mesh> meshes = facets_under_slanted_rays(rng);
+  const std::vector<Mesh> meshes = facets_under_slanted_rays(rng, newer_cell);
   const std::vector<TimePoint> dates{day(0), day(10), day(40)};
   for (const bool prefilter : {true, false}) {
     ChangeParams params;
@@ -271,7 +274,8 @@ TEST(Conflicts, FlagsEqualBruteForceUnderLongSlantedEmptySpaces) {
     // Enough of each kind that a search missing some would show.
     EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
     EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
-    EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 100);
+    EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 20);
+  }
   }
 }
 
@@ -361,7 +365,10 @@ TEST(DetectChanges, PrefilterAndThreadCountNeverChangeTheResult) {
   const ChangeResult a = detect(meshes, dates, with), b = detect(meshes, dates, without);
   expect_same(a, b);
   EXPECT_GT(a.stats.prefilter_skipped, 0u);
-  EXPECT_LT(a.stats.exact_tests, b.stats.exact_tests);
+  // Fewer candidates reach the search (its exact tests are no measure: with many candidates
+  // the empty spaces are indexed by slabs, which leave out more pairs before the exact test).
+  EXPECT_LT(a.stats.conflict_candidates - a.stats.prefilter_skipped,
+            b.stats.conflict_candidates - b.stats.prefilter_skipped);
   EXPECT_GT(std::count(a.state.begin(), a.state.end(), TriangleState::conflicting), 100);
   const StateCounts counts = count_states(a, a.index.offsets[1], a.index.offsets[2]);
   const auto from = a.state.begin() + static_cast<std::ptrdiff_t>(a.index.offsets[1]);
