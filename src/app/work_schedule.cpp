@@ -3,6 +3,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <exception>
 #include <stdexcept>
 
@@ -91,7 +92,73 @@ void LocalChannel::abort() {
   changed_.notify_all();
 }
 
+void LocalChannel::start_loops(unsigned loops) {
+  const std::lock_guard lock(mutex_);
+  loops_ = loops;
+}
+
+LocalChannel::LoopTake LocalChannel::take_for_loop(unsigned max_loops) {
+  const std::lock_guard lock(mutex_);
+  if (aborted_) throw ProcessingError("stopped: another worker failed");
+  LoopTake take;
+  take.item = schedule_.take();
+  if (take.item) {
+    const unsigned room = max_loops > loops_ ? max_loops - loops_ : 0;
+    take.more = static_cast<unsigned>(std::min<std::size_t>(schedule_.ready(), room));
+    loops_ += take.more;
+    return take;
+  }
+  --loops_;
+  if (!schedule_.finished() && schedule_.in_flight() == 0) {
+    throw ProcessingError("work schedule: items wait for each other in a cycle");
+  }
+  return take;
+}
+
+void LocalChannel::finish_for_loop(std::size_t item) {
+  {
+    const std::lock_guard lock(mutex_);
+    schedule_.finish(item);
+    if (on_finish_) on_finish_(item);
+  }
+  changed_.notify_all();
+}
+
+namespace {
+
+/// run_workers on this process's own schedule: loops that end when nothing is ready, started
+/// again as items become ready, so that a thread with nothing to do helps the tiles in flight.
+void run_loops(LocalChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body) {
+  channel.start_loops(workers);
+  parallel_loops(workers, [&](const LoopSpawner& spawner) -> LoopWork {
+    LocalChannel::LoopTake take;
+    try {
+      take = channel.take_for_loop(workers);
+    } catch (...) {
+      channel.abort();
+      throw;
+    }
+    if (take.more > 0) spawner.spawn(take.more);
+    if (!take.item) return {};
+    return [&channel, &body, item = *take.item] {
+      try {
+        body(item);
+      } catch (...) {
+        channel.abort();
+        throw;
+      }
+      channel.finish_for_loop(item);
+    };
+  });
+}
+
+}  // namespace
+
 void run_workers(WorkChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body) {
+  if (auto* local = dynamic_cast<LocalChannel*>(&channel)) {
+    run_loops(*local, std::max(workers, 1u), body);
+    return;
+  }
   parallel_workers(std::max(workers, 1u), [&](unsigned) {
     try {
       std::optional<std::size_t> item = channel.next(std::nullopt);

@@ -31,6 +31,7 @@ class WorkSchedule {
 
   [[nodiscard]] bool finished() const { return done_ == costs_.size(); }
   [[nodiscard]] std::size_t in_flight() const { return in_flight_; }
+  [[nodiscard]] std::size_t ready() const { return ready_.size(); }
   [[nodiscard]] std::size_t size() const { return costs_.size(); }
 
  private:
@@ -70,6 +71,22 @@ class LocalChannel final : public WorkChannel {
   /// next() without blocking, for a worker elsewhere (another rank): an item, wait or done.
   WorkReply poll(std::optional<std::size_t> finished);
 
+  /// For worker loops that come and go (run_workers, through parallel_loops), which end when
+  /// nothing is ready rather than wait: `loops` are running.
+  void start_loops(unsigned loops);
+  /// A ready item for a running loop, and how many more loops the items still ready can use
+  /// within `max_loops` (counted as running from now on: the caller starts them). Without an
+  /// item the loop counts as ended. Throws after abort(), and when nothing is ready or in
+  /// flight before the end (a cycle). Loops that end and loops that start are counted under
+  /// one lock, so an item made ready while a loop ends is never left without one.
+  struct LoopTake {
+    std::optional<std::size_t> item;
+    unsigned more = 0;
+  };
+  LoopTake take_for_loop(unsigned max_loops);
+  /// Marks an item a loop took as finished (on_finish runs under the lock).
+  void finish_for_loop(std::size_t item);
+
  private:
   WorkReply step(std::optional<std::size_t> finished);
 
@@ -78,10 +95,14 @@ class LocalChannel final : public WorkChannel {
   std::mutex mutex_;
   std::condition_variable changed_;
   bool aborted_ = false;
+  unsigned loops_ = 0;  ///< running loops (take_for_loop)
 };
 
-/// Runs `workers` loops (on the TBB pool) that take items from `channel` and call `body` on
-/// each until every item is finished. The first exception stops every loop and is rethrown.
+/// Runs up to `workers` loops (on the TBB pool) that take items from `channel` and call `body`
+/// on each until every item is finished. On this process's own schedule (LocalChannel) a loop
+/// with nothing ready ends and loops start again as items become ready, so that a thread with
+/// nothing to do helps the items in flight with their nested parallel loops; on a cluster's
+/// channel the loops wait for work. The first exception stops every loop and is rethrown.
 void run_workers(WorkChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body);
 
 }  // namespace citymesh::app

@@ -12,6 +12,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <exception>
+#include <mutex>
 
 namespace citymesh {
 
@@ -63,6 +65,67 @@ void parallel_workers(unsigned workers, const std::function<void(unsigned)>& bod
         }
       },
       tbb::simple_partitioner());
+}
+
+namespace {
+
+/// The loops of one parallel_loops call: tasks of one group. Each piece of work runs isolated
+/// with its own cancellation context; `next` and spawn() run outside, so that a loop's nested
+/// waits never pick up a whole loop started meanwhile. Exceptions are kept rather than let
+/// out, which would cancel the group and cut the other loops' nested loops short.
+class LoopGroup {
+ public:
+  explicit LoopGroup(const std::function<LoopWork(const LoopSpawner&)>& next) : next_(next) {}
+
+  void spawn(unsigned loops) {
+    for (unsigned i = 0; i < loops; ++i) group_.run([this] { run_loop(); });
+  }
+
+  /// Waits for every loop, then rethrows the first exception.
+  void wait() {
+    group_.wait();
+    if (first_error_) std::rethrow_exception(first_error_);
+  }
+
+ private:
+  /// What `next` is handed (task_group's destructor may throw, so the group is no LoopSpawner).
+  class Spawner final : public LoopSpawner {
+   public:
+    explicit Spawner(LoopGroup& group) : group_(group) {}
+    void spawn(unsigned loops) const override { group_.spawn(loops); }
+
+   private:
+    LoopGroup& group_;
+  };
+
+  void run_loop() {
+    try {
+      for (LoopWork work = next_(spawner_); work; work = next_(spawner_)) {
+        tbb::this_task_arena::isolate([&] {
+          tbb::task_group_context own(tbb::task_group_context::isolated);
+          tbb::task_group nested(own);
+          nested.run_and_wait([&] { work(); });
+        });
+      }
+    } catch (...) {
+      const std::lock_guard lock(error_mutex_);
+      if (!first_error_) first_error_ = std::current_exception();
+    }
+  }
+
+  const std::function<LoopWork(const LoopSpawner&)>& next_;
+  Spawner spawner_{*this};
+  tbb::task_group group_;
+  std::mutex error_mutex_;
+  std::exception_ptr first_error_;
+};
+
+}  // namespace
+
+void parallel_loops(unsigned loops, const std::function<LoopWork(const LoopSpawner&)>& next) {
+  LoopGroup group(next);
+  group.spawn(loops);
+  group.wait();
 }
 
 void parallel_jobs(std::size_t count, unsigned workers, const std::function<void(std::size_t)>& job) {

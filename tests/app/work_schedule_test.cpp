@@ -5,7 +5,9 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <mutex>
 #include <random>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -101,13 +103,19 @@ TEST(LocalChannel, WorkersRunEveryItemOnceAfterWhatItWaitsFor) {
     std::atomic<bool> early = false;
     std::size_t reported = 0;
     LocalChannel channel(schedule, [&](std::size_t) { ++reported; });
+    std::atomic<unsigned> in_flight{0}, most{0};
     run_workers(channel, threads, [&](std::size_t k) {
+      const unsigned now = ++in_flight;
+      for (unsigned seen = most.load(); now > seen && !most.compare_exchange_weak(seen, now);) {
+      }
       for (const std::size_t d : g.after[k]) early = early || finished[d] == 0;
       std::this_thread::sleep_for(std::chrono::microseconds(200 * g.costs[k]));
       ++runs[k];
       finished[k] = 1;
+      --in_flight;
     });
     EXPECT_FALSE(early) << threads << " threads: an item started before its dependencies";
+    EXPECT_LE(most.load(), threads) << "more items in flight than workers";
     std::size_t expected = 0;
     for (std::size_t k = 0; k < g.costs.size(); ++k) {
       EXPECT_EQ(runs[k].load(), g.done[k] != 0 ? 0 : 1) << "item " << k;
@@ -115,6 +123,27 @@ TEST(LocalChannel, WorkersRunEveryItemOnceAfterWhatItWaitsFor) {
     }
     EXPECT_EQ(reported, expected);
   }
+}
+
+TEST(LocalChannel, AWorkerWithNothingReadyHelpsTheItemInFlight) {
+  const ThreadLimit limit(2);
+  if (available_threads() < 2) GTEST_SKIP() << "one thread";
+  // Item 1 waits for item 0: while item 0 runs, the other worker has nothing to take, and its
+  // thread must help item 0's nested loop rather than sleep (four tiles in four phases).
+  WorkSchedule schedule({2, 1}, {{}, {0}}, {0, 0});
+  LocalChannel channel(schedule, nullptr);
+  std::mutex m;
+  std::set<std::thread::id> threads;
+  run_workers(channel, 2, [&](std::size_t k) {
+    if (k != 0) return;
+    parallel_for_blocks(64, 1, [&](std::size_t, std::size_t) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      const std::lock_guard lock(m);
+      threads.insert(std::this_thread::get_id());
+    });
+  });
+  EXPECT_TRUE(schedule.finished());
+  EXPECT_EQ(threads.size(), 2u);
 }
 
 TEST(LocalChannel, AFailingWorkerStopsTheOthersInsteadOfHanging) {

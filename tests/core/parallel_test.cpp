@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <stdexcept>
 #include <thread>
 #include <mutex>
@@ -73,6 +74,101 @@ TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
   if (started) {
     EXPECT_EQ(blocks_run.load(), kBlocks);
   }
+}
+
+/// Work handed out one piece at a time to parallel_loops: a loop that takes the first piece
+/// starts as many loops as there are pieces left, up to `most` running; a loop ends when none
+/// is left.
+struct LoopPieces {
+  std::mutex m;
+  std::size_t next = 0, count = 0;
+  unsigned running = 0, most = 0;
+  std::vector<std::atomic<int>> runs;
+  LoopPieces(std::size_t n, unsigned loops) : count(n), running(loops), most(loops), runs(n) {}
+
+  LoopWork take(const LoopSpawner& spawner, const std::function<void(std::size_t)>& work) {
+    std::size_t piece = 0;
+    unsigned more = 0;
+    {
+      const std::lock_guard lock(m);
+      if (next == count) {
+        --running;
+        return {};
+      }
+      piece = next++;
+      more = static_cast<unsigned>(std::min<std::size_t>(count - next, most - running));
+      running += more;
+    }
+    spawner.spawn(more);
+    return [this, piece, &work] {
+      work(piece);
+      ++runs[piece];
+    };
+  }
+};
+
+TEST(ParallelLoops, LoopsStartedOnTheWayRunEveryPieceOnce) {
+  for (const unsigned threads : {1u, 2u, 4u}) {
+    ThreadLimit limit(threads);
+    LoopPieces pieces(50, 1);  // one loop at first: the others are started by it
+    pieces.most = threads;
+    std::atomic<int> in_flight{0}, most{0};
+    const std::function<void(std::size_t)> work = [&](std::size_t) {
+      const int now = ++in_flight;
+      for (int seen = most.load(); now > seen && !most.compare_exchange_weak(seen, now);) {
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      --in_flight;
+    };
+    parallel_loops(1, [&](const LoopSpawner& spawner) { return pieces.take(spawner, work); });
+    for (std::size_t i = 0; i < 50; ++i) EXPECT_EQ(pieces.runs[i].load(), 1) << threads << " threads, piece " << i;
+    EXPECT_LE(most.load(), static_cast<int>(threads));
+    EXPECT_EQ(pieces.running, 0u);
+  }
+}
+
+TEST(ParallelLoops, AThrowingLoopDoesNotCutShortTheOthersNestedLoops) {
+  ThreadLimit limit(2);
+  constexpr std::size_t kBlocks = 200;
+  std::atomic<bool> started{false};
+  std::atomic<std::size_t> blocks_run{0};
+  LoopPieces pieces(2, 2);
+  const std::function<void(std::size_t)> work = [&](std::size_t piece) {
+    if (piece == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      throw std::runtime_error("piece 0 fails");
+    }
+    started = true;
+    parallel_for_blocks(kBlocks, 1, [&](std::size_t, std::size_t) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      ++blocks_run;
+    });
+  };
+  EXPECT_THROW(parallel_loops(2, [&](const LoopSpawner& spawner) { return pieces.take(spawner, work); }),
+               std::runtime_error);
+  if (started) {
+    EXPECT_EQ(blocks_run.load(), kBlocks);
+  }
+}
+
+TEST(ParallelLoops, ALoopWithNothingToDoHelpsTheOthersNestedLoops) {
+  ThreadLimit limit(2);
+  if (available_threads() < 2) GTEST_SKIP() << "one thread";
+  // Two loops, one piece: the loop without a piece ends, and its thread takes blocks of the
+  // piece's nested loop (a worker loop of parallel_workers waiting for work would not).
+  LoopPieces pieces(1, 2);
+  std::mutex m;
+  std::set<std::thread::id> threads;
+  const std::function<void(std::size_t)> work = [&](std::size_t) {
+    parallel_for_blocks(64, 1, [&](std::size_t, std::size_t) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      const std::lock_guard lock(m);
+      threads.insert(std::this_thread::get_id());
+    });
+  };
+  parallel_loops(2, [&](const LoopSpawner& spawner) { return pieces.take(spawner, work); });
+  EXPECT_EQ(pieces.runs[0].load(), 1);
+  EXPECT_EQ(threads.size(), 2u);
 }
 
 TEST(ParallelJobs, RunsEveryJobOnceWithAtMostWorkersInFlight) {

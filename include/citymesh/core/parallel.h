@@ -44,6 +44,28 @@ void parallel_sort(std::span<std::uint64_t> values);
 /// short the nested loops of the bodies still running: they finish whatever they started.
 void parallel_workers(unsigned workers, const std::function<void(unsigned)>& body);
 
+/// Starts more loops of the parallel_loops call it was handed by.
+class LoopSpawner {
+ public:
+  virtual ~LoopSpawner() = default;
+  /// Starts `loops` more loops; they run once a thread of the pool is free.
+  virtual void spawn(unsigned loops) const = 0;
+};
+
+/// A loop's next piece of work; empty when the loop ends.
+using LoopWork = std::function<void()>;
+
+/// Runs `loops` worker loops on the pool, each calling `next(spawner)` for its next piece of
+/// work and running it isolated (as parallel_workers runs its bodies), until `next` gives
+/// none. Unlike parallel_workers' loops, these never wait for work: a loop with nothing to do
+/// ends, and its thread helps the loops still working with their nested parallel loops (a
+/// waiting worker loop holds its thread: four tiles in four phases ran on one core). `next`
+/// runs outside the isolation and may start more loops with `spawner` when work becomes
+/// ready; the caller keeps count of them. Returns once every loop has ended; a loop that
+/// throws (in `next` or in its work) ends the call with its exception (the first thrown) once
+/// the others are done, never cutting their nested loops short.
+void parallel_loops(unsigned loops, const std::function<LoopWork(const LoopSpawner&)>& next);
+
 /// Runs `job(i)` for every i in [0, count) on min(workers, count) isolated worker loops (as
 /// parallel_workers), each taking the next index as soon as it is done with one: at most
 /// `workers` jobs are in flight, whatever their lengths. The first job that throws ends the
