@@ -24,7 +24,8 @@ WorkSchedule::WorkSchedule(std::vector<std::uint64_t> costs, const std::vector<s
       continue;
     }
     for (const std::size_t d : after[k]) {
-      if (d >= costs_.size() || d == k) throw std::invalid_argument(fmt::format("WorkSchedule: item {} waits for {}", k, d));
+      if (d >= costs_.size() || d == k)
+        throw std::invalid_argument(fmt::format("WorkSchedule: item {} waits for {}", k, d));
       if (done[d] != 0) continue;
       dependents_[d].push_back(k);
       ++waiting_[k];

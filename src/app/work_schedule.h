@@ -39,7 +39,7 @@ class WorkSchedule {
 
   std::vector<std::uint64_t> costs_;
   std::vector<std::vector<std::size_t>> dependents_;
-  std::vector<std::size_t> waiting_;  ///< unfinished items each item waits for
+  std::vector<std::size_t> waiting_;                       ///< unfinished items each item waits for
   std::set<std::pair<std::uint64_t, std::size_t>> ready_;  ///< (~cost, item): largest first
   std::size_t done_ = 0, in_flight_ = 0;
 };

@@ -189,16 +189,16 @@ struct FacePlanes {
 /// the conflict search indexes: one per empty space, or, when the candidates are many, one
 /// per slab of about kConflictSlabLength. A long empty space (a far return, or one seen at a
 /// slant) has a box far larger than itself, which every triangle under it meets: on three
-/// real Ouster frames each candidate met ~1 000 such boxes, for one exact test in four. The
-/// slabs cover the empty space, so a triangle meeting it meets one of their boxes: the same
-/// pairs are tested, fewer are looked at. Their price is a tree 4-7 times larger, which only
-/// pays when there are many candidates to query it: on the simulated city's tiles (2-15 %
-/// as many candidates as empty spaces) the slabs cut the hits by 3.7x and still made the
-/// change step 8 % slower.
+/// real Ouster frames each candidate met ~1 300 such boxes, one in ~5 000 of them worth an
+/// exact test. The slabs cover the empty space, so a triangle meeting it meets one of their
+/// boxes: the same pairs are tested, fewer are looked at. Their price is a tree 4-7 times
+/// larger, which only pays when there are many candidates to query it: on the simulated
+/// city's tiles (2-15 % as many candidates as empty spaces) the slabs cut the hits by 3.7x
+/// and still made the change step 8 % slower.
 struct EmptySpaces {
-  std::vector<std::uint32_t> ids;  ///< per empty space: its triangle
-  std::vector<FacePlanes> planes;  ///< per empty space
-  bool cut = false;                      ///< into slabs; else slab i is empty space i
+  std::vector<std::uint32_t> ids;       ///< per empty space: its triangle
+  std::vector<FacePlanes> planes;       ///< per empty space
+  bool cut = false;                     ///< into slabs; else slab i is empty space i
   std::vector<std::size_t> first_slab;  ///< per empty space, and one past the last slab
   std::vector<Box3f> slab_boxes;
   std::vector<std::uint32_t> space_of_slab;
@@ -228,14 +228,16 @@ EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j, std::size_t can
     for (std::size_t i = begin; i < end; ++i) {
       const TetrahedronCorners q = f.empty_space(out.ids[i]);
       out.planes[i] = FacePlanes(q);
-      first_slab[i + 1] = cut ? static_cast<std::size_t>(std::min(slab_count(q, kConflictSlabLength), kMaxConflictSlabs)) : 1;
+      first_slab[i + 1] =
+          cut ? static_cast<std::size_t>(std::min(slab_count(q, kConflictSlabLength), kMaxConflictSlabs)) : 1;
     }
   });
   for (std::size_t i = 0; i < n; ++i) first_slab[i + 1] += first_slab[i];
   if (first_slab[n] > UINT32_MAX) {  // the box tree numbers its boxes in 32 bits
-    throw ProcessingError(fmt::format("change detection: {} empty spaces in one acquisition cut into {} slabs, more "
-                                      "than 2^32; tile the acquisitions ([tiling])",
-                                      n, first_slab[n]));
+    throw ProcessingError(
+        fmt::format("change detection: {} empty spaces in one acquisition cut into {} slabs, more "
+                    "than 2^32; tile the acquisitions ([tiling])",
+                    n, first_slab[n]));
   }
   out.slab_boxes.resize(first_slab[n]);
   out.space_of_slab.resize(first_slab[n]);
@@ -253,8 +255,8 @@ EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j, std::size_t can
 }
 
 bool meet(const Box3f& a, const Box3f& b) {
-  return a.min.x <= b.max.x && b.min.x <= a.max.x && a.min.y <= b.max.y && b.min.y <= a.max.y &&
-         a.min.z <= b.max.z && b.min.z <= a.max.z;
+  return a.min.x <= b.max.x && b.min.x <= a.max.x && a.min.y <= b.max.y && b.min.y <= a.max.y && a.min.z <= b.max.z &&
+         b.min.z <= a.max.z;
 }
 
 /// The empty spaces whose slabs a query box met, each once: a slab stands for its empty

@@ -28,8 +28,7 @@ ThreadLimit::ThreadLimit(unsigned threads) : impl_(std::make_unique<Impl>(thread
 ThreadLimit::~ThreadLimit() = default;
 
 unsigned available_threads() {
-  return static_cast<unsigned>(
-      tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  return static_cast<unsigned>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
 
 void parallel_sort(std::span<std::uint64_t> values) { tbb::parallel_sort(values.begin(), values.end()); }

@@ -2,6 +2,8 @@
 // Handing out work: the schedule against a brute-force reference on random dependency graphs,
 // worker threads that never start an item before what it waits for, and failures that stop
 // every worker instead of hanging.
+#include "work_schedule.h"
+
 #include <gtest/gtest.h>
 
 #include <atomic>
@@ -13,7 +15,6 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
-#include "work_schedule.h"
 
 namespace citymesh::app {
 namespace {

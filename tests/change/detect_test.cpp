@@ -246,36 +246,36 @@ TEST(Conflicts, FlagsEqualBruteForceUnderLongSlantedEmptySpaces) {
   // A coarse newer ground gives many candidates per empty space (the search indexes slabs of
   // the empty spaces), a fine one few (it indexes whole empty spaces).
   for (const double newer_cell : {1.0, 0.4}) {
-  std::mt19937 rng(5);
-  const std::vector<Mesh> meshes = facets_under_slanted_rays(rng, newer_cell);
-  const std::vector<TimePoint> dates{day(0), day(10), day(40)};
-  for (const bool prefilter : {true, false}) {
-    ChangeParams params;
-    params.prefilter = prefilter;
-    const ChangeResult r = detect(meshes, dates, params);
-    const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
-    const change_detail::PartnerBits partners = change_detail::partner_bits(f, r.consistent_pairs);
-    std::vector<std::uint8_t> conflicting(f.size(), 0), refutes(f.size(), 0);
-    for (std::size_t t = 0; t < f.size(); ++t) {
-      for (std::size_t j = 0; j < f.acquisitions(); ++j) {
-        if (!(f.date_of(t) < f.dates[j]) || partners.has(t, j)) continue;
-        for (std::size_t u = f.index.offsets[j]; u < f.index.offsets[j + 1]; ++u) {
-          if (f.empty_scale[u] > 0 && triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
-            conflicting[t] = 1;
-            refutes[u] = 1;
+    std::mt19937 rng(5);
+    const std::vector<Mesh> meshes = facets_under_slanted_rays(rng, newer_cell);
+    const std::vector<TimePoint> dates{day(0), day(10), day(40)};
+    for (const bool prefilter : {true, false}) {
+      ChangeParams params;
+      params.prefilter = prefilter;
+      const ChangeResult r = detect(meshes, dates, params);
+      const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
+      const change_detail::PartnerBits partners = change_detail::partner_bits(f, r.consistent_pairs);
+      std::vector<std::uint8_t> conflicting(f.size(), 0), refutes(f.size(), 0);
+      for (std::size_t t = 0; t < f.size(); ++t) {
+        for (std::size_t j = 0; j < f.acquisitions(); ++j) {
+          if (!(f.date_of(t) < f.dates[j]) || partners.has(t, j)) continue;
+          for (std::size_t u = f.index.offsets[j]; u < f.index.offsets[j + 1]; ++u) {
+            if (f.empty_scale[u] > 0 && triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
+              conflicting[t] = 1;
+              refutes[u] = 1;
+            }
           }
         }
       }
+      std::vector<std::uint8_t> found(f.size(), 0);
+      for (std::size_t t = 0; t < f.size(); ++t) found[t] = r.state[t] == TriangleState::conflicting ? 1 : 0;
+      EXPECT_EQ(found, conflicting) << "prefilter " << prefilter;
+      EXPECT_EQ(r.refutes, refutes) << "prefilter " << prefilter;
+      // Enough of each kind that a search missing some would show.
+      EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
+      EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
+      EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 20);
     }
-    std::vector<std::uint8_t> found(f.size(), 0);
-    for (std::size_t t = 0; t < f.size(); ++t) found[t] = r.state[t] == TriangleState::conflicting ? 1 : 0;
-    EXPECT_EQ(found, conflicting) << "prefilter " << prefilter;
-    EXPECT_EQ(r.refutes, refutes) << "prefilter " << prefilter;
-    // Enough of each kind that a search missing some would show.
-    EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
-    EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
-    EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 20);
-  }
   }
 }
 
@@ -292,7 +292,8 @@ TEST(TimeSeries, FirstAndLastSeenSpanPartnersAndDecideSustainability) {
   for (std::uint32_t a = 0; a < 3; ++a) finish(m[a], a);
   const std::vector<TimePoint> dates{day(0), day(20), day(45)};
   const std::size_t ground = 200;
-  for (UnconfirmedPolicy policy : {UnconfirmedPolicy::drop, UnconfirmedPolicy::keep_unobserved, UnconfirmedPolicy::keep}) {
+  for (UnconfirmedPolicy policy :
+       {UnconfirmedPolicy::drop, UnconfirmedPolicy::keep_unobserved, UnconfirmedPolicy::keep}) {
     ChangeParams p;
     p.unconfirmed = policy;
     const ChangeResult r = detect(m, dates, p);
@@ -389,8 +390,8 @@ TEST(EmptySpaceGrids, MarkedOnlyWhereAskedTheyAnswerEveryQuestionAsIfMarkedEvery
   ChangeStats everywhere_stats, asked_stats;
   const std::vector<OccupancyGrid> everywhere =
       change_detail::build_empty_space_grids(f, params, VoxelMask(), everywhere_stats);
-  const std::vector<OccupancyGrid> asked = change_detail::build_empty_space_grids(
-      f, params, change_detail::asked_voxels(f, params.voxel_size), asked_stats);
+  const std::vector<OccupancyGrid> asked =
+      change_detail::build_empty_space_grids(f, params, change_detail::asked_voxels(f, params.voxel_size), asked_stats);
   EXPECT_LT(asked_stats.marked_voxels * 2, everywhere_stats.marked_voxels);  // the mask spares most marks
   // The questions the pre-filter and the unconfirmed policy ask: a triangle's box, of a grid newer.
   std::size_t questions = 0, yes = 0;

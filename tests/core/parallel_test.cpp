@@ -1,18 +1,18 @@
 // SPDX-License-Identifier: MIT
+#include "citymesh/core/parallel.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <functional>
-#include <stdexcept>
-#include <thread>
 #include <mutex>
 #include <random>
 #include <set>
+#include <stdexcept>
+#include <thread>
 #include <vector>
-
-#include "citymesh/core/parallel.h"
 
 namespace citymesh {
 namespace {
