@@ -55,11 +55,15 @@ void WorkSchedule::finish(std::size_t item) {
 LocalChannel::LocalChannel(WorkSchedule& schedule, std::function<void(std::size_t)> on_finish)
     : schedule_(schedule), on_finish_(std::move(on_finish)) {}
 
+void LocalChannel::finish_locked(std::size_t item) {
+  schedule_.finish(item);
+  if (on_finish_) on_finish_(item);
+}
+
 WorkReply LocalChannel::step(std::optional<std::size_t> finished) {
   if (aborted_) throw ProcessingError("stopped: another worker failed");
   if (finished) {
-    schedule_.finish(*finished);
-    if (on_finish_) on_finish_(*finished);
+    finish_locked(*finished);
     changed_.notify_all();
   }
   if (const std::optional<std::size_t> item = schedule_.take()) return {WorkReply::Kind::item, *item};
@@ -119,35 +123,35 @@ LocalChannel::LoopTake LocalChannel::take_for_loop(unsigned max_loops) {
 void LocalChannel::finish_for_loop(std::size_t item) {
   {
     const std::lock_guard lock(mutex_);
-    schedule_.finish(item);
-    if (on_finish_) on_finish_(item);
+    finish_locked(item);
   }
   changed_.notify_all();
 }
 
 namespace {
 
+/// Calls `work`; when it throws, stops every worker on `channel` first (the others must not
+/// wait for an item that will never finish) and passes the exception on.
+template <class Work>
+auto aborting_on_failure(WorkChannel& channel, Work&& work) {
+  try {
+    return work();
+  } catch (...) {
+    channel.abort();
+    throw;
+  }
+}
+
 /// run_workers on this process's own schedule: loops that end when nothing is ready, started
 /// again as items become ready, so that a thread with nothing to do helps the tiles in flight.
 void run_loops(LocalChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body) {
   channel.start_loops(workers);
   parallel_loops(workers, [&](const LoopSpawner& spawner) -> LoopWork {
-    LocalChannel::LoopTake take;
-    try {
-      take = channel.take_for_loop(workers);
-    } catch (...) {
-      channel.abort();
-      throw;
-    }
+    const LocalChannel::LoopTake take = aborting_on_failure(channel, [&] { return channel.take_for_loop(workers); });
     if (take.more > 0) spawner.spawn(take.more);
     if (!take.item) return {};
     return [&channel, &body, item = *take.item] {
-      try {
-        body(item);
-      } catch (...) {
-        channel.abort();
-        throw;
-      }
+      aborting_on_failure(channel, [&] { body(item); });
       channel.finish_for_loop(item);
     };
   });
@@ -161,16 +165,13 @@ void run_workers(WorkChannel& channel, unsigned workers, const std::function<voi
     return;
   }
   parallel_workers(std::max(workers, 1u), [&](unsigned) {
-    try {
+    aborting_on_failure(channel, [&] {
       std::optional<std::size_t> item = channel.next(std::nullopt);
       while (item) {
         body(*item);
         item = channel.next(item);
       }
-    } catch (...) {
-      channel.abort();
-      throw;
-    }
+    });
   });
 }
 

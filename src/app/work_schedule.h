@@ -89,6 +89,8 @@ class LocalChannel final : public WorkChannel {
 
  private:
   WorkReply step(std::optional<std::size_t> finished);
+  /// Marks `item` finished and tells on_finish; under the lock.
+  void finish_locked(std::size_t item);
 
   WorkSchedule& schedule_;
   std::function<void(std::size_t)> on_finish_;

@@ -198,10 +198,12 @@ struct FacePlanes {
 struct EmptySpaces {
   std::vector<std::uint32_t> ids;       ///< per empty space: its triangle
   std::vector<FacePlanes> planes;       ///< per empty space
-  bool cut = false;                     ///< into slabs; else slab i is empty space i
   std::vector<std::size_t> first_slab;  ///< per empty space, and one past the last slab
-  std::vector<Box3f> slab_boxes;
+  std::vector<Box3f> slab_boxes;        ///< empty (moved into the tree) when slab i is empty space i
   std::vector<std::uint32_t> space_of_slab;
+
+  /// Every empty space is one slab (not cut, or cut in no more than one).
+  [[nodiscard]] bool slab_is_space() const { return first_slab.back() == ids.size(); }
 };
 
 /// Slabs of an empty space for the conflict search: a few metres long, so that the boxes stay
@@ -219,8 +221,7 @@ EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j, std::size_t can
     if (f.empty_scale[g] > 0) out.ids.push_back(static_cast<std::uint32_t>(g));
   }
   const std::size_t n = out.ids.size();
-  out.cut = static_cast<double>(candidates) >= kCandidatesPerSpaceToCut * static_cast<double>(n);
-  const bool cut = out.cut;
+  const bool cut = static_cast<double>(candidates) >= kCandidatesPerSpaceToCut * static_cast<double>(n);
   out.planes.resize(n, FacePlanes(TetrahedronCorners{}));
   std::vector<std::size_t>& first_slab = out.first_slab;
   first_slab.assign(n + 1, 0);
@@ -254,9 +255,11 @@ EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j, std::size_t can
   return out;
 }
 
-bool meet(const Box3f& a, const Box3f& b) {
-  return a.min.x <= b.max.x && b.min.x <= a.max.x && a.min.y <= b.max.y && b.min.y <= a.max.y && a.min.z <= b.max.z &&
-         b.min.z <= a.max.z;
+/// The boxes for the tree: spaces_met reads them again only when empty spaces were cut into
+/// several slabs; otherwise they are handed over rather than copied.
+std::vector<Box3f> tree_boxes(EmptySpaces& spaces) {
+  if (spaces.slab_is_space()) return std::move(spaces.slab_boxes);
+  return spaces.slab_boxes;
 }
 
 /// The empty spaces whose slabs a query box met, each once: a slab stands for its empty
@@ -267,13 +270,13 @@ bool meet(const Box3f& a, const Box3f& b) {
 void spaces_met(const EmptySpaces& spaces, const Box3f& query, std::span<const std::uint32_t> hits,
                 std::vector<std::uint32_t>& out) {
   out.clear();
-  if (!spaces.cut) {
+  if (spaces.slab_is_space()) {
     out.assign(hits.begin(), hits.end());
     return;
   }
   for (const std::uint32_t h : hits) {
     const std::uint32_t space = spaces.space_of_slab[h];
-    if (h > spaces.first_slab[space] && meet(spaces.slab_boxes[h - 1], query)) continue;
+    if (h > spaces.first_slab[space] && spaces.slab_boxes[h - 1].intersects(query)) continue;
     out.push_back(space);
   }
 }
@@ -290,7 +293,7 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
     const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.ids.empty()) continue;
     EmptySpaces spaces = empty_spaces(f, j, older.ids.size());
-    const BoxTree tree(spaces.slab_boxes);
+    const BoxTree tree(tree_boxes(spaces));
     // Every overlapping pair is tested (no early exit) so that `refutes` does not depend on
     // the thread count; the flags are only ever raised, so any order of raising gives the
     // same result.

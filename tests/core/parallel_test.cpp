@@ -52,9 +52,18 @@ TEST(ParallelForBlocks, EmptyRangeCallsNothing) {
 
 // A worker that throws must not cut short another worker's nested loop: the loop would return
 // normally with blocks skipped, and a tile computed by it would be written as finished.
+/// Blocks of a nested loop, each sleeping a millisecond: long enough that a failing worker
+/// throws while they run. Counts the blocks that ran.
+constexpr std::size_t kNestedBlocks = 200;
+void run_nested_blocks(std::atomic<std::size_t>& blocks_run) {
+  parallel_for_blocks(kNestedBlocks, 1, [&](std::size_t, std::size_t) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    ++blocks_run;
+  });
+}
+
 TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
   ThreadLimit limit(2);
-  constexpr std::size_t kBlocks = 200;
   std::atomic<bool> started{false};
   std::atomic<std::size_t> blocks_run{0};
   EXPECT_THROW(parallel_workers(2,
@@ -64,15 +73,12 @@ TEST(ParallelWorkers, AThrowingWorkerDoesNotCutShortTheOthersNestedLoops) {
                                     throw std::runtime_error("worker 0 fails");
                                   }
                                   started = true;
-                                  parallel_for_blocks(kBlocks, 1, [&](std::size_t, std::size_t) {
-                                    std::this_thread::sleep_for(std::chrono::milliseconds(1));
-                                    ++blocks_run;
-                                  });
+                                  run_nested_blocks(blocks_run);
                                 }),
                std::runtime_error);
   // With one thread worker 1 may never start; once started, its loop must run every block.
   if (started) {
-    EXPECT_EQ(blocks_run.load(), kBlocks);
+    EXPECT_EQ(blocks_run.load(), kNestedBlocks);
   }
 }
 
@@ -129,7 +135,6 @@ TEST(ParallelLoops, LoopsStartedOnTheWayRunEveryPieceOnce) {
 
 TEST(ParallelLoops, AThrowingLoopDoesNotCutShortTheOthersNestedLoops) {
   ThreadLimit limit(2);
-  constexpr std::size_t kBlocks = 200;
   std::atomic<bool> started{false};
   std::atomic<std::size_t> blocks_run{0};
   LoopPieces pieces(2, 2);
@@ -139,15 +144,12 @@ TEST(ParallelLoops, AThrowingLoopDoesNotCutShortTheOthersNestedLoops) {
       throw std::runtime_error("piece 0 fails");
     }
     started = true;
-    parallel_for_blocks(kBlocks, 1, [&](std::size_t, std::size_t) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(1));
-      ++blocks_run;
-    });
+    run_nested_blocks(blocks_run);
   };
   EXPECT_THROW(parallel_loops(2, [&](const LoopSpawner& spawner) { return pieces.take(spawner, work); }),
                std::runtime_error);
   if (started) {
-    EXPECT_EQ(blocks_run.load(), kBlocks);
+    EXPECT_EQ(blocks_run.load(), kNestedBlocks);
   }
 }
 

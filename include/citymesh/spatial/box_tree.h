@@ -17,6 +17,11 @@ namespace citymesh {
 /// Closed axis-aligned box in a local float frame.
 struct Box3f {
   Vec3f min, max;
+  /// Whether the two closed boxes share a point (as Box3d::intersects).
+  [[nodiscard]] bool intersects(const Box3f& b) const {
+    return min.x <= b.max.x && b.min.x <= max.x && min.y <= b.max.y && b.min.y <= max.y && min.z <= b.max.z &&
+           b.min.z <= max.z;
+  }
 };
 
 /// A fixed set of boxes, indexed for containment and overlap queries.
