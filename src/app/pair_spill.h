@@ -6,8 +6,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
-#include <vector>
 #include <string_view>
+#include <vector>
 
 #include "citymesh/change/detect.h"
 
@@ -57,8 +57,8 @@ class PairSpill {
 class LabelSpill {
  public:
   struct Label {
-    std::uint32_t index = 0;  ///< the triangle, in its acquisition
-    std::uint8_t flags = 0;   ///< state and bits, as TileAssembly packs them
+    std::uint32_t index = 0;            ///< the triangle, in its acquisition
+    std::uint8_t flags = 0;             ///< state and bits, as TileAssembly packs them
     std::uint16_t first = 0, last = 0;  ///< first and last seen, as indices of the dates met
   };
 
@@ -77,8 +77,16 @@ class LabelSpill {
   [[nodiscard]] std::vector<Label> read(std::uint32_t acquisition, std::uint64_t count, std::uint64_t begin,
                                         std::uint64_t end) const;
 
+  /// Appends triangles of `acquisition` that another tile than their owner found refuting
+  /// (any order, repeats allowed). Throws OutputError naming the file.
+  void add_refuted(std::uint32_t acquisition, std::span<const std::uint32_t> indices);
+  /// Those in [begin, end), sorted, each once. Throws ProcessingError naming the acquisition
+  /// when one is not among its `count` triangles.
+  [[nodiscard]] std::vector<std::uint32_t> refuted(std::uint32_t acquisition, std::uint64_t count, std::uint64_t begin,
+                                                   std::uint64_t end) const;
+
  private:
-  [[nodiscard]] std::filesystem::path file(std::uint32_t acquisition) const;
+  [[nodiscard]] std::filesystem::path file(std::uint32_t acquisition, std::string_view kind = "labels") const;
   std::filesystem::path dir_;
 };
 

@@ -40,8 +40,8 @@ std::uint16_t TileAssembly::date_index(std::int64_t ms) {
 void TileAssembly::add(TileResult result) {
   const auto global = [&](std::uint32_t a, std::uint32_t t) -> std::uint32_t {
     if (a >= store_.triangles.size() || t >= store_.triangles[a]) {
-      throw ProcessingError(fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store",
-                                        result.key.name(), t, a));
+      throw ProcessingError(
+          fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store", result.key.name(), t, a));
     }
     return static_cast<std::uint32_t>(index_.offsets[a] + t);
   };
@@ -63,13 +63,14 @@ void TileAssembly::add(TileResult result) {
     fill_left_out_ += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
     if (!labels_) continue;
     if (i > 0 && result.labels[i - 1].acquisition != l.acquisition) spill(result.labels[i - 1].acquisition);
-    spilled.push_back({l.index,
-                       static_cast<std::uint8_t>(static_cast<std::uint8_t>(l.state) | (l.kept != 0 ? kKeptBit : 0) |
-                                                 (l.sustainable != 0 ? kSustainableBit : 0) |
-                                                 (l.refutes != 0 ? kRefutesBit : 0)),
-                       date_index(l.first_ms), date_index(l.last_ms)});
+    spilled.push_back(
+        {l.index,
+         static_cast<std::uint8_t>(static_cast<std::uint8_t>(l.state) | (l.kept != 0 ? kKeptBit : 0) |
+                                   (l.sustainable != 0 ? kSustainableBit : 0) | (l.refutes != 0 ? kRefutesBit : 0)),
+         date_index(l.first_ms), date_index(l.last_ms)});
   }
   if (labels_ && !result.labels.empty()) spill(result.labels.back().acquisition);
+  if (labels_) spill_refuted(result);
   if (labels_) {
     std::vector<TrianglePair> pairs;
     pairs.reserve(result.pairs.size());
@@ -80,6 +81,22 @@ void TileAssembly::add(TileResult result) {
   }
   for (TilePiece& p : result.selected) {
     if (p.triangle_count() > 0) pieces_.push_back(std::move(p));
+  }
+}
+
+void TileAssembly::spill_refuted(const TileResult& result) {
+  std::vector<std::uint32_t> indices;
+  for (std::size_t i = 0; i < result.refuted.size(); ++i) {
+    const RefutedCopy& c = result.refuted[i];
+    if (c.acquisition >= store_.triangles.size() || c.index >= store_.triangles[c.acquisition]) {
+      throw ProcessingError(fmt::format("tile {}: refuted triangle {} of acquisition {} is not in the tile store",
+                                        result.key.name(), c.index, c.acquisition));
+    }
+    indices.push_back(c.index);
+    if (i + 1 == result.refuted.size() || result.refuted[i + 1].acquisition != c.acquisition) {
+      labels_->add_refuted(c.acquisition, indices);
+      indices.clear();
+    }
   }
 }
 
@@ -161,8 +178,8 @@ MergedMesh TileAssembly::take_merged() {
 void TileAssembly::check_labelled() const {
   if (!labels_) throw ProcessingError("tile assembly: labels were not gathered");
   if (owned_ != index_.size()) {
-    throw ProcessingError(fmt::format("tile assembly: {} triangles owned by the tiles, the input has {}", owned_,
-                                      index_.size()));
+    throw ProcessingError(
+        fmt::format("tile assembly: {} triangles owned by the tiles, the input has {}", owned_, index_.size()));
   }
 }
 
@@ -188,6 +205,10 @@ ChangeResult TileAssembly::labels(std::size_t k, std::uint64_t begin, std::uint6
     // check_labelled(): every triangle was labelled, so dates_ms_ holds its dates.
     c.first_seen[t] = TimePoint(Duration(dates_ms_[read[t].first]));
     c.last_seen[t] = TimePoint(Duration(dates_ms_[read[t].last]));
+  }
+  // Raised by tiles where the triangle is a copy (TileResult::refuted).
+  for (const std::uint32_t t : labels_->refuted(static_cast<std::uint32_t>(k), triangle_count(k), begin, end)) {
+    c.refutes[t - begin] = 1;
   }
   c.stats.triangles = n;
   return c;

@@ -52,6 +52,19 @@ TilePiece selected_part(const TilePiece& piece, std::span<const std::uint8_t> se
   return out;
 }
 
+/// Empty-space copies lie outside the tile and its halo: they only bring their empty space,
+/// and are never mosaic candidates (detect_changes does not keep them).
+TriangleUse use_of(TileRole role) {
+  switch (role) {
+    case TileRole::owned:
+      return TriangleUse::labelled;
+    case TileRole::halo:
+      return TriangleUse::context;
+    default:
+      return TriangleUse::empty_space;
+  }
+}
+
 }  // namespace
 
 bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
@@ -77,29 +90,28 @@ std::optional<bool> SettledSelection::selected(std::uint32_t acquisition, std::u
 
 int tile_phase(TileKey key) { return (key.i & 1) * 2 + (key.j & 1); }
 
-TileResult process_tile(const TileStore& store, TileKey key, const Config& config,
-                        const SettledSelection& settled) {
+TileResult process_tile(const TileStore& store, TileKey key, const Config& config, const SettledSelection& settled) {
   Stopwatch clock;
   TileResult r;
   r.key = key;
   std::vector<TilePiece> pieces = read_tile(store, key);
   std::vector<Mesh> meshes;
   std::vector<TimePoint> dates;
+  std::vector<TriangleUse> uses;
   for (std::size_t a = 0; a < pieces.size(); ++a) {
     meshes.push_back(std::move(pieces[a].mesh));
     dates.push_back(config.acquisitions[a].time);
     r.triangles_in_tile += meshes.back().triangle_count();
+    for (const TileRole role : pieces[a].roles) uses.push_back(use_of(role));
   }
   r.seconds_read = clock.restart();
-  ChangeResult change = detect_changes({meshes, dates}, config.change);
+  ChangeResult change = detect_changes({meshes, dates, uses}, config.change);
   r.seconds_detect = clock.restart();
   r.change = change.stats;
   std::vector<std::uint8_t> forced(change.index.size(), 0);
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
     for (std::size_t t = 0; t < pieces[a].roles.size(); ++t) {
       const std::size_t g = change.index.offsets[a] + t;
-      // Empty-space triangles lie outside the tile and its halo: never mosaic candidates.
-      if (pieces[a].roles[t] == TileRole::empty_space) change.kept[g] = 0;
       if (pieces[a].roles[t] != TileRole::halo) continue;
       const std::optional<bool> selected = settled.selected(a, pieces[a].triangle_index[t]);
       if (!selected) continue;
@@ -120,8 +132,11 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   };
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
     for (std::size_t t = 0; t < pieces[a].roles.size(); ++t) {
-      if (pieces[a].roles[t] != TileRole::owned) continue;
       const std::size_t g = change.index.offsets[a] + t;
+      if (pieces[a].roles[t] != TileRole::owned) {
+        if (change.refutes[g] != 0) r.refuted.push_back({a, pieces[a].triangle_index[t]});
+        continue;
+      }
       r.labels.push_back({.acquisition = a,
                           .index = pieces[a].triangle_index[t],
                           .state = change.state[g],
@@ -140,6 +155,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   // A tile keeps each acquisition's triangles in input order, so the labels and the pairs
   // (from sorted global pairs) come sorted already (sorting them was 1 % of a run).
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
+  sort_unless_sorted(r.refuted.begin(), r.refuted.end());
   for (const auto& [g, h] : change.consistent_pairs) {
     if (!owned(g) && !owned(h)) continue;
     auto x = id(g), y = id(h);

@@ -3,6 +3,7 @@
 // owner's decisions written to <work>/results/<tile>.bin (and read back on resume).
 #pragma once
 
+#include <compare>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -53,10 +54,22 @@ class SettledSelection {
   std::vector<std::uint64_t> keys_;
 };
 
+/// A triangle of another tile (a halo or empty-space copy here) whose empty space an owned
+/// triangle of this tile conflicts with: the assembly raises its `refutes` label.
+struct RefutedCopy {
+  std::uint32_t acquisition = 0, index = 0;
+  friend auto operator<=>(const RefutedCopy&, const RefutedCopy&) = default;
+};
+
 struct TileResult {
   TileKey key;
-  std::vector<OwnedLabel> labels;   ///< every owned triangle, by (acquisition, index)
-  std::vector<LabelPair> pairs;     ///< sorted
+  std::vector<OwnedLabel> labels;  ///< every owned triangle, by (acquisition, index)
+  std::vector<LabelPair> pairs;    ///< sorted
+  /// Copies refuted by this tile's owned triangles, sorted. A conflict between an owned triangle
+  /// T and the empty space of a triangle U is found in T's owner tile (U's empty space meets T,
+  /// so it crosses that tile or its halo, and the tiler copied U there): every tile counts the
+  /// conflicts of its owned triangles only, and U's `refutes` is the union over the tiles.
+  std::vector<RefutedCopy> refuted;
   /// Per acquisition, the selected owned triangles with their vertices (tile frame).
   std::vector<TilePiece> selected;
   double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
@@ -69,14 +82,14 @@ struct TileResult {
 int tile_phase(TileKey key);
 inline constexpr int kTilePhases = 4;
 
-/// Reads the tile, runs detect_changes on all of it, then the mosaic (energy or update model)
-/// on its owned and halo triangles (empty-space triangles only give conflicts), and keeps the
-/// owned triangles' outcome. `settled`: the labels of neighbouring tiles of earlier phases
+/// Reads the tile, runs detect_changes on all of it (owned triangles labelled, halo ones as
+/// context, empty-space copies giving only their empty space), then the mosaic (energy or
+/// update model) on its owned and halo triangles, and keeps the owned triangles' outcome and
+/// the copies they refute. `settled`: the labels of neighbouring tiles of earlier phases
 /// (sorted by acquisition and index); their halo triangles keep the owner's choice (selected
 /// ones are forced into the energy mosaic, the others are no candidates), so both sides of a
 /// tile border agree.
-TileResult process_tile(const TileStore& store, TileKey key, const Config& config,
-                        const SettledSelection& settled);
+TileResult process_tile(const TileStore& store, TileKey key, const Config& config, const SettledSelection& settled);
 
 /// Writes the result atomically with the run's fingerprint.
 void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t fingerprint);

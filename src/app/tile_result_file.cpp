@@ -25,7 +25,9 @@ namespace {
 // results of a city took more than the tile store); older results are processed again.
 // Version 06: the change step's figures (ChangeFigures), which the detect summary of a tiled
 // run sums; older results would leave it zeros.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '6'};
+// Version 07: the copies refuted by the tile's owned triangles (TileResult::refuted); older
+// results counted refutes differently.
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '7'};
 
 /// ChangeStats as stored, in the order of kChangeCounts and kChangeSeconds.
 struct ChangeFigures {
@@ -56,8 +58,9 @@ struct ResultHeader {
   double seconds_read, seconds_detect, seconds_mosaic;
   std::uint64_t label_bytes, pair_bytes;  ///< the two varint sections that follow the header
   ChangeFigures change;
+  std::uint64_t refuted, refuted_bytes;  ///< the third varint section, after the pairs
 };
-static_assert(sizeof(ResultHeader) == 184);
+static_assert(sizeof(ResultHeader) == 200);
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
 std::uint64_t label_bits(const OwnedLabel& l) {
@@ -68,8 +71,39 @@ std::uint64_t label_bits(const OwnedLabel& l) {
 
 /// Varints per label: acquisition, index, bits, first and last seen.
 constexpr std::size_t kVarintsPerLabel = 5;
-/// Varints per pair: both acquisitions and indices.
-constexpr std::size_t kVarintsPerPair = 4;
+/// The fields of a record stored as varints, each a delta against the previous record's.
+template <class Record, std::size_t N>
+using DeltaFields = std::array<std::uint32_t Record::*, N>;
+constexpr DeltaFields<LabelPair, 4> kPairFields{&LabelPair::a_acquisition, &LabelPair::a_index,
+                                                &LabelPair::b_acquisition, &LabelPair::b_index};
+constexpr DeltaFields<RefutedCopy, 2> kRefutedFields{&RefutedCopy::acquisition, &RefutedCopy::index};
+
+/// Records (sorted: the deltas stay small) as deltas against the previous record.
+template <class Record, std::size_t N>
+VarintWriter encode_deltas(std::span<const Record> records, const DeltaFields<Record, N>& fields) {
+  VarintWriter w(records.size() * N * max_varint_bytes(32));
+  Record running{};
+  for (const Record& r : records) {
+    for (const auto field : fields) w.put_next(r.*field, running.*field);
+  }
+  return w;
+}
+
+/// The inverse of encode_deltas; false when the bytes do not hold `count` records.
+template <class Record, std::size_t N>
+bool decode_deltas(std::string_view bytes, std::size_t count, const DeltaFields<Record, N>& fields,
+                   std::vector<Record>& records) {
+  VarintReader in(bytes.data(), bytes.data() + bytes.size());
+  records.resize(count);
+  Record running{};
+  for (Record& r : records) {
+    for (const auto field : fields) {
+      if (!in.get_next(running.*field)) return false;
+    }
+    r = running;
+  }
+  return in.at_end();
+}
 
 /// Labels (sorted by triangle) as deltas against the previous label: consecutive labels are
 /// mostly the next triangle of the same acquisition, seen over the same dates.
@@ -83,19 +117,6 @@ VarintWriter encode_labels(std::span<const OwnedLabel> labels) {
     w.put(label_bits(l));
     w.put_next(static_cast<std::uint64_t>(l.first_ms), first);
     w.put_next(static_cast<std::uint64_t>(l.last_ms), last);
-  }
-  return w;
-}
-
-/// Pairs (sorted) as deltas against the previous pair.
-VarintWriter encode_pairs(std::span<const LabelPair> pairs) {
-  VarintWriter w(pairs.size() * kVarintsPerPair * max_varint_bytes(32));
-  LabelPair running{};
-  for (const LabelPair& p : pairs) {
-    w.put_next(p.a_acquisition, running.a_acquisition);
-    w.put_next(p.a_index, running.a_index);
-    w.put_next(p.b_acquisition, running.b_acquisition);
-    w.put_next(p.b_index, running.b_index);
   }
   return w;
 }
@@ -126,21 +147,6 @@ bool decode_labels(std::string_view bytes, std::size_t count, std::vector<OwnedL
   return in.at_end();
 }
 
-/// The inverse of encode_pairs; false when the bytes do not hold `count` pairs.
-bool decode_pairs(std::string_view bytes, std::size_t count, std::vector<LabelPair>& pairs) {
-  VarintReader in(bytes.data(), bytes.data() + bytes.size());
-  pairs.resize(count);
-  LabelPair running{};
-  for (LabelPair& p : pairs) {
-    if (!in.get_next(running.a_acquisition) || !in.get_next(running.a_index) || !in.get_next(running.b_acquisition) ||
-        !in.get_next(running.b_index)) {
-      return false;
-    }
-    p = running;
-  }
-  return in.at_end();
-}
-
 /// After an upgrade every result of the older format is processed again: said once, not once
 /// per tile (a city has tens of thousands).
 std::nullopt_t older_version(const std::filesystem::path& file) {
@@ -162,7 +168,8 @@ void append_raw(std::string& bytes, const T& value) {
 }  // namespace
 
 void write_tile_result(const std::filesystem::path& file, const TileResult& r, std::uint64_t fingerprint) {
-  const VarintWriter labels = encode_labels(r.labels), pairs = encode_pairs(r.pairs);
+  const VarintWriter labels = encode_labels(r.labels), pairs = encode_deltas<LabelPair>(r.pairs, kPairFields),
+                     refuted = encode_deltas<RefutedCopy>(r.refuted, kRefutedFields);
   ResultHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
   h.fingerprint = fingerprint;
@@ -178,10 +185,13 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
   h.label_bytes = labels.bytes().size();
   h.pair_bytes = pairs.bytes().size();
   h.change = figures_of(r.change);
+  h.refuted = r.refuted.size();
+  h.refuted_bytes = refuted.bytes().size();
   std::string bytes;
   append_raw(bytes, h);
   bytes += labels.bytes();
   bytes += pairs.bytes();
+  bytes += refuted.bytes();
   for (const TilePiece& p : r.selected) {
     const std::string block = p.triangle_count() == 0 ? std::string() : encode_tile_block(p);
     append_raw(bytes, std::uint64_t{block.size()});
@@ -223,7 +233,8 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   // Counts are checked against the section sizes (a varint takes a byte at least) before
   // anything is allocated.
   if (h.acquisitions != store.triangles.size() || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
-      h.labels > h.label_bytes / kVarintsPerLabel || h.pairs > h.pair_bytes / kVarintsPerPair) {
+      h.refuted_bytes > body - h.label_bytes - h.pair_bytes || h.labels > h.label_bytes / kVarintsPerLabel ||
+      h.pairs > h.pair_bytes / kPairFields.size() || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
   }
   return CheckedResult{h, std::move(*read)};
@@ -248,10 +259,14 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   std::size_t at = sizeof h;
   if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;
-  if (sections.pairs && !decode_pairs(bytes.substr(at, h.pair_bytes), h.pairs, r.pairs)) {
+  if (sections.pairs && !decode_deltas(bytes.substr(at, h.pair_bytes), h.pairs, kPairFields, r.pairs)) {
     return stale(file, "damaged pairs");
   }
   at += h.pair_bytes;
+  if (!decode_deltas(bytes.substr(at, h.refuted_bytes), h.refuted, kRefutedFields, r.refuted)) {
+    return stale(file, "damaged refuted copies");
+  }
+  at += h.refuted_bytes;
   const Vec3d origin = TileGrid(store.grid).corner(r.key);
   for (std::uint32_t a = 0; a < h.acquisitions; ++a) {
     std::uint64_t size = 0;

@@ -82,7 +82,7 @@ VoxelMask asked_voxels(const TriangleFrames& f, double voxel_size) {
   for (std::size_t a = 0; a < f.acquisitions(); ++a) {
     if (!(f.dates[a] < newest)) continue;
     for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
-      boxes.push_back(voxel_box(f.bounds(g).min, f.bounds(g).max, inverse));
+      if (f.asks(g)) boxes.push_back(voxel_box(f.bounds(g).min, f.bounds(g).max, inverse));
     }
   }
   return VoxelMask(boxes);
@@ -139,7 +139,7 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
   for (std::size_t a = 0; a < f.acquisitions(); ++a) {
     if (!(f.dates[a] < f.dates[j])) continue;
     for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
-      if (partners.has(g, j)) continue;
+      if (!f.asks(g) || partners.has(g, j)) continue;
       ++stats.conflict_candidates;
       const Box3f& box = f.bounds(g);
       if (params.prefilter && !grids[j].any_in_box(box.min, box.max)) {
@@ -303,6 +303,9 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
       for (std::size_t i = begin; i < end; ++i) {
         const std::uint32_t t = older.ids[i];
         const TriangleCorners corners = f.corners(t);  // once per candidate, not per test
+        const bool raises = f.raises_refutes(t);
+        // Without refutes to raise, one conflict settles the triangle.
+        if (!raises && flags.conflicting[t] != 0) continue;
         tree.overlapping(older.boxes[i], hits);
         spaces_met(spaces, older.boxes[i], hits, met);
         for (const std::uint32_t h : met) {
@@ -311,6 +314,7 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
           ++tested;
           if (triangle_intersects_tetrahedron(corners, f.empty_space(u))) {
             flags.conflicting[t] = 1;
+            if (!raises) break;
             std::atomic_ref<std::uint8_t>(flags.refutes[u]).store(1, std::memory_order_relaxed);
           }
         }

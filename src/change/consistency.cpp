@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
-#include <array>
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <iterator>
 #include <numbers>
 
 #include "citymesh/core/parallel.h"
@@ -15,7 +16,8 @@ namespace {
 /// T (centroid c) overlaps U: c lies within `threshold` of U's plane and its projection on
 /// that plane falls inside U (edges included), i.e. the point-to-triangle distance is at most
 /// the threshold and is reached inside U.
-[[gnu::always_inline]] inline bool overlaps(const Vec3d& c, const TriangleFrames& f, std::uint32_t u, double threshold) {
+[[gnu::always_inline]] inline bool overlaps(const Vec3d& c, const TriangleFrames& f, std::uint32_t u,
+                                            double threshold) {
   const std::array<Vec3f, 3>& qf = f.corner[u];
   const TriangleCorners q{Vec3d(qf[0]), Vec3d(qf[1]), Vec3d(qf[2])};
   const Vec3d n(f.normal[u]);
@@ -44,8 +46,8 @@ Box3f prism_box(const TriangleFrames& f, std::size_t u, double threshold) {
 
 /// The pairs (min, max) found from triangle g's side: every U of another acquisition whose
 /// prism holds g's centroid (`hits`), with compatible normals, that g overlaps. A pair that U
-/// also finds from its side (U overlaps g) is kept by the smaller index only, so that each
-/// pair is listed once.
+/// also finds from its side (U overlaps g, and U asks) is kept by the smaller index only, so
+/// that each pair is listed once.
 void pairs_of(const TriangleFrames& f, std::size_t g, std::span<const std::uint32_t> hits, double threshold,
               float cos_min, std::vector<TrianglePair>& out) {
   const std::uint32_t acq = f.index.acquisition_of(g);
@@ -55,7 +57,7 @@ void pairs_of(const TriangleFrames& f, std::size_t g, std::span<const std::uint3
     if (u >= own_begin && u < own_end) continue;  // same acquisition
     if (dot(f.normal[g], f.normal[u]) < cos_min) continue;
     if (!overlaps(Vec3d(f.centroid[g]), f, u, threshold)) continue;
-    if (t > u && overlaps(Vec3d(f.centroid[u]), f, t, threshold)) continue;  // u lists it
+    if (t > u && f.asks(u) && overlaps(Vec3d(f.centroid[u]), f, t, threshold)) continue;  // u lists it
     out.emplace_back(std::min(t, u), std::max(t, u));
   }
 }
@@ -77,7 +79,12 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
   parallel_for_blocks(f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     // In the tree's order, a triangle's candidates are near the previous one's: warm caches,
     // and packets of neighbouring centroids that share one walk down the tree.
-    const std::span<const std::uint32_t> order = prisms.storage_order().subspan(begin, end - begin);
+    std::span<const std::uint32_t> order = prisms.storage_order().subspan(begin, end - begin);
+    std::vector<std::uint32_t> asking;  // only triangles whose labels are wanted query
+    if (!f.use.empty()) {
+      std::copy_if(order.begin(), order.end(), std::back_inserter(asking), [&](std::uint32_t g) { return f.asks(g); });
+      order = asking;
+    }
     prisms.containing_in_packets(
         order.size(), [&](std::size_t i) { return f.centroid[order[i]]; },
         [&](std::size_t i, std::span<const std::uint32_t> hits) {

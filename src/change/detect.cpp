@@ -47,6 +47,11 @@ void compute_time_series(const TriangleFrames& f, const PartnerBits& partners, c
   parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t g = begin; g < end; ++g) {
       r.sustainable[g] = r.last_seen[g] - r.first_seen[g] >= params.sustainability ? 1 : 0;
+      if (!f.asks(g)) {
+        r.state[g] = TriangleState::single;
+        r.kept[g] = 0;
+        continue;
+      }
       if (conflicts.conflicting[g] != 0) {
         r.state[g] = TriangleState::conflicting;
         r.kept[g] = 0;
@@ -75,9 +80,9 @@ void compute_time_series(const TriangleFrames& f, const PartnerBits& partners, c
 
 LabelView label_view(const ChangeResult& r, std::size_t begin, std::size_t end) {
   const std::size_t n = end - begin;
-  return {std::span(r.state).subspan(begin, n),       std::span(r.first_seen).subspan(begin, n),
-          std::span(r.last_seen).subspan(begin, n),   std::span(r.sustainable).subspan(begin, n),
-          std::span(r.kept).subspan(begin, n),        std::span(r.refutes).subspan(begin, n)};
+  return {std::span(r.state).subspan(begin, n),     std::span(r.first_seen).subspan(begin, n),
+          std::span(r.last_seen).subspan(begin, n), std::span(r.sustainable).subspan(begin, n),
+          std::span(r.kept).subspan(begin, n),      std::span(r.refutes).subspan(begin, n)};
 }
 
 StateCounts& StateCounts::operator+=(const StateCounts& o) {

@@ -67,6 +67,9 @@ void check_input(const ChangeInput& input) {
     throw ProcessingError(
         fmt::format("change detection: {} triangles in one set (at most 2^32 - 1; use tiles)", total));
   }
+  if (!input.uses.empty() && input.uses.size() != total) {
+    throw ProcessingError(fmt::format("change detection: {} triangle uses for {} triangles", input.uses.size(), total));
+  }
 }
 
 }  // namespace
@@ -140,6 +143,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
   f.viewpoint.resize(n);
   f.empty_scale.resize(n);
   f.box.resize(n);
+  f.use.assign(input.uses.begin(), input.uses.end());
   for (std::size_t a = 0; a < input.meshes.size(); ++a) {
     const Mesh& m = input.meshes[a];
     const std::size_t base = f.index.offsets[a];

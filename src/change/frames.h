@@ -29,8 +29,14 @@ struct TriangleFrames {
   /// The corners' box, padded (see bounds()): asked for once per newer acquisition and by
   /// every step, so kept rather than recomputed.
   std::vector<Box3f> box;
+  std::vector<TriangleUse> use;  ///< per global triangle; empty: every one labelled
 
   [[nodiscard]] std::size_t size() const { return centroid.size(); }
+  /// Whether triangle g's own labels are wanted: it queries the consistency search and is
+  /// tested for conflicts.
+  [[nodiscard]] bool asks(std::size_t g) const { return use.empty() || use[g] != TriangleUse::empty_space; }
+  /// Whether g's conflicts raise the refutes of the triangles whose empty space it meets.
+  [[nodiscard]] bool raises_refutes(std::size_t g) const { return use.empty() || use[g] == TriangleUse::labelled; }
   [[nodiscard]] std::size_t acquisitions() const { return dates.size(); }
   [[nodiscard]] TriangleCorners corners(std::size_t g) const;
   [[nodiscard]] TetrahedronCorners empty_space(std::size_t g) const;
@@ -77,7 +83,8 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
 /// and projects inside it (point-to-triangle distance reached inside). Candidates come from
 /// point queries in a BVH of every triangle's prism box (the triangle thickened by the
 /// threshold along its normal), which holds exactly the points that can pass the test.
-/// Sorted, each pair once.
+/// Only triangles that ask (TriangleFrames::asks) query: a pair of which only an
+/// empty-space triangle overlaps the other is not found. Sorted, each pair once.
 std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& frames, const ChangeParams& params,
                                                 ChangeStats& stats);
 

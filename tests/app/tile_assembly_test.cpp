@@ -1,19 +1,20 @@
 // SPDX-License-Identifier: MIT
 // The tiled run's labels: the consistent pairs spilled to disk come back sorted and unique,
 // and the assembly's compact labels expand to exactly what the tiles handed in.
+#include "tile_assembly.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <span>
 #include <random>
 #include <set>
+#include <span>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/record_file.h"
 #include "detect_output.h"
 #include "pair_spill.h"
 #include "test_support.h"
-#include "tile_assembly.h"
 
 namespace citymesh::app {
 namespace {
@@ -40,8 +41,10 @@ TEST(PairSpill, WritesEveryPairOnceInOrderWhateverTheOrderAdded) {
         expected.emplace(a, b);
       }
       // Half the batches in order, as tiles give them (no regrouping), half shuffled.
-      if (batch % 2 == 0) std::sort(pairs.begin(), pairs.end());
-      else std::shuffle(pairs.begin(), pairs.end(), rng);
+      if (batch % 2 == 0)
+        std::sort(pairs.begin(), pairs.end());
+      else
+        std::shuffle(pairs.begin(), pairs.end(), rng);
       spill.add(pairs);
     }
     EXPECT_EQ(spill.write_sorted(tmp / "pairs.bin", kPairsMagic), expected.size());
@@ -75,8 +78,11 @@ TileResult tile_of(std::uint32_t begin, std::uint32_t end, std::minstd_rand& rng
   const std::int64_t dates[] = {1767607200000, 1770199200000, 1770544800000};
   for (std::uint32_t a = 0; a < 2; ++a) {
     for (std::uint32_t t = begin; t < end; ++t) {
-      OwnedLabel l{.acquisition = a, .index = t, .state = static_cast<TriangleState>(rng() % 3),
-                   .kept = static_cast<std::uint8_t>(rng() % 2), .sustainable = static_cast<std::uint8_t>(rng() % 2),
+      OwnedLabel l{.acquisition = a,
+                   .index = t,
+                   .state = static_cast<TriangleState>(rng() % 3),
+                   .kept = static_cast<std::uint8_t>(rng() % 2),
+                   .sustainable = static_cast<std::uint8_t>(rng() % 2),
                    .refutes = static_cast<std::uint8_t>(rng() % 2)};
       l.first_ms = dates[rng() % 3];
       l.last_ms = dates[rng() % 3];
@@ -87,15 +93,26 @@ TileResult tile_of(std::uint32_t begin, std::uint32_t end, std::minstd_rand& rng
   return r;
 }
 
+/// Two acquisitions of 300 triangles each, in three tiles.
+constexpr std::uint32_t kTrianglesEach = 300;
+TileStore store_of_two() {
+  TileStore store;
+  store.triangles = {kTrianglesEach, kTrianglesEach};
+  return store;
+}
+std::vector<TileResult> three_tiles(std::minstd_rand& rng) {
+  return {tile_of(0, 120, rng), tile_of(120, 250, rng), tile_of(250, kTrianglesEach, rng)};
+}
+
 TEST(TileAssembly, CompactLabelsExpandToWhatTheTilesGave) {
   test::TempDir tmp;
-  TileStore store;
-  store.triangles = {300, 300};
+  const TileStore store = store_of_two();
   std::minstd_rand rng(11);
-  std::vector<TileResult> tiles{tile_of(0, 120, rng), tile_of(120, 250, rng), tile_of(250, 300, rng)};
+  const std::vector<TileResult> tiles = three_tiles(rng);
   std::set<TrianglePair> pairs;
   for (const TileResult& r : tiles) {
-    for (const LabelPair& p : r.pairs) pairs.emplace(p.a_acquisition * 300 + p.a_index, p.b_acquisition * 300 + p.b_index);
+    for (const LabelPair& p : r.pairs)
+      pairs.emplace(p.a_acquisition * 300 + p.a_index, p.b_acquisition * 300 + p.b_index);
   }
   TileAssembly assembly(store, tmp / "pairs");
   for (const std::size_t k : {2, 0, 1}) assembly.add(tiles[k]);  // any order
@@ -118,6 +135,48 @@ TEST(TileAssembly, CompactLabelsExpandToWhatTheTilesGave) {
   EXPECT_EQ(read_u32_records(tmp / "pairs.bin", kPairsMagic, "pairs"), flat(pairs));
 }
 
+TEST(TileAssembly, CopiesATileFoundRefutingRaiseTheirOwnersRefutes) {
+  test::TempDir tmp;
+  const TileStore store = store_of_two();
+  std::minstd_rand rng(17);
+  std::vector<TileResult> tiles = three_tiles(rng);
+  // Each tile refutes some triangles of the others (repeats across tiles allowed).
+  std::set<std::pair<std::uint32_t, std::uint32_t>> raised;
+  for (TileResult& r : tiles) {
+    for (int k = 0; k < 40; ++k) {
+      const RefutedCopy c{static_cast<std::uint32_t>(rng() % 2), static_cast<std::uint32_t>(rng() % kTrianglesEach)};
+      r.refuted.push_back(c);
+      raised.emplace(c.acquisition, c.index);
+    }
+    std::sort(r.refuted.begin(), r.refuted.end());
+    r.refuted.erase(std::unique(r.refuted.begin(), r.refuted.end()), r.refuted.end());
+  }
+  TileAssembly assembly(store, tmp / "pairs");
+  for (const TileResult& r : tiles) assembly.add(r);
+  std::size_t raised_here = 0;
+  for (std::uint32_t a = 0; a < 2; ++a) {
+    const ChangeResult c = assembly.labels(a);
+    const ChangeResult window = assembly.labels(a, 100, 200);
+    for (const TileResult& r : tiles) {
+      for (const OwnedLabel& l : r.labels) {
+        if (l.acquisition != a) continue;
+        const bool refutes = l.refutes != 0 || raised.contains({a, l.index});
+        EXPECT_EQ(c.refutes[l.index], refutes ? 1 : 0) << a << " " << l.index;
+        if (l.index >= 100 && l.index < 200) {
+          EXPECT_EQ(window.refutes[l.index - 100], c.refutes[l.index]);
+        }
+        raised_here += l.refutes == 0 && refutes ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_GT(raised_here, 20u);  // raised only by another tile
+  // A copy outside the input is refused.
+  TileResult bad = tile_of(0, 120, rng);
+  bad.refuted = {{1, kTrianglesEach}};
+  TileAssembly other(store, tmp / "other");
+  EXPECT_THROW(other.add(bad), ProcessingError);
+}
+
 TEST(TileAssembly, RefusesLabelsWhenATileIsMissing) {
   test::TempDir tmp;
   TileStore store;
@@ -136,7 +195,8 @@ TEST(LabelSpill, LabelsAddedInPiecesComeBackByIndexAndGapsOrRepeatsAreRefused) {
   LabelSpill spill(tmp / "spill");
   std::vector<LabelSpill::Label> all;
   for (std::uint32_t t = 0; t < 1000; ++t) {
-    all.push_back({t, static_cast<std::uint8_t>(t % 31), static_cast<std::uint16_t>(t % 7), static_cast<std::uint16_t>(t % 65536)});
+    all.push_back({t, static_cast<std::uint8_t>(t % 31), static_cast<std::uint16_t>(t % 7),
+                   static_cast<std::uint16_t>(t % 65536)});
   }
   std::minstd_rand rng(5);
   std::vector<LabelSpill::Label> shuffled = all;
@@ -165,14 +225,15 @@ TEST(LabelSpill, WindowsOfTheLabelsAreSlicesOfTheWholeAndAGapInOneIsRefused) {
   LabelSpill spill(tmp / "spill");
   std::vector<LabelSpill::Label> all;
   for (std::uint32_t t = 0; t < 200000; ++t) {  // more than one read of the file
-    all.push_back({t, static_cast<std::uint8_t>(t % 29), static_cast<std::uint16_t>(t % 5), static_cast<std::uint16_t>(t % 9)});
+    all.push_back(
+        {t, static_cast<std::uint8_t>(t % 29), static_cast<std::uint16_t>(t % 5), static_cast<std::uint16_t>(t % 9)});
   }
   std::vector<LabelSpill::Label> shuffled = all;
   std::shuffle(shuffled.begin(), shuffled.end(), std::minstd_rand(8));
   spill.add(1, shuffled);
   const std::vector<LabelSpill::Label> whole = spill.read(1, all.size());
-  for (const auto& [begin, end] : {std::pair{0u, 1u}, std::pair{1u, 70001u}, std::pair{70001u, 200000u},
-                                   std::pair{5u, 5u}}) {
+  for (const auto& [begin, end] :
+       {std::pair{0u, 1u}, std::pair{1u, 70001u}, std::pair{70001u, 200000u}, std::pair{5u, 5u}}) {
     const std::vector<LabelSpill::Label> window = spill.read(1, all.size(), begin, end);
     ASSERT_EQ(window.size(), end - begin);
     for (std::size_t i = 0; i < window.size(); ++i) {

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Tile result files: labels, pairs and the change step's figures of any values round-trip; damage under a valid checksum
-// makes the tile "processed again", never a crash or a wrong result.
+// Tile result files: labels, pairs and the change step's figures of any values round-trip; damage under a valid
+// checksum makes the tile "processed again", never a crash or a wrong result.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,6 +59,11 @@ TileResult random_result(std::uint32_t seed, bool scan_order) {
     r.pairs.push_back({static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng()),
                        static_cast<std::uint32_t>(rng()), static_cast<std::uint32_t>(rng())});
   }
+  for (std::uint32_t k = 0; k < 300; ++k) {
+    r.refuted.push_back({scan_order ? k / 200 : static_cast<std::uint32_t>(rng()),
+                         scan_order ? 3 * k : static_cast<std::uint32_t>(rng())});
+  }
+  std::sort(r.refuted.begin(), r.refuted.end());
   r.selected.resize(2);
   for (TilePiece& p : r.selected) p.mesh.origin = {651000 + 50 * 13020.0, 6860000 - 50 * 7.0, 0};
   return r;
@@ -93,6 +98,7 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
     for (std::size_t k = 0; k < r.pairs.size(); ++k) {
       EXPECT_EQ(std::memcmp(&back->pairs[k], &r.pairs[k], sizeof(LabelPair)), 0) << "pair " << k;
     }
+    EXPECT_EQ(back->refuted, r.refuted);
     // Without the pairs, as the assembly reads it when no labelled PLY is written.
     const std::optional<TileResult> no_pairs = read_tile_result(tmp / "t.bin", kFingerprint, store, {.pairs = false});
     ASSERT_TRUE(no_pairs.has_value());
@@ -128,8 +134,12 @@ TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
   int refused = 0;
   for (int trial = 0; trial < 500; ++trial) {
     std::string bytes = good;
-    // A count or section size in the header (bytes 24-56 and 80-96), or the varint sections.
-    const std::size_t at = trial % 4 == 0 ? 24 + rng() % 32 : trial % 4 == 1 ? 80 + rng() % 16 : 96 + rng() % 3000;
+    // A count or section size in the header (bytes 24-56, 80-96 and 184-200), or the varint
+    // sections.
+    const std::size_t at = trial % 5 == 0   ? 24 + rng() % 32
+                           : trial % 5 == 1 ? 80 + rng() % 16
+                           : trial % 5 == 2 ? 184 + rng() % 16
+                                            : 200 + rng() % 3000;
     bytes[at] = static_cast<char>(rng());
     const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
     std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);

@@ -382,6 +382,106 @@ TEST(DetectChanges, PrefilterAndThreadCountNeverChangeTheResult) {
   expect_same(a, detect(meshes, dates, with));
 }
 
+// ---- triangle uses: what a tile asks of its own triangles and of its copies ---------------
+
+/// Per global triangle, its corners' x extent.
+std::vector<std::pair<double, double>> x_extents(const std::vector<Mesh>& meshes) {
+  std::vector<std::pair<double, double>> out;
+  for (const Mesh& m : meshes) {
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const auto c = m.corners(t);
+      out.emplace_back(std::min({c[0].x, c[1].x, c[2].x}), std::max({c[0].x, c[1].x, c[2].x}));
+    }
+  }
+  return out;
+}
+
+TEST(TriangleUses, ContextTrianglesRaiseNoRefutesAndTwoHalvesAddUpToTheWhole) {
+  std::vector<TimePoint> dates;
+  const std::vector<Mesh> meshes = simulated_street(dates);
+  const ChangeResult whole = detect(meshes, dates);
+  const auto extents = x_extents(meshes);
+  const double middle = 0.5 * (extents.front().first + extents.front().second);
+  std::vector<TriangleUse> left(extents.size()), right(extents.size());
+  for (std::size_t g = 0; g < extents.size(); ++g) {
+    const bool is_left = extents[g].first + extents[g].second < 2 * middle;
+    left[g] = is_left ? TriangleUse::labelled : TriangleUse::context;
+    right[g] = is_left ? TriangleUse::context : TriangleUse::labelled;
+  }
+  const ChangeResult a = detect_changes({meshes, dates, left}, {}), b = detect_changes({meshes, dates, right}, {});
+  for (const ChangeResult* half : {&a, &b}) {
+    EXPECT_EQ(half->consistent_pairs, whole.consistent_pairs);
+    EXPECT_EQ(half->state, whole.state);
+    EXPECT_EQ(half->kept, whole.kept);
+    EXPECT_NE(half->refutes, whole.refutes);  // each half misses the other's refutations
+  }
+  std::vector<std::uint8_t> either(whole.refutes.size());
+  for (std::size_t g = 0; g < either.size(); ++g) either[g] = a.refutes[g] | b.refutes[g];
+  EXPECT_EQ(either, whole.refutes);
+}
+
+TEST(TriangleUses, TilesOfOwnedHaloAndEmptySpaceTrianglesLabelLikeTheWhole) {
+  // Three tiles across the street, as the tiler cuts them: a triangle is labelled in the tile
+  // holding its centroid, context where its box lies within the halo, and only lends its empty
+  // space elsewhere. Each triangle's labels from its own tile, and its refutes from all tiles
+  // together, are the untiled ones.
+  std::vector<TimePoint> dates;
+  const std::vector<Mesh> meshes = simulated_street(dates);
+  const ChangeResult whole = detect(meshes, dates);
+  const auto extents = x_extents(meshes);
+  double lo = extents.front().first, hi = extents.front().second;
+  for (const auto& [a, b] : extents) {
+    lo = std::min(lo, a);
+    hi = std::max(hi, b);
+  }
+  constexpr int kTiles = 3;
+  constexpr double kHalo = 2.0;
+  const double size = (hi - lo) / kTiles + 1e-6;
+  const auto tile_of = [&](std::size_t g) {
+    return std::min(kTiles - 1, static_cast<int>((0.5 * (extents[g].first + extents[g].second) - lo) / size));
+  };
+  const auto near = [&](std::size_t g, int k) {
+    return extents[g].second >= lo + k * size - kHalo && extents[g].first <= lo + (k + 1) * size + kHalo;
+  };
+  // The halo holds every partner of a tile's own triangles: they ask in that tile.
+  for (const auto& [g, h] : whole.consistent_pairs) {
+    ASSERT_TRUE(near(h, tile_of(g)) && near(g, tile_of(h))) << g << " " << h;
+  }
+  std::vector<std::uint8_t> refutes(whole.refutes.size(), 0);
+  std::size_t empty_space_triangles = 0;
+  for (int k = 0; k < kTiles; ++k) {
+    std::vector<TriangleUse> uses(extents.size());
+    for (std::size_t g = 0; g < uses.size(); ++g) {
+      uses[g] = tile_of(g) == k ? TriangleUse::labelled : near(g, k) ? TriangleUse::context : TriangleUse::empty_space;
+      empty_space_triangles += uses[g] == TriangleUse::empty_space ? 1 : 0;
+    }
+    const ChangeResult tile = detect_changes({meshes, dates, uses}, {});
+    for (std::size_t g = 0; g < uses.size(); ++g) {
+      refutes[g] |= tile.refutes[g];
+      if (uses[g] == TriangleUse::empty_space) {
+        ASSERT_EQ(tile.kept[g], 0) << g;
+        ASSERT_NE(tile.state[g], TriangleState::conflicting) << g;
+      }
+      if (uses[g] != TriangleUse::labelled) continue;
+      ASSERT_EQ(tile.state[g], whole.state[g]) << g;
+      ASSERT_EQ(tile.kept[g], whole.kept[g]) << g;
+      ASSERT_EQ(tile.sustainable[g], whole.sustainable[g]) << g;
+      ASSERT_EQ(tile.first_seen[g], whole.first_seen[g]) << g;
+      ASSERT_EQ(tile.last_seen[g], whole.last_seen[g]) << g;
+    }
+  }
+  EXPECT_GT(empty_space_triangles, extents.size());  // most of the street lends only its empty space
+  EXPECT_EQ(refutes, whole.refutes);
+  EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 100);
+}
+
+TEST(TriangleUses, AUseForEachTriangleOrNone) {
+  std::vector<TimePoint> dates;
+  const std::vector<Mesh> meshes = simulated_street(dates);
+  const std::vector<TriangleUse> one(1, TriangleUse::labelled);
+  EXPECT_THROW((void)detect_changes({meshes, dates, one}, {}), ProcessingError);
+}
+
 TEST(EmptySpaceGrids, MarkedOnlyWhereAskedTheyAnswerEveryQuestionAsIfMarkedEverywhere) {
   std::vector<TimePoint> dates;
   const std::vector<Mesh> meshes = simulated_street(dates);

@@ -17,11 +17,26 @@
 
 namespace citymesh {
 
+/// What the caller wants of a triangle. A tile holds its own triangles, copies of its
+/// neighbours' near its border (their labels give the tile's mosaic its context) and copies of
+/// triangles whose empty space crosses it (to find the conflicts they cause there).
+enum class TriangleUse : std::uint8_t {
+  /// Its labels; its conflicts raise the `refutes` of the newer triangles they come from.
+  labelled = 0,
+  /// Its labels; its conflicts raise no `refutes` (the caller counts them where it is labelled).
+  context = 1,
+  /// Only its empty space: it asks nothing (no consistency query, no conflict test of its
+  /// own); only its `refutes` is meaningful, and it is never kept.
+  empty_space = 2,
+};
+
 /// The meshes of every acquisition, index = acquisition index (config order), all in one local
 /// frame (the same origin) and with sensor positions; dates may come in any order.
 struct ChangeInput {
   std::span<const Mesh> meshes;
   std::span<const TimePoint> dates;  ///< one per mesh
+  /// Per global triangle (see GlobalTriangles); empty: every triangle is labelled.
+  std::span<const TriangleUse> uses = {};
 };
 
 enum class TriangleState : std::uint8_t { consistent = 0, conflicting = 1, single = 2 };
@@ -77,7 +92,7 @@ struct ChangeResult {
   std::vector<std::uint8_t> sustainable;  ///< last_seen - first_seen >= Ts
   std::vector<std::uint8_t> kept;         ///< survives the time series (not conflicting; sustainable or
                                           ///< kept by the unconfirmed policy)
-  std::vector<std::uint8_t> refutes;      ///< its empty space made an older triangle conflict
+  std::vector<std::uint8_t> refutes;      ///< its empty space made an older labelled triangle conflict
   std::vector<TrianglePair> consistent_pairs;
   ChangeStats stats;
 };
