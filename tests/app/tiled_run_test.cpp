@@ -85,7 +85,7 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   }
   // The labels of many tiles are the untiled ones, refutes too: a tile counts the conflicts of
   // its own triangles only, and the assembly gathers the refutations of every tile (before,
-  // 10 m tiles missed up to 7 % of them). Up to the tile frame's rounding: one triangle.
+  // 10 m tiles missed up to 7.5 % of them). Up to the tile frame's rounding: one triangle.
   const nlohmann::json untiled_acquisitions = read_json(dir / "sim/out/detect/summary.json")["acquisitions"];
   std::uint64_t refuting = 0;
   for (std::size_t k = 0; k < untiled_acquisitions.size(); ++k) {
