@@ -23,14 +23,24 @@ constexpr const char* kSummaryFile = "summary.json";
 constexpr int kSummaryVersion = 2;
 
 nlohmann::json stats_json(const TilingStats& s) {
-  return {{"input_bytes", s.input_bytes}, {"halo_copies", s.halo_copies}, {"empty_space_copies", s.empty_space_copies},
-          {"blocks", s.blocks},           {"bytes_written", s.bytes_written}, {"seconds", s.seconds}};
+  return {{"input_bytes", s.input_bytes},
+          {"halo_copies", s.halo_copies},
+          {"empty_space_copies", s.empty_space_copies},
+          {"blocks", s.blocks},
+          {"bytes_written", s.bytes_written},
+          {"seconds", s.seconds},
+          {"largest_radius", s.largest_radius}};
 }
 
 TilingStats stats_from_json(const nlohmann::json& s) {
-  return {s.at("input_bytes").get<std::uint64_t>(),  s.at("halo_copies").get<std::uint64_t>(),
-          s.at("empty_space_copies").get<std::uint64_t>(), s.at("blocks").get<std::uint64_t>(),
-          s.at("bytes_written").get<std::uint64_t>(), s.at("seconds").get<double>()};
+  // largest_radius came later: a store tiled before says nothing of it (0).
+  return {s.at("input_bytes").get<std::uint64_t>(),
+          s.at("halo_copies").get<std::uint64_t>(),
+          s.at("empty_space_copies").get<std::uint64_t>(),
+          s.at("blocks").get<std::uint64_t>(),
+          s.at("bytes_written").get<std::uint64_t>(),
+          s.at("seconds").get<double>(),
+          s.value("largest_radius", 0.0)};
 }
 
 /// Byte ranges as a flat list: offset, bytes, offset, bytes...
@@ -106,8 +116,10 @@ void write_acquisition_tiling(const std::filesystem::path& dir, const Acquisitio
   for (const auto& [key, t] : tiling.tiles) {
     tiles.push_back({{"i", key.i}, {"j", key.j}, {"triangles", t.counts}, {"blocks", ranges_json(t.blocks)}});
   }
-  const nlohmann::json j{{"version", kSummaryVersion}, {"fingerprint", tiling.fingerprint},
-                         {"triangles", tiling.triangles}, {"stats", stats_json(tiling.stats)},
+  const nlohmann::json j{{"version", kSummaryVersion},
+                         {"fingerprint", tiling.fingerprint},
+                         {"triangles", tiling.triangles},
+                         {"stats", stats_json(tiling.stats)},
                          {"tiles", std::move(tiles)}};
   write_file_atomically(dir / kSummaryFile, j.dump() + "\n");
 }
@@ -125,8 +137,8 @@ std::optional<AcquisitionTiling> publish_acquisition_tiling(const std::filesyste
     return std::nullopt;
   }
   if (errno != EEXIST && errno != ENOTEMPTY) {
-    throw OutputError(fmt::format("{}: cannot rename the tiled acquisition into place: {}", target.string(),
-                                  std::strerror(errno)));
+    throw OutputError(
+        fmt::format("{}: cannot rename the tiled acquisition into place: {}", target.string(), std::strerror(errno)));
   }
   if (std::optional<AcquisitionTiling> first = read_summary(target, fingerprint)) {
     std::error_code ec;
@@ -192,9 +204,10 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
       return std::nullopt;
     }
     if (version != kManifestVersion) {
-      throw InputError(fmt::format("{}: manifest version {} (this build writes {}); delete the work folder or run "
-                                   "with --force",
-                                   file.string(), j.at("version").dump(), kManifestVersion));
+      throw InputError(
+          fmt::format("{}: manifest version {} (this build writes {}); delete the work folder or run "
+                      "with --force",
+                      file.string(), j.at("version").dump(), kManifestVersion));
     }
     TileStore store;
     store.dir = dir;

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <span>
 
@@ -41,7 +42,7 @@ struct AcquisitionVertices {
 
 /// A triangle of the current batch: what its copies need once the batch is written.
 struct BatchTriangle {
-  Triangle corners;     ///< vertex ids in the acquisition
+  Triangle corners;  ///< vertex ids in the acquisition
   std::uint32_t fan = 0;
   std::uint64_t face = 0;
   std::uint32_t index = 0;  ///< in the acquisition (PlyReader's order)
@@ -117,6 +118,7 @@ class AcquisitionTiler {
     if (zero_area_dropped_ > 0) log::info("{}: dropped {} zero-area triangles", file.string(), zero_area_dropped_);
     out_.triangles = next_index_;
     out_.stats.input_bytes += reader.stats().bytes;
+    out_.stats.largest_radius = std::sqrt(largest_radius_squared_);
   }
 
  private:
@@ -141,8 +143,7 @@ class AcquisitionTiler {
   /// number the others alike).
   bool add_triangle(const BatchTriangle& triangle, const std::filesystem::path& file) {
     const Triangle& tri = triangle.corners;
-    const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]],
-                                 vertices_.positions[tri[2]]};
+    const std::array<Vec3d, 3> c{vertices_.positions[tri[0]], vertices_.positions[tri[1]], vertices_.positions[tri[2]]};
     Box3d corners;
     for (const Vec3d& p : c) corners.extend(p);
     check_face_extent(file, triangle.face, corners, c[0], c[1], c[2]);
@@ -150,10 +151,10 @@ class AcquisitionTiler {
       ++zero_area_dropped_;
       return false;
     }
+    note_radius(c, corners);
     const auto t = static_cast<std::uint32_t>(batch_.size());
     batch_.push_back(triangle);
-    const Vec3d viewpoint =
-        (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
+    const Vec3d viewpoint = (vertices_.sensors[tri[0]] + vertices_.sensors[tri[1]] + vertices_.sensors[tri[2]]) / 3.0;
     // Most triangles lie, with their viewpoint, inside the previous triangle's owner: that
     // tile owns them and no other gets a copy (what owner() and copy_targets() would say).
     Box3d reach = corners;
@@ -172,6 +173,19 @@ class AcquisitionTiler {
     out_.stats.halo_copies += halo_.size();
     out_.stats.empty_space_copies += crossed_.size();
     return true;
+  }
+
+  /// Keeps the largest x-y distance from a centroid to a corner (TilingStats::largest_radius),
+  /// squared. The box's diagonal bounds it, so only the rare triangle whose box could beat the
+  /// largest so far costs the exact distances.
+  void note_radius(const std::array<Vec3d, 3>& c, const Box3d& box) {
+    const double dx = box.max.x - box.min.x, dy = box.max.y - box.min.y;
+    if (dx * dx + dy * dy <= largest_radius_squared_) return;
+    const Vec3d centroid = (c[0] + c[1] + c[2]) / 3.0;
+    for (const Vec3d& p : c) {
+      const double ex = p.x - centroid.x, ey = p.y - centroid.y;
+      largest_radius_squared_ = std::max(largest_radius_squared_, ex * ex + ey * ey);
+    }
   }
 
   void add_copy(TileKey key, std::uint32_t triangle, TileRole role) {
@@ -250,7 +264,7 @@ class AcquisitionTiler {
   // The batch: triangles read since the last flush and their copies.
   std::vector<BatchTriangle> batch_;
   std::vector<TileCopy> copies_;
-  std::vector<BatchTile> tiles_;             ///< by slot
+  std::vector<BatchTile> tiles_;  ///< by slot
   std::map<TileKey, std::uint32_t> slot_of_;
   std::uint32_t last_slot_ = 0;
   std::vector<TileKey> halo_, crossed_;  ///< the current triangle's other tiles
@@ -258,10 +272,11 @@ class AcquisitionTiler {
   /// holding nothing.
   TileInterior last_interior_{.key = {INT32_MIN, INT32_MIN}};
   std::uint32_t largest_tile_ = 0;  ///< copies of the batch's largest tile
+  double largest_radius_squared_ = 0;
   // Reused by every flush.
   std::vector<std::uint32_t> sorted_;
   tiler_detail::TileBlockWriter block_;
-  Vec3d origin_;  ///< of the tile whose block is being built
+  Vec3d origin_;                      ///< of the tile whose block is being built
   std::vector<std::uint64_t> slots_;  ///< per vertex: stamp << 32 | index in the block
   std::uint32_t stamp_ = 0;           ///< of the block being built; slots start at 0, stamps at 1
 };
@@ -328,6 +343,7 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
     store.stats.blocks += s.blocks;
     store.stats.bytes_written += s.bytes_written;
     store.stats.seconds += s.seconds;
+    store.stats.largest_radius = std::max(store.stats.largest_radius, s.largest_radius);
     for (const auto& [key, here] : part.tiles) {
       TileContents& t = tiles[key];
       t.key = key;
@@ -343,8 +359,7 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
   return store;
 }
 
-TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params,
-                            unsigned at_once) {
+TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params, unsigned at_once) {
   std::error_code ec;
   std::filesystem::remove_all(params.dir, ec);
   std::filesystem::create_directories(params.dir, ec);

@@ -16,14 +16,14 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_reader.h"
 #include "detect_output.h"
+#include "leaf_outputs.h"
 #include "leftovers.h"
 #include "mosaic_output.h"
 #include "mosaic_step.h"
-#include "run_state.h"
-#include "tile_assembly.h"
 #include "run_stages.h"
-#include "leaf_outputs.h"
+#include "run_state.h"
 #include "seam_parts.h"
+#include "tile_assembly.h"
 #include "tile_job.h"
 #include "tiled_detect_output.h"
 #include "tileset_output.h"
@@ -59,7 +59,6 @@ void write_labels(const Config& config, const TileAssembly& assembly, const Pict
                         .at_once = labels_at_once(config, described, pictures.pictures)});
 }
 
-
 /// Adds one tile's result to the assembly and its entry to the run report.
 void add_tile_result(const Config& config, const TileContents& tile, bool processed, std::optional<TileResult> r,
                      TileAssembly& assembly, std::vector<nlohmann::json>& per_tile) {
@@ -83,9 +82,10 @@ class FinalOutput {
     if (seam_pass_in_blocks(config)) {
       seams_.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
     } else if (config.run.seam_pass == SeamPass::automatic && config.mosaic.method == MosaicMethod::energy) {
-      log::info("tiles of {} m are too narrow for the seam pass by blocks (over {:.2f} m): the whole output is "
-                "stitched at once, in memory",
-                config.tiling.tile_size, 4 * tile_grid_blocks(config).band);
+      log::info(
+          "tiles of {} m are too narrow for the seam pass by blocks (over {:.2f} m): the whole output is "
+          "stitched at once, in memory",
+          config.tiling.tile_size, 4 * tile_grid_blocks(config).band);
     }
   }
 
@@ -117,12 +117,14 @@ class FinalOutput {
       nlohmann::json figures = stitch_parts_and_report(config_, parts_, *seams_, seams_->source_sizes());
       // The outputs read the stitched output one grid tile at a time.
       leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
-                      TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}), parts_, *seams_);
+                      TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}), parts_,
+                      *seams_);
       seams_->release_stitched();
       return figures;
     }
     // The baseline, like the paper's, is not stitched.
-    return config_.mosaic.method == MosaicMethod::energy ? stitch_and_report(config_, merged_) : nlohmann::json::object();
+    return config_.mosaic.method == MosaicMethod::energy ? stitch_and_report(config_, merged_)
+                                                         : nlohmann::json::object();
   }
 
   void write_mosaic(const MosaicStats& stats, const MosaicOutputParams& params) const {
@@ -135,7 +137,8 @@ class FinalOutput {
 
   /// The 3D Tiles and per-tile PLYs; then the pass's files go.
   nlohmann::json export_tiles() {
-    const nlohmann::json exported = leaves_ ? write_tileset_outputs(config_, *leaves_) : write_tileset_outputs(config_, merged_);
+    const nlohmann::json exported =
+        leaves_ ? write_tileset_outputs(config_, *leaves_) : write_tileset_outputs(config_, merged_);
     leaves_.reset();
     seams_.reset();
     return exported;
@@ -196,8 +199,8 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   };
   // The pairs and labels wait on disk (a city has 0.7 GB of pairs), in a folder of this
   // process's own.
-  TileAssembly assembly(store, config.output.labels ? std::optional(pair_spill_folder(config.project.work))
-                                                    : std::nullopt);
+  TileAssembly assembly(store,
+                        config.output.labels ? std::optional(pair_spill_folder(config.project.work)) : std::nullopt);
   FinalOutput output(config);
   std::vector<nlohmann::json> per_tile;
   read_tile_results(config, store, fingerprint, tiles, assembly, output, per_tile);
@@ -245,15 +248,17 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   report["triangles_per_second"] = static_cast<double>(assembly.owned()) / std::max(wall, 1e-9);
   report["tiling"] = {{"halo_copies", store.stats.halo_copies},
                       {"empty_space_copies", store.stats.empty_space_copies},
-                      {"bytes_written", store.stats.bytes_written}};
+                      {"bytes_written", store.stats.bytes_written},
+                      {"largest_radius", store.stats.largest_radius}};
   report["export"] = exported;
   report["per_tile"] = per_tile;
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
-  std::cout << fmt::format("run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
-                           "({:.2f} M triangles/s), {} rank(s), peak memory {:.0f} MiB (rank 0)\n",
-                           store.tiles.size(), reused, assembly.owned(), output_triangles, wall,
-                           static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6, ranks,
-                           static_cast<double>(peak_resident_bytes()) / (1 << 20));
+  std::cout << fmt::format(
+      "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
+      "({:.2f} M triangles/s), {} rank(s), peak memory {:.0f} MiB (rank 0)\n",
+      store.tiles.size(), reused, assembly.owned(), output_triangles, wall,
+      static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6, ranks,
+      static_cast<double>(peak_resident_bytes()) / (1 << 20));
 }
 
 /// Every tile index of the store.
@@ -273,11 +278,11 @@ void run_subset(const Config& config, const TileStore& store, std::uint64_t fing
   const TileStageReport report = process_tiles(config, store, fingerprint, cluster, needed);
   std::size_t own_processed = 0;
   for (const std::size_t k : own) own_processed += report.processed[k];
-  std::cout << fmt::format("subset {}: {} of its {} tiles processed ({} reused); {} tiles of other subsets it waits "
-                           "for processed here, {} reused; {:.2f} s. When every subset is done: citymesh merge CONFIG\n",
-                           subset.name(), own_processed, own.size(), own.size() - own_processed,
-                           report.count - own_processed, needed.size() - own.size() - (report.count - own_processed),
-                           clock.seconds());
+  std::cout << fmt::format(
+      "subset {}: {} of its {} tiles processed ({} reused); {} tiles of other subsets it waits "
+      "for processed here, {} reused; {:.2f} s. When every subset is done: citymesh merge CONFIG\n",
+      subset.name(), own_processed, own.size(), own.size() - own_processed, report.count - own_processed,
+      needed.size() - own.size() - (report.count - own_processed), clock.seconds());
 }
 
 }  // namespace
@@ -301,7 +306,8 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   release_freed_memory();
   seconds["tiles"] = clock.restart();
   // The seam pass and the outputs need every tile: the root writes them alone.
-  if (cluster.root()) write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, cluster.size());
+  if (cluster.root())
+    write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, cluster.size());
   cluster.barrier();
 }
 
@@ -313,21 +319,24 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const std::uint64_t result_fingerprint = fingerprint(keys, false);
   const std::optional<TileStore> store = finished_tile_store(config, fingerprint(keys, true));
   if (!store) {
-    throw InputError(fmt::format("{}: no finished tile store for this config; run the subsets first "
-                                 "(citymesh run CONFIG --subset i/N)",
-                                 (config.project.work / "tiles").string()));
+    throw InputError(
+        fmt::format("{}: no finished tile store for this config; run the subsets first "
+                    "(citymesh run CONFIG --subset i/N)",
+                    (config.project.work / "tiles").string()));
   }
   std::vector<std::string> missing;
   for (const TileContents& tile : store->tiles) {
-    if (!read_tile_result(result_path(config, tile.key), result_fingerprint, *store)) missing.push_back(tile.key.name());
+    if (!read_tile_result(result_path(config, tile.key), result_fingerprint, *store))
+      missing.push_back(tile.key.name());
   }
   if (!missing.empty()) {
     const std::size_t shown = std::min<std::size_t>(missing.size(), 8);
-    throw InputError(fmt::format("{}: {} of {} tiles have no finished result ({}{}); run the subsets that own them "
-                                 "again, or citymesh run CONFIG to finish them here",
-                                 (config.project.work / "results").string(), missing.size(), store->tiles.size(),
-                                 fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
-                                 shown < missing.size() ? ", ..." : ""));
+    throw InputError(
+        fmt::format("{}: {} of {} tiles have no finished result ({}{}); run the subsets that own them "
+                    "again, or citymesh run CONFIG to finish them here",
+                    (config.project.work / "results").string(), missing.size(), store->tiles.size(),
+                    fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
+                    shown < missing.size() ? ", ..." : ""));
   }
   const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0};
   write_run_outputs(config, *store, result_fingerprint, none, pictures, nlohmann::json::object(), 1);

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/error.h"
@@ -28,7 +29,8 @@ std::vector<std::uint64_t> file_sizes(std::span<const Acquisition> acquisitions)
 
 /// Which acquisition comes first: the largest file (a cluster), or the subset's own share
 /// first, then the others in turn (a subset beside unknown others).
-std::vector<std::uint64_t> tiling_priorities(std::span<const std::uint64_t> sizes, const std::optional<Subset>& subset) {
+std::vector<std::uint64_t> tiling_priorities(std::span<const std::uint64_t> sizes,
+                                             const std::optional<Subset>& subset) {
   if (!subset) return {sizes.begin(), sizes.end()};
   const std::size_t n = sizes.size(), start = (subset->index - 1) * n / subset->count;
   std::vector<std::uint64_t> priority(n);
@@ -47,6 +49,20 @@ unsigned tiling_workers(std::span<const std::uint64_t> sizes, std::uint64_t memo
   return static_cast<unsigned>(std::clamp<std::uint64_t>(fits, 1, available_threads()));
 }
 
+/// Says when some triangle reaches farther from its centroid than the halo less the distance
+/// threshold: a tile may then miss a partner or a conflict of such a triangle that lies
+/// beyond its halo, so labels near tile borders may differ from an untiled run's (long-range
+/// sensors mesh far surfaces with long edges).
+void warn_if_halo_too_narrow(const TileStore& store, const Config& config) {
+  const double needed = store.stats.largest_radius + config.change.distance_threshold;
+  if (needed <= store.grid.halo) return;
+  log::warn(
+      "tiling: some triangles reach {:.2f} m from their centroid, more than the halo ({} m) less the distance "
+      "threshold ({} m): next to tile borders their labels may differ from an untiled run's; "
+      "[tiling] halo = {:.1f} avoids it (a wider halo makes more copies)",
+      store.stats.largest_radius, store.grid.halo, config.change.distance_threshold, std::ceil(needed * 10) / 10);
+}
+
 }  // namespace
 
 std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t fingerprint) {
@@ -63,6 +79,7 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
   cluster.barrier();  // every rank has looked before any rank changes the store
   if (existing) {
     log::info("{}: reusing the tile store ({} tiles)", dir.string(), existing->tiles.size());
+    if (cluster.root()) warn_if_halo_too_narrow(*existing, config);
     return *existing;
   }
   Stopwatch clock;
@@ -82,8 +99,8 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
     for (std::size_t k = 0; k < acquisitions.size(); ++k) {
       done[k] = read_acquisition_tiling(dir, static_cast<std::uint32_t>(k), wanted).has_value() ? 1 : 0;
     }
-    schedule.emplace(tiling_priorities(sizes, subset),
-                     std::vector<std::vector<std::size_t>>(acquisitions.size()), done);
+    schedule.emplace(tiling_priorities(sizes, subset), std::vector<std::vector<std::size_t>>(acquisitions.size()),
+                     done);
   }
   {
     const auto channel = cluster.share(schedule ? &*schedule : nullptr, nullptr);
@@ -94,7 +111,9 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
     std::vector<AcquisitionTiling> parts;
     for (std::uint32_t k = 0; k < acquisitions.size(); ++k) {
       std::optional<AcquisitionTiling> part = read_acquisition_tiling(dir, k, wanted);
-      if (!part) throw ProcessingError(fmt::format("{}: the tiled acquisition vanished", acquisition_tiles_path(dir, k).string()));
+      if (!part)
+        throw ProcessingError(
+            fmt::format("{}: the tiled acquisition vanished", acquisition_tiles_path(dir, k).string()));
       parts.push_back(std::move(*part));
     }
     TileStore store = assemble_tile_store(dir, params.grid, parts, wanted);
@@ -105,10 +124,12 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
   cluster.barrier();
   std::optional<TileStore> store = finished_tile_store(config, fingerprint);
   if (!store) {
-    throw ProcessingError(fmt::format("{}: no finished tile store after tiling (is the work folder shared by every "
-                                      "rank?)",
-                                      dir.string()));
+    throw ProcessingError(
+        fmt::format("{}: no finished tile store after tiling (is the work folder shared by every "
+                    "rank?)",
+                    dir.string()));
   }
+  if (cluster.root()) warn_if_halo_too_narrow(*store, config);
   return *store;
 }
 

@@ -262,7 +262,7 @@ std::vector<KeyDef> make_keys() {
 
   keys.push_back(real_key(tiling, "tile_size", "edge of a square tile (metres)",
       [](auto& c) -> auto& { return c.tiling.tile_size; }, 1, 100000));
-  keys.push_back(real_key(tiling, "halo", "context copied from neighbouring tiles (metres, < tile_size / 2)",
+  keys.push_back(real_key(tiling, "halo", "context copied from neighbouring tiles (metres, < tile_size / 2; at least the largest triangle's reach from its centroid plus distance_threshold, or run warns)",
       [](auto& c) -> auto& { return c.tiling.halo; }, 0, 10000));
   keys.push_back({tiling, "origin", "grid origin [easting, northing] in the project CRS (metres)", "",
       [](Config& c, const toml::node& n, const KeyContext& k) {

@@ -30,6 +30,7 @@ TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
   for (const auto& [name, size] : {std::pair{"one", 1000}, std::pair{"many", 10}}) {
     const auto run = test::run_citymesh(run_args(sim, name, fmt::format("--set tiling.tile_size={}", size)));
     ASSERT_EQ(run.exit_code, 0) << run.err;
+    EXPECT_EQ(run.err.find("more than the halo"), std::string::npos) << run.err;  // the default halo holds them
     const auto eval = test::run_citymesh(fmt::format("eval {}/{} --truth {}", sim, name, sim));
     ASSERT_EQ(eval.exit_code, 0) << eval.err;
   }
@@ -113,6 +114,24 @@ std::vector<double> source_faces_of(const std::filesystem::path& ply) {
     if (kind == PlyReader::ChunkKind::faces) out.insert(out.end(), faces.extras[0].begin(), faces.extras[0].end());
   }
   return out;
+}
+
+TEST(TiledRun, AHaloNarrowerThanTheTrianglesReachIsWarnedOf) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const auto run = test::run_citymesh(run_args(sim, "narrow", "--set tiling.halo=0.2"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const double radius = read_json(dir / "sim/narrow/run.json")["tiling"]["largest_radius"].get<double>();
+  EXPECT_GT(radius, 0.2);
+  EXPECT_NE(run.err.find(
+                fmt::format("some triangles reach {:.2f} m from their centroid, more than the halo (0.2 m)", radius)),
+            std::string::npos)
+      << run.err;
+  // The halo it suggests holds them.
+  const std::size_t at = run.err.find("[tiling] halo = ");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_GE(std::stod(run.err.substr(at + 16)), radius + 0.1);
 }
 
 TEST(TiledRun, AZeroAreaInputTriangleIsDroppedAlikeByTheTilerAndTheLabelledPlys) {

@@ -1,4 +1,6 @@
 // SPDX-License-Identifier: MIT
+#include "citymesh/tiler/tiler.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +15,6 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
-#include "citymesh/tiler/tiler.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -53,7 +54,8 @@ void sort_in_rows(Mesh& m) {
     const Vec3f& p = m.positions[t[0]];
     return std::pair(std::floor(p.y / 10), p.x);
   };
-  std::sort(m.triangles.begin(), m.triangles.end(), [&](const Triangle& a, const Triangle& b) { return key(a) < key(b); });
+  std::sort(m.triangles.begin(), m.triangles.end(),
+            [&](const Triangle& a, const Triangle& b) { return key(a) < key(b); });
 }
 
 struct Fixture {
@@ -141,7 +143,8 @@ void expect_brute_force_roles(const Fixture& f, const TileStore& store) {
         for (std::size_t k = 0; k < 3; ++k) {
           const Vec3d got = p.mesh.world_position(p.mesh.triangles[t][k]);
           EXPECT_LT(norm(got - want[k]), 1e-5);
-          EXPECT_EQ(p.mesh.intensities[p.mesh.triangles[t][k]], f.meshes[a].intensities[f.meshes[a].triangles[index][k]]);
+          EXPECT_EQ(p.mesh.intensities[p.mesh.triangles[t][k]],
+                    f.meshes[a].intensities[f.meshes[a].triangles[index][k]]);
         }
       }
       EXPECT_EQ(per_role, tile.triangles[a]);
@@ -167,8 +170,8 @@ void expect_brute_force_roles(const Fixture& f, const TileStore& store) {
   EXPECT_EQ(owned, 6000u);
   // Whatever remains expected belongs to tiles that own nothing (not listed: no work there).
   for (const auto& [key, role] : expected) {
-    const bool listed = std::any_of(store.tiles.begin(), store.tiles.end(),
-                                    [&](const TileContents& t) { return t.key == key.first; });
+    const bool listed =
+        std::any_of(store.tiles.begin(), store.tiles.end(), [&](const TileContents& t) { return t.key == key.first; });
     EXPECT_FALSE(listed) << key.first.name();
   }
   EXPECT_GT(store.stats.halo_copies, 0u);
@@ -186,6 +189,28 @@ TEST(Tiler, TrianglesInScanOrderAreOwnedAndCopiedWhereBruteForceSays) {
   // the grid says.
   Fixture f(256ull << 20, true);
   expect_brute_force_roles(f, tile_acquisitions(f.acquisitions, f.params));
+}
+
+TEST(Tiler, TheLargestRadiusIsTheBruteForceMaximumOverEveryTriangle) {
+  Fixture f;
+  double expected = 0;
+  for (const Mesh& m : f.meshes) {
+    for (std::size_t t = 0; t < m.triangle_count(); ++t) {
+      const auto c = world_corners(m, t);
+      const Vec3d centroid = (c[0] + c[1] + c[2]) / 3.0;
+      for (const Vec3d& p : c) expected = std::max(expected, std::hypot(p.x - centroid.x, p.y - centroid.y));
+    }
+  }
+  const TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  EXPECT_GT(expected, 0.5);
+  EXPECT_NEAR(store.stats.largest_radius, expected, 1e-9);
+  // It survives the manifest (and a store written before it existed reads as 0).
+  TileStore written = store;
+  written.fingerprint = "abc";
+  write_tile_manifest(written);
+  const std::optional<TileStore> back = read_tile_manifest(store.dir);
+  ASSERT_TRUE(back.has_value());
+  EXPECT_EQ(back->stats.largest_radius, store.stats.largest_radius);
 }
 
 TEST(Tiler, SmallBuffersWriteManyBlocksThatReadBackTheSame) {
@@ -388,7 +413,8 @@ TEST(Tiler, AcquisitionsTiledSeparatelyOrTwiceGiveTheSameStore) {
   }
   auto files = folder_bytes(f.params.dir);
   auto expected = reference;
-  for (auto* m : {&files, &expected}) std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
+  for (auto* m : {&files, &expected})
+    std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
   EXPECT_TRUE(files == expected) << "block files differ from a store tiled in one go";
   for (std::size_t k = 0; k < whole.tiles.size(); ++k) EXPECT_EQ(assembled.tiles[k].blocks, whole.tiles[k].blocks);
   EXPECT_EQ(b.triangles, 3000u);
@@ -403,7 +429,8 @@ TEST(Tiler, TwoAcquisitionsAtOnceGiveTheSameBlockBytes) {
   const TileStore store_two = tile_acquisitions(f.acquisitions, f.params, 2);
   auto two = folder_bytes(f.params.dir);
   ASSERT_EQ(store_one.tiles.size(), store_two.tiles.size());
-  for (std::size_t k = 0; k < store_one.tiles.size(); ++k) EXPECT_EQ(store_one.tiles[k].blocks, store_two.tiles[k].blocks);
+  for (std::size_t k = 0; k < store_one.tiles.size(); ++k)
+    EXPECT_EQ(store_one.tiles[k].blocks, store_two.tiles[k].blocks);
   // The summaries hold the tiling time; everything else must match byte for byte.
   for (auto* m : {&one, &two}) std::erase_if(*m, [](const auto& e) { return e.first.ends_with("summary.json"); });
   EXPECT_EQ(one.size(), 2u);
@@ -415,8 +442,8 @@ TEST(Tiler, PruneKeepsOnlyWhatTheFingerprintOwns) {
   std::filesystem::remove_all(f.params.dir);
   (void)tile_acquisition(f.acquisitions[0], f.params, "old");
   (void)tile_acquisition(f.acquisitions[1], f.params, "new");
-  std::filesystem::create_directories(f.params.dir / "3_4");           // an older layout
-  std::filesystem::create_directories(f.params.dir / "a7");            // beyond the acquisitions
+  std::filesystem::create_directories(f.params.dir / "3_4");             // an older layout
+  std::filesystem::create_directories(f.params.dir / "a7");              // beyond the acquisitions
   std::filesystem::create_directories(f.params.dir / "staging/a0.x.1");  // another process's work
   prune_tile_store(f.params.dir, 2, "new", false);
   EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a0"));

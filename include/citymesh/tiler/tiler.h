@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The tiler: streams each acquisition once, with bounded buffers, onto the tile grid and
 // writes the tile store: a folder per acquisition (its block file and a summary saying where
-// each tile's blocks lie), then a manifest. Acquisitions are tiled independently, so the processes of a cluster share them.
+// each tile's blocks lie), then a manifest. Acquisitions are tiled independently, so the processes of a cluster share
+// them.
 #pragma once
 
 #include <array>
@@ -23,7 +24,7 @@ namespace citymesh {
 struct TilerParams {
   TileGridParams grid;
   PlyReadParams ply;
-  std::filesystem::path dir;                ///< the tile store folder
+  std::filesystem::path dir;                  ///< the tile store folder
   std::uint64_t buffer_bytes = 256ull << 20;  ///< buffered triangles are flushed past this
 };
 
@@ -41,6 +42,10 @@ struct TileContents {
 struct TilingStats {
   std::uint64_t input_bytes = 0, halo_copies = 0, empty_space_copies = 0, blocks = 0, bytes_written = 0;
   double seconds = 0;
+  /// Metres: the largest x-y distance from a triangle's centroid to one of its corners (its
+  /// radius about the centroid). A tile's halo holds every partner and every point of its
+  /// owned triangles while this plus the distance threshold stays within the halo.
+  double largest_radius = 0;
 };
 
 struct TileStore {
@@ -61,7 +66,7 @@ struct AcquisitionTile {
 
 /// What tiling one acquisition gave (its <dir>/a<k>/summary.json).
 struct AcquisitionTiling {
-  std::uint64_t triangles = 0;              ///< the acquisition's triangles
+  std::uint64_t triangles = 0;               ///< the acquisition's triangles
   std::map<TileKey, AcquisitionTile> tiles;  ///< the tiles it has triangles in
   TilingStats stats;
   std::string fingerprint;  ///< what the caller says the tiling was made from
@@ -104,8 +109,7 @@ void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions
 /// Empties `params.dir`, tiles every acquisition, largest file first and `at_once` at a time
 /// (each alone, with its own buffers: the store's bytes do not depend on it), and assembles
 /// the store (without a fingerprint or manifest).
-TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params,
-                            unsigned at_once = 1);
+TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params, unsigned at_once = 1);
 
 /// The folder of one acquisition in the store.
 std::filesystem::path acquisition_tiles_path(const std::filesystem::path& dir, std::uint32_t acquisition);
