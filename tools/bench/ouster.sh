@@ -45,12 +45,13 @@ time = "2026-01-01T00:00:00.2Z"
 TOML
 for threads in 1 2; do
   echo "== detect, untiled, $threads thread(s)"
-  "$bin" detect "$dir/ouster.toml" --no-pictures --threads "$threads" 2>/dev/null | tail -2
+  "$bin" detect "$dir/ouster.toml" --no-pictures --threads "$threads" --set project.output=out-untiled 2>/dev/null |
+    tail -2
 done
 echo "== run, 2 threads"
 rm -rf "$dir/work" "$dir/out"
 "$bin" run "$dir/ouster.toml" --no-pictures --threads 2 2>/dev/null | tail -1
-python3 - "$dir/out/run.json" <<'PY'
+python3 - "$dir/out/run.json" "$dir/out/detect/summary.json" "$dir/out-untiled/detect/summary.json" <<'PY'
 import json, sys
 r = json.load(open(sys.argv[1]))
 print("  stages (s): " + ", ".join(f"{k} {v:.2f}" for k, v in r["seconds"].items()))
@@ -58,4 +59,10 @@ for t in r["per_tile"]:
     if t["triangles"] > 1000:
         s = t["seconds"]
         print(f"  tile {t['tile']}: {t['owned']} owned of {t['triangles']}, detect {s['detect']:.2f} s, mosaic {s['mosaic']:.2f} s")
+# Tiled against untiled labels: the counts per acquisition (they differ by the tile frame's
+# rounding only, a few triangles).
+tiled, untiled = (json.load(open(p))["acquisitions"] for p in sys.argv[2:4])
+for a, b in zip(tiled, untiled):
+    print(f"  {a['name']}: tiled - untiled: " +
+          ", ".join(f"{k} {a['counts'][k] - b['counts'][k]:+d}" for k in ("consistent", "conflicting", "kept", "refutes")))
 PY
