@@ -219,6 +219,23 @@ TEST(LabelSpill, LabelsAddedInPiecesComeBackByIndexAndGapsOrRepeatsAreRefused) {
   EXPECT_THROW((void)spill.read(4, 3), ProcessingError);
 }
 
+TEST(LabelSpill, RefutedTrianglesComeBackSortedOnceByWindowAndDamageIsAnError) {
+  test::TempDir tmp;
+  std::filesystem::create_directories(tmp / "spill");
+  LabelSpill spill(tmp / "spill");
+  EXPECT_TRUE(spill.refuted(0, 100, 0, 100).empty());  // no tile found any
+  spill.add_refuted(0, std::vector<std::uint32_t>{40, 7, 99});
+  spill.add_refuted(0, std::vector<std::uint32_t>{7, 0});  // repeats from another tile
+  spill.add_refuted(1, std::vector<std::uint32_t>{5});
+  EXPECT_EQ(spill.refuted(0, 100, 0, 100), (std::vector<std::uint32_t>{0, 7, 40, 99}));
+  EXPECT_EQ(spill.refuted(0, 100, 7, 99), (std::vector<std::uint32_t>{7, 40}));
+  EXPECT_EQ(spill.refuted(1, 100, 0, 100), (std::vector<std::uint32_t>{5}));
+  // A triangle the acquisition does not have, and a torn file, are errors naming them.
+  EXPECT_THROW((void)spill.refuted(0, 99, 0, 99), ProcessingError);
+  std::filesystem::resize_file(tmp / "spill/1.refuted", 3);
+  EXPECT_THROW((void)spill.refuted(1, 100, 0, 100), InputError);
+}
+
 TEST(LabelSpill, WindowsOfTheLabelsAreSlicesOfTheWholeAndAGapInOneIsRefused) {
   test::TempDir tmp;
   std::filesystem::create_directories(tmp / "spill");
