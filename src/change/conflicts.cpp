@@ -4,7 +4,10 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cfloat>
 #include <cmath>
+#include <numeric>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -128,6 +131,17 @@ namespace {
 struct BoxedTriangles {
   std::vector<std::uint32_t> ids;
   std::vector<Box3f> boxes;
+  /// Holds every box (min above max while there is none).
+  Box3f around{Vec3f{FLT_MAX, FLT_MAX, FLT_MAX}, Vec3f{-FLT_MAX, -FLT_MAX, -FLT_MAX}};
+
+  void add(std::uint32_t id, const Box3f& box) {
+    ids.push_back(id);
+    boxes.push_back(box);
+    around.min = {std::min(around.min.x, box.min.x), std::min(around.min.y, box.min.y),
+                  std::min(around.min.z, box.min.z)};
+    around.max = {std::max(around.max.x, box.max.x), std::max(around.max.y, box.max.y),
+                  std::max(around.max.z, box.max.z)};
+  }
 };
 
 /// The triangles that must be tested against acquisition j's empty space: older, not
@@ -146,8 +160,7 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
         ++stats.prefilter_skipped;
         continue;
       }
-      out.ids.push_back(static_cast<std::uint32_t>(g));
-      out.boxes.push_back(box);
+      out.add(static_cast<std::uint32_t>(g), box);
     }
   }
   return out;
@@ -186,15 +199,8 @@ struct FacePlanes {
 };
 
 /// Acquisition j's triangles that have an empty space, with their face planes, and the boxes
-/// the conflict search indexes: one per empty space, or, when the candidates are many, one
-/// per slab of about kConflictSlabLength. A long empty space (a far return, or one seen at a
-/// slant) has a box far larger than itself, which every triangle under it meets: on three
-/// real Ouster frames each candidate met ~1 300 such boxes, one in ~5 000 of them worth an
-/// exact test. The slabs cover the empty space, so a triangle meeting it meets one of their
-/// boxes: the same pairs are tested, fewer are looked at. Their price is a tree 4-7 times
-/// larger, which only pays when there are many candidates to query it: on the simulated
-/// city's tiles (2-15 % as many candidates as empty spaces) the slabs cut the hits by 3.7x
-/// and still made the change step 8 % slower.
+/// the conflict search indexes: one per empty space, or one per slab of about
+/// kConflictSlabLength when that pays (worth_cutting()).
 struct EmptySpaces {
   std::vector<std::uint32_t> ids;       ///< per empty space: its triangle
   std::vector<FacePlanes> planes;       ///< per empty space
@@ -211,55 +217,117 @@ struct EmptySpaces {
 /// the boxes of very long ones take bounded memory (see docs/change-detection.md).
 constexpr double kConflictSlabLength = 2.0;
 constexpr int kMaxConflictSlabs = 32;
-/// Empty spaces are cut into slabs when there are at least this many candidates per empty
-/// space (0.3-0.6 on the Ouster frames, 0.02-0.15 on the city's tiles).
-constexpr double kCandidatesPerSpaceToCut = 0.25;
 
-EmptySpaces empty_spaces(const TriangleFrames& f, std::size_t j, std::size_t candidates) {
+/// Acquisition j's empty spaces, each one slab (its whole box), with the slab count each
+/// would be cut into (`cut_slabs`, for cut_into_slabs()).
+EmptySpaces whole_empty_spaces(const TriangleFrames& f, std::size_t j, std::vector<std::uint8_t>& cut_slabs) {
   EmptySpaces out;
   for (std::size_t g = f.index.offsets[j]; g < f.index.offsets[j + 1]; ++g) {
     if (f.empty_scale[g] > 0) out.ids.push_back(static_cast<std::uint32_t>(g));
   }
   const std::size_t n = out.ids.size();
-  const bool cut = static_cast<double>(candidates) >= kCandidatesPerSpaceToCut * static_cast<double>(n);
   out.planes.resize(n, FacePlanes(TetrahedronCorners{}));
-  std::vector<std::size_t>& first_slab = out.first_slab;
-  first_slab.assign(n + 1, 0);
+  out.slab_boxes.resize(n);
+  cut_slabs.resize(n);
   parallel_for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const TetrahedronCorners q = f.empty_space(out.ids[i]);
       out.planes[i] = FacePlanes(q);
-      first_slab[i + 1] =
-          cut ? static_cast<std::size_t>(std::min(slab_count(q, kConflictSlabLength), kMaxConflictSlabs)) : 1;
+      out.slab_boxes[i] = EmptySpaceSlabs(q).slab(0, 1);
+      cut_slabs[i] = static_cast<std::uint8_t>(std::min(slab_count(q, kConflictSlabLength), kMaxConflictSlabs));
     }
   });
-  for (std::size_t i = 0; i < n; ++i) first_slab[i + 1] += first_slab[i];
+  out.first_slab.resize(n + 1);
+  out.space_of_slab.resize(n);
+  for (std::size_t i = 0; i <= n; ++i) out.first_slab[i] = i;
+  for (std::size_t i = 0; i < n; ++i) out.space_of_slab[i] = static_cast<std::uint32_t>(i);
+  return out;
+}
+
+/// Cuts every empty space of `spaces` into its `cut_slabs` slabs.
+void cut_into_slabs(const TriangleFrames& f, std::span<const std::uint8_t> cut_slabs, EmptySpaces& spaces) {
+  const std::size_t n = spaces.ids.size();
+  std::vector<std::size_t>& first_slab = spaces.first_slab;
+  for (std::size_t i = 0; i < n; ++i) first_slab[i + 1] = first_slab[i] + cut_slabs[i];
   if (first_slab[n] > UINT32_MAX) {  // the box tree numbers its boxes in 32 bits
     throw ProcessingError(
         fmt::format("change detection: {} empty spaces in one acquisition cut into {} slabs, more "
                     "than 2^32; tile the acquisitions ([tiling])",
                     n, first_slab[n]));
   }
-  out.slab_boxes.resize(first_slab[n]);
-  out.space_of_slab.resize(first_slab[n]);
+  spaces.slab_boxes.resize(first_slab[n]);
+  spaces.space_of_slab.resize(first_slab[n]);
   parallel_for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
-      const EmptySpaceSlabs slabs(f.empty_space(out.ids[i]));
-      const auto count = static_cast<int>(first_slab[i + 1] - first_slab[i]);
+      const EmptySpaceSlabs slabs(f.empty_space(spaces.ids[i]));
+      const int count = cut_slabs[i];
       for (int k = 0; k < count; ++k) {
-        out.slab_boxes[first_slab[i] + k] = slabs.slab(k, count);
-        out.space_of_slab[first_slab[i] + k] = static_cast<std::uint32_t>(i);
+        spaces.slab_boxes[first_slab[i] + k] = slabs.slab(k, count);
+        spaces.space_of_slab[first_slab[i] + k] = static_cast<std::uint32_t>(i);
       }
     }
   });
-  return out;
 }
 
-/// The boxes for the tree: spaces_met reads them again only when empty spaces were cut into
-/// several slabs; otherwise they are handed over rather than copied.
-std::vector<Box3f> tree_boxes(EmptySpaces& spaces) {
-  if (spaces.slab_is_space()) return std::move(spaces.slab_boxes);
-  return spaces.slab_boxes;
+/// What the conflict search indexes: the boxes of the slabs that meet `around`, the box
+/// around every candidate, and which slab each is. The others can meet no candidate: a
+/// tile's empty-space copies reach far beyond it, and their far slabs go.
+struct IndexedSlabs {
+  std::vector<std::uint32_t> slab;  ///< per box of the tree; empty when box k is slab k
+  std::size_t boxes = 0;
+
+  [[nodiscard]] std::uint32_t slab_of(std::uint32_t box) const { return slab.empty() ? box : slab[box]; }
+};
+
+/// The boxes of the slabs of `spaces` that meet `around`, for the tree. spaces_met reads the
+/// slab boxes again only when empty spaces are cut into several slabs; otherwise they are
+/// handed over.
+std::vector<Box3f> indexed_boxes(EmptySpaces& spaces, const Box3f& around, IndexedSlabs& indexed) {
+  std::vector<Box3f>& all = spaces.slab_boxes;
+  indexed.slab.clear();
+  indexed.boxes = static_cast<std::size_t>(
+      std::count_if(all.begin(), all.end(), [&](const Box3f& b) { return b.intersects(around); }));
+  if (indexed.boxes == all.size()) return spaces.slab_is_space() ? std::move(all) : all;
+  std::vector<Box3f> boxes;
+  boxes.reserve(indexed.boxes);
+  indexed.slab.reserve(indexed.boxes);
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (!all[k].intersects(around)) continue;
+    boxes.push_back(all[k]);
+    indexed.slab.push_back(static_cast<std::uint32_t>(k));
+  }
+  if (spaces.slab_is_space()) std::vector<Box3f>().swap(all);
+  return boxes;
+}
+
+/// Every how many candidates one is queried to decide whether to cut (a fixed stride: the
+/// decision depends on the data only).
+constexpr std::size_t kCutSampleStride = 64;
+/// Cut when the candidates would meet more whole-space boxes than this many per slab the cut
+/// tree would hold (a box met costs a few comparisons, a slab its share of building the
+/// tree). Measured ratios: 18-130 on the real Ouster frames (tiled or not), where cutting
+/// takes two thirds off the search; 4.3-6.7 on the simulated street untiled and at most 2.1
+/// on the city's tiles, where it gains nothing or costs up to 9 %.
+constexpr double kHitsPerSlabToCut = 10.0;
+
+/// Whether cutting the empty spaces into `slabs` slabs pays, from a sample of the candidates
+/// queried against the tree of whole spaces. A long empty space (a far return, or one seen at
+/// a slant) has a box far larger than itself, which every candidate under it meets: on three
+/// real Ouster frames each candidate met ~1 300 such boxes, one in ~5 000 of them worth an
+/// exact test. The slabs cover the empty space, so the same pairs are tested, fewer are looked
+/// at; their price is a tree 4-7 times larger, which only many hits repay (on the simulated
+/// city's tiles it made the change step 8 % slower).
+bool worth_cutting(const BoxTree& whole, const BoxedTriangles& candidates, std::size_t slabs) {
+  std::uint64_t hits_sampled = 0, sampled = 0;
+  std::vector<std::uint32_t> hits;
+  for (std::size_t i = 0; i < candidates.ids.size(); i += kCutSampleStride) {
+    whole.overlapping(candidates.boxes[i], hits);
+    hits_sampled += hits.size();
+    ++sampled;
+  }
+  const double expected_hits =
+      double(hits_sampled) / double(std::max<std::uint64_t>(sampled, 1)) * double(candidates.ids.size());
+  return expected_hits > kHitsPerSlabToCut * double(slabs);
 }
 
 /// The empty spaces whose slabs a query box met, each once: a slab stands for its empty
@@ -284,7 +352,7 @@ void spaces_met(const EmptySpaces& spaces, const Box3f& query, std::span<const s
 }  // namespace
 
 ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partners, std::span<const OccupancyGrid> grids,
-                             const ChangeParams& params, ChangeStats& stats) {
+                             const ChangeParams& params, ChangeStats& stats, SlabCut cut) {
   ConflictFlags flags;
   flags.conflicting.assign(f.size(), 0);
   flags.refutes.assign(f.size(), 0);
@@ -292,8 +360,17 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   for (std::size_t j = 0; j < f.acquisitions(); ++j) {
     const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.ids.empty()) continue;
-    EmptySpaces spaces = empty_spaces(f, j, older.ids.size());
-    const BoxTree tree(tree_boxes(spaces));
+    std::vector<std::uint8_t> cut_slabs;
+    EmptySpaces spaces = whole_empty_spaces(f, j, cut_slabs);
+    IndexedSlabs indexed;
+    std::optional<BoxTree> tree;
+    tree.emplace(indexed_boxes(spaces, older.around, indexed));
+    const std::size_t slabs = std::accumulate(cut_slabs.begin(), cut_slabs.end(), std::size_t{0});
+    if (slabs > spaces.ids.size() && cut != SlabCut::never &&
+        (cut == SlabCut::always || worth_cutting(*tree, older, slabs))) {
+      cut_into_slabs(f, cut_slabs, spaces);
+      tree.emplace(indexed_boxes(spaces, older.around, indexed));
+    }
     // Every overlapping pair is tested (no early exit) so that `refutes` does not depend on
     // the thread count; the flags are only ever raised, so any order of raising gives the
     // same result.
@@ -306,7 +383,8 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
         const bool raises = f.raises_refutes(t);
         // Without refutes to raise, one conflict settles the triangle.
         if (!raises && flags.conflicting[t] != 0) continue;
-        tree.overlapping(older.boxes[i], hits);
+        tree->overlapping(older.boxes[i], hits);
+        for (std::uint32_t& h : hits) h = indexed.slab_of(h);
         spaces_met(spaces, older.boxes[i], hits, met);
         for (const std::uint32_t h : met) {
           if (spaces.planes[h].misses(f.corner[t])) continue;

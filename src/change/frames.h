@@ -120,11 +120,19 @@ struct ConflictFlags {
   std::vector<std::uint8_t> refutes;
 };
 
+/// How the conflict search indexes an acquisition's empty spaces: as measured on a sample of
+/// the candidates (what detect_changes does), always whole, or always cut into slabs (tests
+/// of both indexes).
+enum class SlabCut : std::uint8_t { measured, never, always };
+
 /// A triangle conflicts with a newer acquisition j it is not consistent with when it meets
 /// the margin-reduced empty space of one of j's triangles (exact triangle-tetrahedron test).
-/// Candidates: a box tree's collision between the triangles and j's empty spaces; with the
-/// pre-filter, triangles whose box meets no voxel of j's grid are not tested at all.
+/// Candidates: a box tree's collision between the triangles and j's empty spaces (whole, or
+/// cut into slabs of a few metres; only those near some candidate); with the pre-filter,
+/// triangles whose box meets no voxel of j's grid are not tested at all. The flags do not
+/// depend on `cut`.
 ConflictFlags find_conflicts(const TriangleFrames& frames, const PartnerBits& partners,
-                             std::span<const OccupancyGrid> grids, const ChangeParams& params, ChangeStats& stats);
+                             std::span<const OccupancyGrid> grids, const ChangeParams& params, ChangeStats& stats,
+                             SlabCut cut = SlabCut::measured);
 
 }  // namespace citymesh::change_detail

@@ -243,38 +243,47 @@ std::vector<Mesh> facets_under_slanted_rays(std::mt19937& rng, double newer_cell
 }
 
 TEST(Conflicts, FlagsEqualBruteForceUnderLongSlantedEmptySpaces) {
-  // A coarse newer ground gives many candidates per empty space (the search indexes slabs of
-  // the empty spaces), a fine one few (it indexes whole empty spaces).
+  // The newer empty spaces are indexed whole, cut into slabs, or as the search measures (a
+  // coarse newer ground: many candidates per empty space; a fine one: few).
   for (const double newer_cell : {1.0, 0.4}) {
     std::mt19937 rng(5);
     const std::vector<Mesh> meshes = facets_under_slanted_rays(rng, newer_cell);
     const std::vector<TimePoint> dates{day(0), day(10), day(40)};
-    for (const bool prefilter : {true, false}) {
-      ChangeParams params;
-      params.prefilter = prefilter;
-      const ChangeResult r = detect(meshes, dates, params);
-      const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
-      const change_detail::PartnerBits partners = change_detail::partner_bits(f, r.consistent_pairs);
-      std::vector<std::uint8_t> conflicting(f.size(), 0), refutes(f.size(), 0);
-      for (std::size_t t = 0; t < f.size(); ++t) {
-        for (std::size_t j = 0; j < f.acquisitions(); ++j) {
-          if (!(f.date_of(t) < f.dates[j]) || partners.has(t, j)) continue;
-          for (std::size_t u = f.index.offsets[j]; u < f.index.offsets[j + 1]; ++u) {
-            if (f.empty_scale[u] > 0 && triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
-              conflicting[t] = 1;
-              refutes[u] = 1;
-            }
+    ChangeParams params;
+    const ChangeResult r = detect(meshes, dates, params);
+    const change_detail::TriangleFrames f = change_detail::prepare_triangles({meshes, dates}, params);
+    const change_detail::PartnerBits partners = change_detail::partner_bits(f, r.consistent_pairs);
+    std::vector<std::uint8_t> conflicting(f.size(), 0), refutes(f.size(), 0);
+    for (std::size_t t = 0; t < f.size(); ++t) {
+      for (std::size_t j = 0; j < f.acquisitions(); ++j) {
+        if (!(f.date_of(t) < f.dates[j]) || partners.has(t, j)) continue;
+        for (std::size_t u = f.index.offsets[j]; u < f.index.offsets[j + 1]; ++u) {
+          if (f.empty_scale[u] > 0 && triangle_intersects_tetrahedron(f.corners(t), f.empty_space(u))) {
+            conflicting[t] = 1;
+            refutes[u] = 1;
           }
         }
       }
-      std::vector<std::uint8_t> found(f.size(), 0);
-      for (std::size_t t = 0; t < f.size(); ++t) found[t] = r.state[t] == TriangleState::conflicting ? 1 : 0;
-      EXPECT_EQ(found, conflicting) << "prefilter " << prefilter;
-      EXPECT_EQ(r.refutes, refutes) << "prefilter " << prefilter;
-      // Enough of each kind that a search missing some would show.
-      EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
-      EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
-      EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 20);
+    }
+    // Enough of each kind that a search missing some would show.
+    EXPECT_GT(std::count(conflicting.begin(), conflicting.end(), 1), 40);
+    EXPECT_GT(std::count(conflicting.begin(), conflicting.begin() + 300, 0), 40);
+    EXPECT_GT(std::count(refutes.begin(), refutes.end(), 1), 20);
+    std::vector<std::uint8_t> found(f.size(), 0);
+    for (std::size_t t = 0; t < f.size(); ++t) found[t] = r.state[t] == TriangleState::conflicting ? 1 : 0;
+    EXPECT_EQ(found, conflicting);
+    EXPECT_EQ(r.refutes, refutes);
+    for (const bool prefilter : {true, false}) {
+      params.prefilter = prefilter;
+      ChangeStats stats;
+      const std::vector<OccupancyGrid> grids =
+          change_detail::build_empty_space_grids(f, params, change_detail::asked_voxels(f, params.voxel_size), stats);
+      for (const auto cut : {change_detail::SlabCut::never, change_detail::SlabCut::always}) {
+        const change_detail::ConflictFlags flags =
+            change_detail::find_conflicts(f, partners, grids, params, stats, cut);
+        EXPECT_EQ(flags.conflicting, conflicting) << "prefilter " << prefilter << ", cut " << int(cut);
+        EXPECT_EQ(flags.refutes, refutes) << "prefilter " << prefilter << ", cut " << int(cut);
+      }
     }
   }
 }
