@@ -274,7 +274,6 @@ void cut_into_slabs(const TriangleFrames& f, std::span<const std::uint8_t> cut_s
 /// tile's empty-space copies reach far beyond it, and their far slabs go.
 struct IndexedSlabs {
   std::vector<std::uint32_t> slab;  ///< per box of the tree; empty when box k is slab k
-  std::size_t boxes = 0;
 
   [[nodiscard]] std::uint32_t slab_of(std::uint32_t box) const { return slab.empty() ? box : slab[box]; }
 };
@@ -285,12 +284,12 @@ struct IndexedSlabs {
 std::vector<Box3f> indexed_boxes(EmptySpaces& spaces, const Box3f& around, IndexedSlabs& indexed) {
   std::vector<Box3f>& all = spaces.slab_boxes;
   indexed.slab.clear();
-  indexed.boxes = static_cast<std::size_t>(
+  const auto near = static_cast<std::size_t>(
       std::count_if(all.begin(), all.end(), [&](const Box3f& b) { return b.intersects(around); }));
-  if (indexed.boxes == all.size()) return spaces.slab_is_space() ? std::move(all) : all;
+  if (near == all.size()) return spaces.slab_is_space() ? std::move(all) : all;
   std::vector<Box3f> boxes;
-  boxes.reserve(indexed.boxes);
-  indexed.slab.reserve(indexed.boxes);
+  boxes.reserve(near);
+  indexed.slab.reserve(near);
   for (std::size_t k = 0; k < all.size(); ++k) {
     if (!all[k].intersects(around)) continue;
     boxes.push_back(all[k]);
