@@ -200,13 +200,13 @@ struct FacePlanes {
 
 /// Acquisition j's triangles that have an empty space, with their face planes, and the boxes
 /// the conflict search indexes: one per empty space, or one per slab of about
-/// kConflictSlabLength when that pays (worth_cutting()).
+/// kConflictSlabLength when that pays (cut_if_it_pays()).
 struct EmptySpaces {
-  std::vector<std::uint32_t> ids;       ///< per empty space: its triangle
-  std::vector<FacePlanes> planes;       ///< per empty space
-  std::vector<std::size_t> first_slab;  ///< per empty space, and one past the last slab
-  std::vector<Box3f> slab_boxes;        ///< empty (moved into the tree) when slab i is empty space i
-  std::vector<std::uint32_t> space_of_slab;
+  std::vector<std::uint32_t> ids;            ///< per empty space: its triangle
+  std::vector<FacePlanes> planes;            ///< per empty space
+  std::vector<std::size_t> first_slab;       ///< per empty space, and one past the last slab
+  std::vector<Box3f> slab_boxes;             ///< empty (moved into the tree) when slab i is empty space i
+  std::vector<std::uint32_t> space_of_slab;  ///< per slab, once cut (spaces_met reads it only then)
 
   /// Every empty space is one slab (not cut, or cut in no more than one).
   [[nodiscard]] bool slab_is_space() const { return first_slab.back() == ids.size(); }
@@ -218,9 +218,8 @@ struct EmptySpaces {
 constexpr double kConflictSlabLength = 2.0;
 constexpr int kMaxConflictSlabs = 32;
 
-/// Acquisition j's empty spaces, each one slab (its whole box), with the slab count each
-/// would be cut into (`cut_slabs`, for cut_into_slabs()).
-EmptySpaces whole_empty_spaces(const TriangleFrames& f, std::size_t j, std::vector<std::uint8_t>& cut_slabs) {
+/// Acquisition j's empty spaces, each one slab (its whole box).
+EmptySpaces whole_empty_spaces(const TriangleFrames& f, std::size_t j) {
   EmptySpaces out;
   for (std::size_t g = f.index.offsets[j]; g < f.index.offsets[j + 1]; ++g) {
     if (f.empty_scale[g] > 0) out.ids.push_back(static_cast<std::uint32_t>(g));
@@ -228,20 +227,28 @@ EmptySpaces whole_empty_spaces(const TriangleFrames& f, std::size_t j, std::vect
   const std::size_t n = out.ids.size();
   out.planes.resize(n, FacePlanes(TetrahedronCorners{}));
   out.slab_boxes.resize(n);
-  cut_slabs.resize(n);
   parallel_for_blocks(n, 8192, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const TetrahedronCorners q = f.empty_space(out.ids[i]);
       out.planes[i] = FacePlanes(q);
       out.slab_boxes[i] = EmptySpaceSlabs(q).slab(0, 1);
-      cut_slabs[i] = static_cast<std::uint8_t>(std::min(slab_count(q, kConflictSlabLength), kMaxConflictSlabs));
     }
   });
   out.first_slab.resize(n + 1);
-  out.space_of_slab.resize(n);
-  for (std::size_t i = 0; i <= n; ++i) out.first_slab[i] = i;
-  for (std::size_t i = 0; i < n; ++i) out.space_of_slab[i] = static_cast<std::uint32_t>(i);
+  std::iota(out.first_slab.begin(), out.first_slab.end(), std::size_t{0});
   return out;
+}
+
+/// The slabs each empty space of `spaces` would be cut into.
+std::vector<std::uint8_t> cut_slab_counts(const TriangleFrames& f, const EmptySpaces& spaces) {
+  std::vector<std::uint8_t> counts(spaces.ids.size());
+  parallel_for_blocks(counts.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      counts[i] = static_cast<std::uint8_t>(
+          std::min(slab_count(f.empty_space(spaces.ids[i]), kConflictSlabLength), kMaxConflictSlabs));
+    }
+  });
+  return counts;
 }
 
 /// Cuts every empty space of `spaces` into its `cut_slabs` slabs.
@@ -309,14 +316,14 @@ constexpr std::size_t kCutSampleStride = 64;
 /// on the city's tiles, where it gains nothing or costs up to 9 %.
 constexpr double kHitsPerSlabToCut = 10.0;
 
-/// Whether cutting the empty spaces into `slabs` slabs pays, from a sample of the candidates
-/// queried against the tree of whole spaces. A long empty space (a far return, or one seen at
-/// a slant) has a box far larger than itself, which every candidate under it meets: on three
-/// real Ouster frames each candidate met ~1 300 such boxes, one in ~5 000 of them worth an
-/// exact test. The slabs cover the empty space, so the same pairs are tested, fewer are looked
-/// at; their price is a tree 4-7 times larger, which only many hits repay (on the simulated
-/// city's tiles it made the change step 8 % slower).
-bool worth_cutting(const BoxTree& whole, const BoxedTriangles& candidates, std::size_t slabs) {
+/// How many whole-space boxes all the candidates would meet, from a sample of them queried
+/// against `whole`. A long empty space (a far return, or one seen at a slant) has a box far
+/// larger than itself, which every candidate under it meets: on three real Ouster frames each
+/// candidate met ~1 300 such boxes, one in ~5 000 of them worth an exact test. Slabs cover
+/// the empty space, so the same pairs are tested, fewer are looked at; their price is a tree
+/// 4-7 times larger, which only many hits repay (on the simulated city's tiles it made the
+/// change step 8 % slower).
+double expected_hits(const BoxTree& whole, const BoxedTriangles& candidates) {
   std::uint64_t hits_sampled = 0, sampled = 0;
   std::vector<std::uint32_t> hits;
   for (std::size_t i = 0; i < candidates.ids.size(); i += kCutSampleStride) {
@@ -324,9 +331,26 @@ bool worth_cutting(const BoxTree& whole, const BoxedTriangles& candidates, std::
     hits_sampled += hits.size();
     ++sampled;
   }
-  const double expected_hits =
-      double(hits_sampled) / double(std::max<std::uint64_t>(sampled, 1)) * double(candidates.ids.size());
-  return expected_hits > kHitsPerSlabToCut * double(slabs);
+  return double(hits_sampled) / double(std::max<std::uint64_t>(sampled, 1)) * double(candidates.ids.size());
+}
+
+/// Cuts acquisition j's empty spaces into slabs when `cut` says so or, measured, when the
+/// expected hits pass kHitsPerSlabToCut per slab; returns whether it did. The slab counts
+/// are worked out only when the hits pass that many per whole space (there are at least as
+/// many slabs as spaces).
+bool cut_if_it_pays(const TriangleFrames& f, const BoxTree& whole, const BoxedTriangles& candidates, SlabCut cut,
+                    EmptySpaces& spaces) {
+  if (cut == SlabCut::never) return false;
+  const double hits = cut == SlabCut::measured ? expected_hits(whole, candidates) : 0.0;
+  const auto pays = [&](std::size_t slabs) {
+    return cut == SlabCut::always || hits > kHitsPerSlabToCut * double(slabs);
+  };
+  if (!pays(spaces.ids.size())) return false;
+  const std::vector<std::uint8_t> counts = cut_slab_counts(f, spaces);
+  const std::size_t slabs = std::accumulate(counts.begin(), counts.end(), std::size_t{0});
+  if (slabs == spaces.ids.size() || !pays(slabs)) return false;
+  cut_into_slabs(f, counts, spaces);
+  return true;
 }
 
 /// The empty spaces whose slabs a query box met, each once: a slab stands for its empty
@@ -359,17 +383,11 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   for (std::size_t j = 0; j < f.acquisitions(); ++j) {
     const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.ids.empty()) continue;
-    std::vector<std::uint8_t> cut_slabs;
-    EmptySpaces spaces = whole_empty_spaces(f, j, cut_slabs);
+    EmptySpaces spaces = whole_empty_spaces(f, j);
     IndexedSlabs indexed;
     std::optional<BoxTree> tree;
     tree.emplace(indexed_boxes(spaces, older.around, indexed));
-    const std::size_t slabs = std::accumulate(cut_slabs.begin(), cut_slabs.end(), std::size_t{0});
-    if (slabs > spaces.ids.size() && cut != SlabCut::never &&
-        (cut == SlabCut::always || worth_cutting(*tree, older, slabs))) {
-      cut_into_slabs(f, cut_slabs, spaces);
-      tree.emplace(indexed_boxes(spaces, older.around, indexed));
-    }
+    if (cut_if_it_pays(f, *tree, older, cut, spaces)) tree.emplace(indexed_boxes(spaces, older.around, indexed));
     // Every overlapping pair is tested (no early exit) so that `refutes` does not depend on
     // the thread count; the flags are only ever raised, so any order of raising gives the
     // same result.
