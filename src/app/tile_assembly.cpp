@@ -37,12 +37,16 @@ std::uint16_t TileAssembly::date_index(std::int64_t ms) {
   return static_cast<std::uint16_t>(dates_ms_.size() - 1);
 }
 
+void TileAssembly::check_in_store(const TileResult& result, std::uint32_t a, std::uint32_t t) const {
+  if (a >= store_.triangles.size() || t >= store_.triangles[a]) {
+    throw ProcessingError(
+        fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store", result.key.name(), t, a));
+  }
+}
+
 void TileAssembly::add(TileResult result) {
   const auto global = [&](std::uint32_t a, std::uint32_t t) -> std::uint32_t {
-    if (a >= store_.triangles.size() || t >= store_.triangles[a]) {
-      throw ProcessingError(
-          fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store", result.key.name(), t, a));
-    }
+    check_in_store(result, a, t);
     return static_cast<std::uint32_t>(index_.offsets[a] + t);
   };
   change_.add(result.change);
@@ -88,10 +92,7 @@ void TileAssembly::spill_refuted(const TileResult& result) {
   std::vector<std::uint32_t> indices;
   for (std::size_t i = 0; i < result.refuted.size(); ++i) {
     const RefutedCopy& c = result.refuted[i];
-    if (c.acquisition >= store_.triangles.size() || c.index >= store_.triangles[c.acquisition]) {
-      throw ProcessingError(fmt::format("tile {}: refuted triangle {} of acquisition {} is not in the tile store",
-                                        result.key.name(), c.index, c.acquisition));
-    }
+    check_in_store(result, c.acquisition, c.index);
     indices.push_back(c.index);
     if (i + 1 == result.refuted.size() || result.refuted[i + 1].acquisition != c.acquisition) {
       labels_->add_refuted(c.acquisition, indices);

@@ -58,6 +58,8 @@ class TileAssembly {
   /// The index of a label's first_seen or last_seen among the dates met so far.
   std::uint16_t date_index(std::int64_t ms);
   void check_labelled() const;
+  /// Throws ProcessingError naming the tile unless triangle t of acquisition a is in the store.
+  void check_in_store(const TileResult& result, std::uint32_t a, std::uint32_t t) const;
   /// Spills the copies a tile found refuting, for labels() to raise their `refutes`.
   void spill_refuted(const TileResult& result);
 

@@ -71,15 +71,17 @@ std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t
   return store;
 }
 
-TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
-                             const std::optional<Subset>& subset) {
+namespace {
+
+/// prepare_tile_store without the halo check: the store reused or made now.
+TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+                                const std::optional<Subset>& subset) {
   const std::filesystem::path dir = config.project.work / "tiles";
   const std::string wanted = store_fingerprint(fingerprint);
   const std::optional<TileStore> existing = finished_tile_store(config, fingerprint);
   cluster.barrier();  // every rank has looked before any rank changes the store
   if (existing) {
     log::info("{}: reusing the tile store ({} tiles)", dir.string(), existing->tiles.size());
-    if (cluster.root()) warn_if_halo_too_narrow(*existing, config);
     return *existing;
   }
   Stopwatch clock;
@@ -129,8 +131,16 @@ TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cl
                     "rank?)",
                     dir.string()));
   }
-  if (cluster.root()) warn_if_halo_too_narrow(*store, config);
   return *store;
+}
+
+}  // namespace
+
+TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+                             const std::optional<Subset>& subset) {
+  TileStore store = reused_or_tiled_store(config, fingerprint, cluster, subset);
+  if (cluster.root()) warn_if_halo_too_narrow(store, config);
+  return store;
 }
 
 }  // namespace citymesh::app
