@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -20,6 +21,20 @@ namespace {
 bool affects_results(const std::string& section) {
   return section == "input" || section == "change" || section == "mosaic" || section == "tiling" ||
          section.starts_with("acquisition[");
+}
+
+/// "acquisition[1] (/data/b.ply) was rewritten (17500 -> 17547 bytes)" from the `.file`
+/// key's two values ("<size> bytes, modified <ticks>"): the ticks mean nothing to a reader.
+std::string describe_rewrite(const std::map<std::string, std::string>& keys, const std::string& file_key,
+                             const std::string& before, const std::string& after) {
+  const std::string acquisition = file_key.substr(0, file_key.size() - std::string_view(".file").size());
+  const auto path = keys.find(acquisition + ".path");
+  const std::string where = path == keys.end() ? acquisition : fmt::format("{} ({})", acquisition, path->second);
+  const auto size_of = [](const std::string& value) { return std::strtoull(value.c_str(), nullptr, 10); };
+  const std::string how = size_of(before) == size_of(after)
+                              ? fmt::format("same size, {} bytes, new modification time", size_of(after))
+                              : fmt::format("{} -> {} bytes", size_of(before), size_of(after));
+  return fmt::format("{} was rewritten since the last run ({})", where, how);
 }
 
 std::string trim(std::string s) {
@@ -89,7 +104,8 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
       if (what.empty()) continue;
       // A rewritten input file is not a config change: its tiles are simply redone.
       if (k.ends_with(".file")) {
-        log::warn("{} changed since the last run ({}): its work is redone", k, what);
+        log::warn("{}: its work is redone", it == before.end() ? fmt::format("{} changed since the last run ({})", k, what)
+                                                                 : describe_rewrite(keys, k, it->second, v));
       } else {
         changed.push_back(what);
       }
