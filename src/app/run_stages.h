@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "citymesh/config/config.h"
@@ -39,7 +40,11 @@ struct TileStageReport {
 /// tile_dependencies) that has no finished result, each once its dependencies are done,
 /// largest first, on the worker threads of every rank within each rank's memory budget.
 /// Results go to <work>/results. Collective; the report is complete on the root only.
+/// `theirs` (per store tile, or empty): tiles another process owns (a subset's dependencies
+/// in other subsets). They are taken only when nothing else is ready, and skipped when their
+/// result has appeared meanwhile, so subsets started together redo fewer of each other's.
 TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
-                              Cluster& cluster, const std::vector<std::size_t>& tiles);
+                              Cluster& cluster, const std::vector<std::size_t>& tiles,
+                              std::span<const std::uint8_t> theirs = {});
 
 }  // namespace citymesh::app

@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstdint>
+#include <utility>
 
 #include "citymesh/core/error.h"
 #include "tile_job.h"
@@ -25,6 +27,17 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
   }
   std::sort(after.begin(), after.end());
   return after;
+}
+
+std::vector<std::uint64_t> tile_priorities(const TileStore& store, const std::vector<std::size_t>& tiles,
+                                           std::span<const std::uint8_t> theirs) {
+  std::uint64_t own_first = 1;  // above every tile's cost
+  for (const std::size_t k : tiles) own_first += store.tiles[k].total();
+  std::vector<std::uint64_t> priorities;
+  for (const std::size_t k : tiles) {
+    priorities.push_back(store.tiles[k].total() + (!theirs.empty() && theirs[k] != 0 ? 0 : own_first));
+  }
+  return priorities;
 }
 
 std::uint64_t tile_memory_estimate(const TileContents& tile) { return tile.total() * kBytesPerTileTriangle; }
@@ -59,20 +72,69 @@ Subset Subset::parse(const std::string& text) {
 
 std::string Subset::name() const { return fmt::format("{}/{}", index, count); }
 
-std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset) {
-  double total = 0;
-  for (const TileContents& t : store.tiles) total += static_cast<double>(t.total());
-  // A tile belongs to the subset in whose share of the total its cost's midpoint falls.
-  std::vector<std::size_t> tiles;
-  double before = 0;
-  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
-    const double cost = static_cast<double>(store.tiles[k].total());
-    const double middle = (before + cost / 2) / std::max(total, 1.0);
-    const auto owner = std::min(static_cast<std::size_t>(middle * static_cast<double>(subset.count)), subset.count - 1);
-    if (owner == subset.index - 1) tiles.push_back(k);
-    before += cost;
+namespace {
+
+/// A subset redoes about one column of tiles along a cut between columns (a tile waits for
+/// the column before it only for phases 0 and 1, which wait for nothing across), and two to
+/// three rows along a cut between rows (tile_phase() takes the column's parity as the major
+/// bit, so a row of phase 2 and 3 tiles waits for rows on both sides): the cost of a cut
+/// along a row, per tile of its length, against one along a column.
+constexpr double kRowCutCost = 2.5;
+
+/// Splits `tiles` (indices into store.tiles) into `parts` subsets of about equal cost, appended
+/// to `out` in order: halves of the subset count, cut across the longer side of the tiles'
+/// extent (in grid cells), recursively. Compact subsets have short borders, and a subset redoes
+/// only the tiles across its border that it waits for.
+void bisect(const TileStore& store, std::vector<std::size_t> tiles, std::size_t parts,
+            std::vector<std::vector<std::size_t>>& out) {
+  if (parts == 1) {
+    std::sort(tiles.begin(), tiles.end());
+    out.push_back(std::move(tiles));
+    return;
   }
-  return tiles;
+  std::int64_t i0 = INT64_MAX, i1 = INT64_MIN, j0 = INT64_MAX, j1 = INT64_MIN;
+  double total = 0;
+  for (const std::size_t k : tiles) {
+    const TileKey key = store.tiles[k].key;
+    i0 = std::min<std::int64_t>(i0, key.i), i1 = std::max<std::int64_t>(i1, key.i);
+    j0 = std::min<std::int64_t>(j0, key.j), j1 = std::max<std::int64_t>(j1, key.j);
+    total += static_cast<double>(store.tiles[k].total());
+  }
+  // Along i when the extent is wider in i (ties: i, as the key order): whole cells of the
+  // other axis stay together, so the cut runs straight along a grid line where it can.
+  const bool along_i = tiles.empty() || kRowCutCost * static_cast<double>(i1 - i0 + 1) >= static_cast<double>(j1 - j0 + 1);
+  std::sort(tiles.begin(), tiles.end(), [&](std::size_t a, std::size_t b) {
+    const TileKey x = store.tiles[a].key, y = store.tiles[b].key;
+    return along_i ? x < y : std::pair(x.j, x.i) < std::pair(y.j, y.i);
+  });
+  const std::size_t first_parts = parts / 2;
+  const double target = total * static_cast<double>(first_parts) / static_cast<double>(parts);
+  // A tile goes to the first half when its cost's midpoint falls before the target.
+  std::size_t cut = 0;
+  double before = 0;
+  while (cut < tiles.size()) {
+    const auto cost = static_cast<double>(store.tiles[tiles[cut]].total());
+    if (before + cost / 2 > target) break;
+    before += cost;
+    ++cut;
+  }
+  const auto middle = tiles.begin() + static_cast<std::ptrdiff_t>(cut);
+  bisect(store, std::vector<std::size_t>(tiles.begin(), middle), first_parts, out);
+  bisect(store, std::vector<std::size_t>(middle, tiles.end()), parts - first_parts, out);
+}
+
+}  // namespace
+
+std::vector<std::vector<std::size_t>> all_subsets(const TileStore& store, std::size_t count) {
+  std::vector<std::size_t> tiles(store.tiles.size());
+  for (std::size_t k = 0; k < tiles.size(); ++k) tiles[k] = k;
+  std::vector<std::vector<std::size_t>> out;
+  bisect(store, std::move(tiles), std::max<std::size_t>(count, 1), out);
+  return out;
+}
+
+std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset) {
+  return all_subsets(store, subset.count)[subset.index - 1];
 }
 
 std::vector<std::size_t> with_dependencies(const TileStore& store, const std::vector<std::size_t>& tiles) {

@@ -5,6 +5,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -15,6 +16,14 @@ namespace citymesh::app {
 /// The tiles (indices into store.tiles) that tile `k` waits for: its neighbours (sides and
 /// corners) of earlier phases, in index order.
 std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k);
+
+/// The order in which the work schedule takes ready tiles (higher first), per tile of `tiles`:
+/// largest first (triangles held: big tiles do not end a run alone), but every tile of this
+/// process's own before any of `theirs` (per store tile, or empty: all own), the tiles of
+/// other subsets that this one waits for. Those are left for their owners as long as this
+/// process has work of its own, and skipped when their result has appeared meanwhile.
+std::vector<std::uint64_t> tile_priorities(const TileStore& store, const std::vector<std::size_t>& tiles,
+                                           std::span<const std::uint8_t> theirs);
 
 /// Estimated peak bytes of a tile in flight per triangle it holds (all roles): meshes, change
 /// step (~180 B) and mosaic, measured on the default street (docs/tiling.md).
@@ -36,9 +45,14 @@ struct Subset {
   [[nodiscard]] std::string name() const;
 };
 
-/// The tiles subset `subset` owns: consecutive tiles in key order (column strips, so that few
-/// of their dependencies lie in other subsets) holding about 1/N of the store's triangles.
-/// Every tile is in exactly one subset; a subset may be empty when N exceeds the tiles.
+/// The tiles of each of `count` subsets (indices into store.tiles, each sorted): compact
+/// blocks of the grid of about equal cost (triangles held), cut in halves of the subset count
+/// across the longer side, recursively, so that their borders, across which a subset redoes
+/// the tiles it waits for, stay short. Every tile is in exactly one subset; a subset may be
+/// empty when `count` exceeds the tiles.
+std::vector<std::vector<std::size_t>> all_subsets(const TileStore& store, std::size_t count);
+
+/// The tiles subset `subset` owns: all_subsets(store, subset.count)[subset.index - 1].
 std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset);
 
 /// `tiles` and every tile they wait for, transitively: what a subset must have before its

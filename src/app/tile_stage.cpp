@@ -95,12 +95,10 @@ SettledSelection settled_selection(const Config& config, const TileStore& store,
 
 /// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
 WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::uint64_t fingerprint,
-                           const std::vector<std::size_t>& tiles) {
-  std::vector<std::uint64_t> costs;
+                           const std::vector<std::size_t>& tiles, std::span<const std::uint8_t> theirs) {
   std::vector<std::vector<std::size_t>> after;
   std::vector<std::uint8_t> done;
   for (const std::size_t k : tiles) {
-    costs.push_back(store.tiles[k].total());
     std::vector<std::size_t> positions;
     for (const std::size_t d : tile_dependencies(store, k)) {
       const auto it = std::lower_bound(tiles.begin(), tiles.end(), d);
@@ -113,7 +111,7 @@ WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::ui
     after.push_back(std::move(positions));
     done.push_back(read_tile_result(result_path(config, store.tiles[k].key), fingerprint, store) ? 1 : 0);
   }
-  return WorkSchedule(std::move(costs), after, done);
+  return WorkSchedule(tile_priorities(store, tiles, theirs), after, done);
 }
 
 /// Says once which tiles the budget cannot hold, and what to change.
@@ -135,7 +133,11 @@ std::filesystem::path result_path(const Config& config, TileKey key) {
 }
 
 TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
-                              Cluster& cluster, const std::vector<std::size_t>& tiles) {
+                              Cluster& cluster, const std::vector<std::size_t>& tiles,
+                              std::span<const std::uint8_t> theirs) {
+  if (!theirs.empty() && theirs.size() != store.tiles.size()) {
+    throw ProcessingError("process_tiles: the other processes' tiles are not given per tile");
+  }
   std::filesystem::create_directories(config.project.work / "results");
   TileStageReport report;
   report.processed.assign(store.tiles.size(), 0);
@@ -144,7 +146,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   for (const std::size_t k : tiles) input += store.tiles[k].owned();
   Progress progress(tiles.size(), input);
   if (cluster.root()) {
-    schedule.emplace(tile_schedule(config, store, fingerprint, tiles));
+    schedule.emplace(tile_schedule(config, store, fingerprint, tiles, theirs));
     warn_tiles_over_budget(config, store, tiles);
   }
   MemoryGate gate(config.run.memory);
@@ -153,12 +155,17 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     ++report.count;
     progress.done(store.tiles[tiles[item]].owned());
   };
+  std::vector<std::uint8_t> finished_elsewhere(tiles.size(), 0);  // per item; each written by its worker only
   // The channel ends (every rank's workers stopped) before the report is returned.
   auto channel = cluster.share(schedule ? &*schedule : nullptr, on_finish);
   run_workers(*channel, available_threads(), [&](std::size_t item) {
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
     throw_if_interrupted("tile processing");
+    if (!theirs.empty() && theirs[k] != 0 && read_tile_result(result_path(config, tile.key), fingerprint, store)) {
+      finished_elsewhere[item] = 1;  // its owner made it while this process did its own
+      return;
+    }
     const std::uint64_t estimate = tile_memory_estimate(tile);
     gate.acquire(estimate);
     // The memory earlier tiles freed stays resident for reuse (keep_freed_memory_for_reuse),
@@ -178,6 +185,11 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     gate.release(estimate);
   });
   channel.reset();
+  for (std::size_t item = 0; item < tiles.size(); ++item) {
+    if (finished_elsewhere[item] == 0) continue;
+    report.processed[tiles[item]] = 0;
+    --report.count;
+  }
   return report;
 }
 

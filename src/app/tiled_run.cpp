@@ -275,7 +275,9 @@ void run_subset(const Config& config, const TileStore& store, std::uint64_t fing
   Stopwatch clock;
   const std::vector<std::size_t> own = subset_tiles(store, subset);
   const std::vector<std::size_t> needed = with_dependencies(store, own);
-  const TileStageReport report = process_tiles(config, store, fingerprint, cluster, needed);
+  std::vector<std::uint8_t> theirs(store.tiles.size(), 1);
+  for (const std::size_t k : own) theirs[k] = 0;
+  const TileStageReport report = process_tiles(config, store, fingerprint, cluster, needed, theirs);
   std::size_t own_processed = 0;
   for (const std::size_t k : own) own_processed += report.processed[k];
   std::cout << fmt::format(
