@@ -33,6 +33,8 @@ MosaicSelection select(const Config& config, const LoadedAcquisitions& input, co
   return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in) : select_mosaic(in, config.mosaic);
 }
 
+}  // namespace
+
 StitchParams stitch_params(const Config& config) {
   const double reach = config.mosaic.stitch_reach * config.change.distance_threshold;
   return {.snap = reach,
@@ -42,8 +44,6 @@ StitchParams stitch_params(const Config& config) {
           .clip_angle = config.mosaic.clip_angle,
           .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0};
 }
-
-}  // namespace
 
 namespace {
 
@@ -109,13 +109,15 @@ BlockStitchParams tile_grid_blocks(const Config& config) {
 }
 
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes) {
+                                       std::span<const std::uint64_t> source_sizes,
+                                       decltype(PartStitchRun::run_level) run_level) {
   check_seam_pass(config);
   Stopwatch clock;
   const PartStitchRun run{.params = stitch_params(config),
                           .blocks = tile_grid_blocks(config),
                           .source_sizes = {source_sizes.begin(), source_sizes.end()},
-                          .frame = std::nullopt};
+                          .frame = std::nullopt,
+                          .run_level = std::move(run_level)};
   const double before = parts_open_boundary(parts, store, false, run.blocks);
   log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   BlockStitchStats s = stitch_parts(parts, store, run);

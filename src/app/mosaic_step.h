@@ -34,11 +34,16 @@ nlohmann::json stitch_and_report(const Config& config, MergedMesh& merged);
 /// stitching's reach allows.
 BlockStitchParams tile_grid_blocks(const Config& config);
 
+/// Stitching's parameters from `[mosaic]` and the distance threshold.
+StitchParams stitch_params(const Config& config);
+
 /// Stitches the parts in `store` block by block on the tile grid (`[run] seam_pass =
 /// "blocks"`), `source_sizes` the output's triangles per source; prints and returns the
-/// figures as stitch_and_report does.
+/// figures as stitch_and_report does. `run_level`: where each level's parts are stitched
+/// (PartStitchRun::run_level; unset: on this process's threads).
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes);
+                                       std::span<const std::uint64_t> source_sizes,
+                                       decltype(PartStitchRun::run_level) run_level = {});
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

@@ -198,9 +198,23 @@ SeamPartFiles::SeamPartFiles(std::filesystem::path dir, const BlockStitchParams&
   make_empty_folder(dir_, "the seam pass");
 }
 
+SeamPartFiles::SeamPartFiles(std::filesystem::path dir, std::vector<BlockPartKey> keys)
+    : dir_(std::move(dir)), keys_(std::move(keys)), owned_(false) {}
+
 SeamPartFiles::~SeamPartFiles() {
+  if (!owned_) return;
   std::error_code ec;
   std::filesystem::remove_all(dir_, ec);  // best effort: a leftover holds no finished output
+}
+
+std::uint64_t SeamPartFiles::input_bytes(std::size_t part) const {
+  std::error_code ec;
+  const std::uintmax_t bytes = std::filesystem::file_size(part_file(keys_.at(part), false), ec);
+  return ec ? 0 : static_cast<std::uint64_t>(bytes);
+}
+
+std::filesystem::path SeamPartFiles::beside(std::size_t part, std::string_view suffix) const {
+  return dir_ / fmt::format("{}.{}", keys_.at(part).name(), suffix);
 }
 
 std::filesystem::path SeamPartFiles::part_file(const BlockPartKey& key, bool stitched) const {

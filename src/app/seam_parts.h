@@ -45,6 +45,9 @@ class SeamPartFiles final : public PartStore {
  public:
   /// `blocks`: the grid, in the project CRS.
   SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks);
+  /// The parts `keys` (in part order) of another process's folder `dir` (an MPI rank helping
+  /// the root's seam pass): loads and saves them there, never creates nor removes the folder.
+  SeamPartFiles(std::filesystem::path dir, std::vector<BlockPartKey> keys);
   ~SeamPartFiles() override;
   SeamPartFiles(const SeamPartFiles&) = delete;
   SeamPartFiles& operator=(const SeamPartFiles&) = delete;
@@ -63,6 +66,11 @@ class SeamPartFiles final : public PartStore {
   void release_input(std::size_t part) override;
   /// Removes every stitched part's file, once the output is filed by tile (OutputLeaves).
   void release_stitched();
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
+  /// Bytes of part `part`'s file before stitching: what stitching it costs, roughly.
+  [[nodiscard]] std::uint64_t input_bytes(std::size_t part) const;
+  /// "<dir>/<part>.<suffix>": a file beside the part's (the outcome of its stitching).
+  [[nodiscard]] std::filesystem::path beside(std::size_t part, std::string_view suffix) const;
 
  private:
   [[nodiscard]] std::filesystem::path part_file(const BlockPartKey& key, bool stitched) const;
@@ -73,6 +81,7 @@ class SeamPartFiles final : public PartStore {
   std::map<BlockPartKey, Box3d> boxes_;
   std::vector<BlockPartKey> keys_;  ///< the parts, once finished
   std::vector<std::uint64_t> source_sizes_;
+  bool owned_ = true;  ///< the folder is this object's: made empty, removed with it
 };
 
 /// A grid tile of the output: its key and what its triangles span.

@@ -23,6 +23,7 @@
 #include "run_stages.h"
 #include "run_state.h"
 #include "seam_parts.h"
+#include "seam_ranks.h"
 #include "tile_assembly.h"
 #include "tile_job.h"
 #include "tiled_detect_output.h"
@@ -78,7 +79,8 @@ void add_tile_result(const Config& config, const TileContents& tile, bool proces
 /// nothing holds it whole. Every step of the pass asks it, whichever it is.
 class FinalOutput {
  public:
-  explicit FinalOutput(const Config& config) : config_(config) {
+  /// `cluster`: the MPI job whose ranks share the seam pass (null or one rank: this process).
+  FinalOutput(const Config& config, Cluster* cluster) : config_(config), cluster_(cluster) {
     if (seam_pass_in_blocks(config)) {
       seams_.emplace(seam_parts_folder(config.project.work), tile_grid_blocks(config));
     } else if (config.run.seam_pass == SeamPass::automatic && config.mosaic.method == MosaicMethod::energy) {
@@ -114,7 +116,11 @@ class FinalOutput {
   /// tiles are joined like seams inside a tile. Returns the figures for the summary.
   nlohmann::json stitch() {
     if (seams_) {
-      nlohmann::json figures = stitch_parts_and_report(config_, parts_, *seams_, seams_->source_sizes());
+      const bool shared = cluster_ != nullptr && cluster_->size() > 1;
+      nlohmann::json figures = stitch_parts_and_report(
+          config_, parts_, *seams_, seams_->source_sizes(),
+          shared ? share_seam_levels(config_, *cluster_, *seams_, seams_->source_sizes()) : nullptr);
+      if (shared) remove_seam_plan(config_);
       // The outputs read the stitched output one grid tile at a time.
       leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
                       TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}), parts_,
@@ -153,6 +159,7 @@ class FinalOutput {
 
  private:
   const Config& config_;
+  Cluster* cluster_;
   MergedMesh merged_;
   std::optional<SeamPartFiles> seams_;
   std::vector<BlockPart> parts_;
@@ -187,7 +194,8 @@ void read_tile_results(const Config& config, const TileStore& store, std::uint64
 /// run.json. `seconds` holds the stages timed so far.
 void write_run_outputs(const Config& config, const TileStore& store, std::uint64_t fingerprint,
                        const TileStageReport& tiles, const PictureOptions& pictures, nlohmann::json seconds,
-                       int ranks) {
+                       Cluster* cluster) {
+  const int ranks = cluster != nullptr ? cluster->size() : 1;
   Stopwatch total, clock;
   // Each stage hands the memory it freed back to the system: the next one then starts from
   // what is still in use, and the pass peaks at its largest stage rather than at the heap
@@ -201,7 +209,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // process's own.
   TileAssembly assembly(store,
                         config.output.labels ? std::optional(pair_spill_folder(config.project.work)) : std::nullopt);
-  FinalOutput output(config);
+  FinalOutput output(config, cluster);
   std::vector<nlohmann::json> per_tile;
   read_tile_results(config, store, fingerprint, tiles, assembly, output, per_tile);
   const std::uint64_t selected = output.assemble(assembly);
@@ -307,9 +315,13 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   const TileStageReport tiles = process_tiles(config, store, result_fingerprint, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
-  // The seam pass and the outputs need every tile: the root writes them alone.
-  if (cluster.root())
-    write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, cluster.size());
+  // The seam pass and the outputs need every tile: the root writes them, the other ranks
+  // help it stitch.
+  if (cluster.root()) {
+    write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, &cluster);
+  } else if (seam_pass_in_blocks(config)) {
+    help_seam_pass(config, cluster);
+  }
   cluster.barrier();
 }
 
@@ -341,7 +353,7 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     shown < missing.size() ? ", ..." : ""));
   }
   const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0};
-  write_run_outputs(config, *store, result_fingerprint, none, pictures, nlohmann::json::object(), 1);
+  write_run_outputs(config, *store, result_fingerprint, none, pictures, nlohmann::json::object(), nullptr);
 }
 
 }  // namespace citymesh::app

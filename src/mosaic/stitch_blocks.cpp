@@ -29,7 +29,7 @@ using mosaic_detail::PartCut;
 
 namespace {
 
-constexpr int kLevels = 4;
+constexpr int kLevels = kBlockStitchLevels;
 
 /// Along one axis: the block holding a coordinate and, within `band` of a block side, that
 /// side's grid line.
@@ -128,13 +128,6 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.rejected += s.rejected;
 }
 
-/// What stitching one part of a level gives back.
-struct PartOutcome {
-  StitchStats stats;
-  Box3d box;
-  std::size_t cut_triangles = 0;
-};
-
 /// Loads part p and the parts around it as level `level` sees them, stitches it and saves it.
 PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int level, const PartFinder& finder,
                        PartStore& store, const PartStitchRun& run, double context) {
@@ -163,33 +156,21 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
 /// memory is what a level adds (the city's largest part with its surroundings: ~30 MB).
 constexpr unsigned kMaxPartsInFlight = 16;
 
-/// Stitches the parts of one level in parallel, one per worker thread at a time, each worker
-/// taking the next part as soon as it is done with one (no wait for the slowest of a batch).
-/// Each part sees the others of its level as they were before the level (never as stitched),
-/// and the outcomes are summed in part order, so that the output is the same for any thread
-/// count and any number in flight.
+/// Stitches the parts of one level (run.run_level, or here), each part seeing the others of
+/// its level as they were before the level (never as stitched); the outcomes are summed in
+/// part order, so that the output is the same for any thread count, any number in flight and
+/// any process doing each part.
 void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, const PartStitchRun& run,
-                  double context, BlockStitchStats& stats) {
-  const PartFinder finder(parts, run.blocks, level);
-  std::vector<std::size_t> of_level;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    if (parts[i].key.level == level) of_level.push_back(i);
-  }
-  std::vector<PartOutcome> outcomes(of_level.size());
-  // Isolated workers: a thread waiting inside one part's parallel loops never starts another
-  // part, so the parts in flight stay at most one per thread. One part's error stops the
-  // others after their current part.
-  const unsigned workers = std::min(available_threads(), kMaxPartsInFlight);
-  parallel_jobs(of_level.size(), workers, [&](std::size_t i) {
-    throw_if_interrupted("the seam pass");
-    outcomes[i] = stitch_one(parts, of_level[i], level, finder, store, run, context);
-  });
-  for (std::size_t i = 0; i < of_level.size(); ++i) {
-    parts[of_level[i]].stitched_box = outcomes[i].box;
+                  BlockStitchStats& stats) {
+  const LevelStitcher stitcher(parts, level, store, run);
+  const std::vector<PartOutcome> outcomes = run.run_level ? run.run_level(stitcher) : stitch_level_here(stitcher);
+  if (outcomes.size() != stitcher.size()) throw ProcessingError("stitching block by block: a level's outcomes are missing");
+  for (std::size_t i = 0; i < outcomes.size(); ++i) {
+    parts[stitcher.parts_of_level()[i]].stitched_box = outcomes[i].box;
     stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);
     add_counts(stats.stitch, outcomes[i].stats);
   }
-  stats.parts[static_cast<std::size_t>(level)] = of_level.size();
+  stats.parts[static_cast<std::size_t>(level)] = stitcher.size();
 }
 
 /// The length of the edges of `own`'s triangles used by exactly one triangle of `own` and
@@ -253,6 +234,41 @@ double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& st
   return total;
 }
 
+struct LevelStitcher::Finder {
+  PartFinder finder;
+};
+
+LevelStitcher::LevelStitcher(std::span<const BlockPart> parts, int level, PartStore& store, const PartStitchRun& run)
+    : parts_(parts),
+      level_(level),
+      store_(store),
+      run_(run),
+      context_(run.blocks.context > 0 ? run.blocks.context : block_context(run.params)),
+      finder_(std::make_unique<Finder>(Finder{PartFinder(parts, run.blocks, level)})) {
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    if (parts[i].key.level == level) of_level_.push_back(i);
+  }
+}
+
+LevelStitcher::~LevelStitcher() = default;
+
+PartOutcome LevelStitcher::stitch(std::size_t i) const {
+  return stitch_one(parts_, of_level_.at(i), level_, finder_->finder, store_, run_, context_);
+}
+
+std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level) {
+  std::vector<PartOutcome> outcomes(level.size());
+  // Isolated workers: a thread waiting inside one part's parallel loops never starts another
+  // part, so the parts in flight stay at most one per thread. One part's error stops the
+  // others after their current part.
+  const unsigned workers = std::min(available_threads(), kMaxPartsInFlight);
+  parallel_jobs(level.size(), workers, [&](std::size_t i) {
+    throw_if_interrupted("the seam pass");
+    outcomes[i] = level.stitch(i);
+  });
+  return outcomes;
+}
+
 std::string BlockPartKey::name() const { return fmt::format("{}_{}_{}", level, x, y); }
 
 BlockPartKey block_part_of(const Vec3d& centroid, const BlockStitchParams& p) {
@@ -290,7 +306,7 @@ BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, c
   BlockStitchStats stats;
   const Stopwatch clock;
   for (int level = 0; level < kLevels; ++level) {
-    stitch_level(parts, level, store, run, context, stats);
+    stitch_level(parts, level, store, run, stats);
     // Later levels see this level's parts stitched only.
     for (std::size_t p = 0; p < parts.size(); ++p) {
       if (parts[p].key.level == level) store.release_input(p);

@@ -132,7 +132,7 @@ void gather(MergedMesh& m, std::span<const std::shared_ptr<const KeyedPiece>> pa
 
 BlockStitchStats stitch_in_blocks(MergedMesh& mesh, const StitchParams& params, const BlockStitchParams& blocks) {
   Stopwatch clock;
-  PartStitchRun run{.params = params, .blocks = blocks, .source_sizes = source_sizes(mesh), .frame = mesh.mesh.origin};
+  PartStitchRun run{.params = params, .blocks = blocks, .source_sizes = source_sizes(mesh), .frame = mesh.mesh.origin, .run_level = {}};
   run.blocks.origin_x += mesh.mesh.origin.x;  // the pieces' positions are in the project CRS
   run.blocks.origin_y += mesh.mesh.origin.y;
   run.blocks.context = blocks.context > 0 ? blocks.context : block_context(params);

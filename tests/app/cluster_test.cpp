@@ -72,6 +72,32 @@ TEST_F(ClusterRun, ThreeMpiRanksGiveTheBytesOfOneProcess) {
   EXPECT_EQ(report["reused_tiles"], 0);
 }
 
+TEST_F(ClusterRun, ThreeMpiRanksShareTheSeamPassByBlocksAndGiveTheBytesOfOneProcess) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  // 20 m tiles take the seam pass by blocks (10 m ones are too narrow for its bands).
+  const std::string blocks = " --set tiling.tile_size=20 --set run.seam_pass=blocks --threads 1";
+  const auto one = test::run_citymesh("run " + args(sim_, "blocks-one") + blocks);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const std::string cmd = fmt::format("{} run {}{} > {} 2>&1", mpirun(3), args(sim_, "blocks-mpi"), blocks,
+                                      (*dir_ / "blocks.log").string());
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(*dir_ / "blocks.log");
+  EXPECT_TRUE(test::result_bytes(output("blocks-mpi")) == test::result_bytes(output("blocks-one")))
+      << "3 ranks stitching differ from one process";
+  // Ranks 1 and 2 each say how many parts they stitched: some of them did.
+  const std::string log = test::read_text(*dir_ / "blocks.log");
+  std::size_t remote = 0, lines = 0;
+  for (const int rank : {1, 2}) {
+    const std::string said = fmt::format("rank {}: stitched ", rank);
+    const auto at = log.find(said);
+    if (at == std::string::npos) continue;
+    ++lines;
+    remote += std::stoul(log.substr(at + said.size()));
+  }
+  EXPECT_EQ(lines, 2u) << log;
+  EXPECT_GT(remote, 0u) << log;
+  EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "seam-level.json")) << "the plan was left behind";
+}
+
 TEST_F(ClusterRun, AKilledRankLosesOnlyItsWorkInFlight) {
   if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
   // Kill the newest rank (SIGKILL) while the job runs, as soon as a first tile is finished

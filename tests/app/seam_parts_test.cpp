@@ -202,7 +202,7 @@ TEST(SeamParts, StitchingFromFilesGivesWhatStitchingInMemoryGives) {
   SeamPartFiles files(dir / "seams", blocks());
   files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
   std::vector<BlockPart> parts = files.finish();
-  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = Vec3d{}};
+  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = Vec3d{}, .run_level = {}};
   run.blocks.context = block_context(kParams);
   const double before = parts_open_boundary(parts, files, false, run.blocks);
   const BlockStitchStats s = stitch_parts(parts, files, run);
@@ -250,7 +250,7 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   SeamPartFiles files(dir / "seams", blocks());
   files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
   std::vector<BlockPart> parts = files.finish();
-  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = std::nullopt};
+  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = std::nullopt, .run_level = {}};
   (void)stitch_parts(parts, files, run);
   const MergedMesh gathered = gather_stitched_parts(parts, files);
   // Tiles of 1 m: vertices shared by up to four tiles, some by tiles that meet at a corner only.

@@ -7,6 +7,7 @@
 
 #include <array>
 #include <compare>
+#include <functional>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -78,6 +79,9 @@ BlockPartKey block_part_of(const Vec3d& centroid, const BlockStitchParams& block
 /// surroundings of `context` metres.
 void check_block_layout(const BlockStitchParams& blocks, double context);
 
+/// The levels of stitch_parts(): block interiors, bands along x, bands along y, corners.
+inline constexpr int kBlockStitchLevels = 4;
+
 /// Keys of the vertices stitching makes: kNewVertexKey | part << 32 | k for the k-th vertex
 /// part `part` (its index in the run's part list) made. Other keys are the caller's own, below.
 inline constexpr std::uint64_t kNewVertexKey = std::uint64_t{1} << 63;
@@ -103,6 +107,15 @@ struct BlockPart {
   Box3d box, stitched_box;
 };
 
+class LevelStitcher;
+
+/// What stitching one part gives back.
+struct PartOutcome {
+  StitchStats stats;
+  Box3d box;                      ///< of the stitched part's triangles
+  std::size_t cut_triangles = 0;  ///< the part with its surroundings, as stitched
+};
+
 struct PartStitchRun {
   StitchParams params;
   BlockStitchParams blocks;  ///< in the frame of the pieces' positions, context set
@@ -111,7 +124,49 @@ struct PartStitchRun {
   /// The frame every part is stitched in; unset: each part's own, the lowest corner of its
   /// box in whole metres (floats relative to it keep their precision anywhere in a city).
   std::optional<Vec3d> frame;
+  /// Stitches every part of one level (stitcher.stitch(i) for each i < stitcher.size(), on
+  /// any thread of any process sharing the store) and returns their outcomes in that order.
+  /// Unset: on this process's threads (stitch_level_here). A tiled MPI run hands the parts out
+  /// to every rank.
+  std::function<std::vector<PartOutcome>(const LevelStitcher&)> run_level;
 };
+
+/// The parts of one level of stitch_parts(), each stitched on its own: loaded with the parts
+/// around it as the level sees them, stitched, and saved in the store. Parts of one level
+/// never meet, so any number can be stitched at once, in any order, by any process whose
+/// store reads and writes the same parts.
+class LevelStitcher {
+ public:
+  /// `parts` as stitch_parts() has them when the level starts (the stitched boxes of earlier
+  /// levels set); they, the store and the run must outlive this.
+  LevelStitcher(std::span<const BlockPart> parts, int level, PartStore& store, const PartStitchRun& run);
+  ~LevelStitcher();
+  LevelStitcher(const LevelStitcher&) = delete;
+  LevelStitcher& operator=(const LevelStitcher&) = delete;
+
+  [[nodiscard]] int level() const { return level_; }
+  /// Every part of the run, as this level sees them.
+  [[nodiscard]] std::span<const BlockPart> parts() const { return parts_; }
+  /// The parts of this level, as indices into the run's parts, in part order.
+  [[nodiscard]] std::span<const std::size_t> parts_of_level() const { return of_level_; }
+  [[nodiscard]] std::size_t size() const { return of_level_.size(); }
+  /// Stitches the i-th part of the level and saves it. Thread-safe for different i.
+  [[nodiscard]] PartOutcome stitch(std::size_t i) const;
+
+ private:
+  struct Finder;
+  std::span<const BlockPart> parts_;
+  int level_;
+  PartStore& store_;
+  const PartStitchRun& run_;
+  double context_;
+  std::vector<std::size_t> of_level_;
+  std::unique_ptr<Finder> finder_;
+};
+
+/// Runs every part of the level on this process's threads, a few at a time (the default of
+/// PartStitchRun::run_level).
+std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level);
 
 /// Stitches every part of `parts` (sorted by key, boxes set) level by level as
 /// stitch_in_blocks describes, reading them from `store` and saving each one stitched there;
