@@ -109,21 +109,20 @@ BlockStitchParams tile_grid_blocks(const Config& config) {
 }
 
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes,
-                                       decltype(PartStitchRun::run_level) run_level) {
+                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work) {
   check_seam_pass(config);
   Stopwatch clock;
   const PartStitchRun run{.params = stitch_params(config),
                           .blocks = tile_grid_blocks(config),
                           .source_sizes = {source_sizes.begin(), source_sizes.end()},
                           .frame = std::nullopt,
-                          .run_level = std::move(run_level)};
-  const double before = parts_open_boundary(parts, store, false, run.blocks);
+                          .run_level = work.run_level};
+  const double before = parts_open_boundary(parts, store, false, run.blocks, work.measure_parts);
   log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   BlockStitchStats s = stitch_parts(parts, store, run);
   log::debug("stitch by blocks: stitched at {:.2f} s", clock.seconds());
   s.stitch.open_boundary_before = before;
-  s.stitch.open_boundary_after = parts_open_boundary(parts, store, true, run.blocks);
+  s.stitch.open_boundary_after = parts_open_boundary(parts, store, true, run.blocks, work.measure_parts);
   log::debug("stitch by blocks: open boundary after measured at {:.2f} s", clock.seconds());
   s.stitch.seconds = clock.seconds();
   std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "

@@ -37,13 +37,20 @@ BlockStitchParams tile_grid_blocks(const Config& config);
 /// Stitching's parameters from `[mosaic]` and the distance threshold.
 StitchParams stitch_params(const Config& config);
 
+/// Where the parts of a seam pass by blocks are stitched and measured (unset: on this
+/// process's threads; a tiled MPI run shares them with every rank, seam_ranks.h). Before
+/// stitching, the open boundary is measured; then the four levels are stitched; then it is
+/// measured again: the steps the ranks helping follow.
+struct SeamPassWork {
+  decltype(PartStitchRun::run_level) run_level;
+  MeasureParts measure_parts;
+};
+
 /// Stitches the parts in `store` block by block on the tile grid (`[run] seam_pass =
 /// "blocks"`), `source_sizes` the output's triangles per source; prints and returns the
-/// figures as stitch_and_report does. `run_level`: where each level's parts are stitched
-/// (PartStitchRun::run_level; unset: on this process's threads).
+/// figures as stitch_and_report does.
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes,
-                                       decltype(PartStitchRun::run_level) run_level = {});
+                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work = {});
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

@@ -69,47 +69,39 @@ PartOutcome outcome_from(const nlohmann::json& j) {
 
 constexpr std::string_view kOutcomeSuffix = "outcome.json";
 
-PartOutcome read_outcome(const std::filesystem::path& file) {
-  std::ifstream in(file);
-  if (!in) throw ProcessingError(fmt::format("{}: missing (a part another rank stitched)", file.string()));
-  try {
-    return outcome_from(nlohmann::json::parse(in));
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
-}
-
-/// The plan another rank needs: the root's folder, the level, every part as the level sees
-/// it, and the sources' sizes (clipping's precedence).
-struct LevelPlan {
+/// The plan another rank needs for one step: the root's folder, every part as the step sees
+/// it, the sources' sizes (clipping's precedence) and what to do with the parts: measure
+/// their open boundary (before or after stitching) or stitch those of one level.
+struct StepPlan {
   std::filesystem::path dir;
-  int level = 0;
+  std::string step;  ///< "measure" or "stitch"
+  int level = 0;     ///< stitch: the level
+  bool stitched = false;  ///< measure: after stitching
   std::vector<BlockPart> parts;
   std::vector<std::uint64_t> source_sizes;
 };
 
-void write_plan(const Config& config, const SeamPartFiles& files, const LevelStitcher& level,
-                std::span<const std::uint64_t> source_sizes) {
+void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json parts = nlohmann::json::array();
-  for (const BlockPart& p : level.parts()) {
+  for (const BlockPart& p : plan.parts) {
     parts.push_back({{"key", {p.key.level, p.key.x, p.key.y}}, {"box", box_bits(p.box)}, {"stitched_box", box_bits(p.stitched_box)}});
   }
-  const nlohmann::json plan{{"dir", files.dir().string()},
-                            {"level", level.level()},
-                            {"parts", parts},
-                            {"source_sizes", std::vector<std::uint64_t>(source_sizes.begin(), source_sizes.end())}};
-  write_file_atomically(plan_path(config), plan.dump() + "\n");
+  const nlohmann::json j{{"dir", plan.dir.string()},     {"step", plan.step},   {"level", plan.level},
+                         {"stitched", plan.stitched},     {"parts", parts},      {"source_sizes", plan.source_sizes}};
+  write_file_atomically(plan_path(config), j.dump() + "\n");
 }
 
-LevelPlan read_plan(const Config& config) {
+StepPlan read_plan(const Config& config) {
   const std::filesystem::path file = plan_path(config);
   std::ifstream in(file);
   if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of the seam pass)", file.string()));
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
-    LevelPlan plan;
+    StepPlan plan;
     plan.dir = j.at("dir").get<std::string>();
+    plan.step = j.at("step").get<std::string>();
     plan.level = j.at("level").get<int>();
+    plan.stitched = j.at("stitched").get<bool>();
     for (const auto& p : j.at("parts")) {
       const auto& key = p.at("key");
       plan.parts.push_back({{key.at(0).get<int>(), key.at(1).get<std::int64_t>(), key.at(2).get<std::int64_t>()},
@@ -123,28 +115,66 @@ LevelPlan read_plan(const Config& config) {
   }
 }
 
-unsigned part_workers() { return std::min(available_threads(), kMaxPartsInFlight); }
+/// A part's open boundary as its bits (the sum must come out the same as on one process).
+nlohmann::json length_json(double metres) { return {{"bits", std::bit_cast<std::uint64_t>(metres)}}; }
+double length_from(const nlohmann::json& j) { return std::bit_cast<double>(j.at("bits").get<std::uint64_t>()); }
+
+constexpr std::string_view kLengthSuffix = "length.json";
+
+/// Reads what another rank wrote for a part (an outcome or a length) and removes the file.
+nlohmann::json take_result(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw ProcessingError(fmt::format("{}: missing (a part another rank did)", file.string()));
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
+  }
+  in.close();
+  std::filesystem::remove(file);
+  return j;
+}
+
+/// Hands out `count` items (item i: index[i] in the parts, costs by the part's file size) to
+/// every rank's workers; `here(i)` does one on this rank. Returns once every rank is done.
+template <class Here>
+void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const std::size_t> index, Here here) {
+  std::vector<std::uint64_t> costs;  // largest first, as tiles: none is left to end a step alone
+  for (const std::size_t p : index) costs.push_back(files.input_bytes(p));
+  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(index.size()),
+                        std::vector<std::uint8_t>(index.size(), 0));
+  auto channel = cluster.share(&schedule, [](std::size_t) {});
+  run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t i) {
+    throw_if_interrupted("the seam pass");
+    here(i);
+  });
+}
 
 }  // namespace
 
-decltype(PartStitchRun::run_level) share_seam_levels(const Config& config, Cluster& cluster,
-                                                     const SeamPartFiles& files,
-                                                     std::span<const std::uint64_t> source_sizes) {
-  return [&config, &cluster, &files, source_sizes](const LevelStitcher& level) {
-    write_plan(config, files, level, source_sizes);
-    // Largest part first, as tiles: none is left to end the level alone.
-    std::vector<std::uint64_t> costs;
-    for (const std::size_t p : level.parts_of_level()) costs.push_back(files.input_bytes(p));
-    WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(level.size()),
-                          std::vector<std::uint8_t>(level.size(), 0));
+SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files,
+                             std::span<const std::uint64_t> source_sizes) {
+  const std::vector<std::uint64_t> sizes(source_sizes.begin(), source_sizes.end());
+  SeamPassWork work;
+  work.measure_parts = [&config, &cluster, &files, sizes](const BoundaryMeasurer& measurer) {
+    const StepPlan plan{files.dir(), "measure", 0, measurer.stitched(), {measurer.parts().begin(), measurer.parts().end()}, sizes};
+    write_plan(config, plan);
+    std::vector<std::size_t> all(measurer.size());
+    for (std::size_t p = 0; p < all.size(); ++p) all[p] = p;
+    std::vector<std::optional<double>> here(all.size());
+    share_items(cluster, files, all, [&](std::size_t p) { here[p] = measurer.measure(p); });
+    std::vector<double> lengths(all.size());
+    for (std::size_t p = 0; p < all.size(); ++p) {
+      lengths[p] = here[p] ? *here[p] : length_from(take_result(files.beside(p, kLengthSuffix)));
+    }
+    return lengths;
+  };
+  work.run_level = [&config, &cluster, &files, sizes](const LevelStitcher& level) {
+    const StepPlan plan{files.dir(), "stitch", level.level(), false, {level.parts().begin(), level.parts().end()}, sizes};
+    write_plan(config, plan);
     std::vector<std::optional<PartOutcome>> here(level.size());
-    {
-      auto channel = cluster.share(&schedule, [](std::size_t) {});
-      run_workers(*channel, part_workers(), [&](std::size_t i) {
-        throw_if_interrupted("the seam pass");
-        here[i] = level.stitch(i);
-      });
-    }  // every rank's workers have stopped: their outcomes are written
+    share_items(cluster, files, level.parts_of_level(), [&](std::size_t i) { here[i] = level.stitch(i); });
     std::vector<PartOutcome> outcomes(level.size());
     std::size_t elsewhere = 0;
     for (std::size_t i = 0; i < level.size(); ++i) {
@@ -152,14 +182,13 @@ decltype(PartStitchRun::run_level) share_seam_levels(const Config& config, Clust
         outcomes[i] = *here[i];
         continue;
       }
-      const std::filesystem::path file = files.beside(level.parts_of_level()[i], kOutcomeSuffix);
-      outcomes[i] = read_outcome(file);
-      std::filesystem::remove(file);
+      outcomes[i] = outcome_from(take_result(files.beside(level.parts_of_level()[i], kOutcomeSuffix)));
       ++elsewhere;
     }
     log::debug("seam pass: level {}: {} of {} parts stitched by other ranks", level.level(), elsewhere, level.size());
     return outcomes;
   };
+  return work;
 }
 
 void remove_seam_plan(const Config& config) {
@@ -173,29 +202,42 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
                           .source_sizes = {},
                           .frame = std::nullopt,
                           .run_level = {}};
-  std::atomic<std::size_t> stitched = 0;
-  for (int level = 0; level < kBlockStitchLevels; ++level) {
-    // The root writes the plan before it shares the level, and sharing starts with a barrier.
+  std::atomic<std::size_t> stitched = 0, measured = 0;
+  // The root's steps: the boundary measured, the levels stitched, the boundary measured again.
+  for (int step = 0; step < kBlockStitchLevels + 2; ++step) {
+    // The root writes the plan before it shares the step, and sharing starts with a barrier.
     auto channel = cluster.share(nullptr, {});
-    const LevelPlan plan = read_plan(config);
-    if (plan.level != level) {
-      throw ProcessingError(fmt::format("{}: level {} where {} was expected", plan_path(config).string(), plan.level, level));
+    const StepPlan plan = read_plan(config);
+    const bool measuring = step == 0 || step == kBlockStitchLevels + 1;
+    if (plan.step != (measuring ? "measure" : "stitch") || (!measuring && plan.level != step - 1)) {
+      throw ProcessingError(fmt::format("{}: step '{}' (level {}) where step {} of the seam pass was expected",
+                                        plan_path(config).string(), plan.step, plan.level, step));
     }
     std::vector<BlockPartKey> keys;
     for (const BlockPart& p : plan.parts) keys.push_back(p.key);
     SeamPartFiles files(plan.dir, std::move(keys));
+    if (measuring) {
+      const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, run.blocks);
+      run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t p) {
+        throw_if_interrupted("the seam pass");
+        // Written before the root hears that the part is done (the next request says so).
+        write_file_atomically(files.beside(p, kLengthSuffix), length_json(measurer.measure(p)).dump());
+        ++measured;
+      });
+      continue;
+    }
     PartStitchRun level_run = run;
     level_run.source_sizes = plan.source_sizes;
     const LevelStitcher stitcher(plan.parts, plan.level, files, level_run);
-    run_workers(*channel, part_workers(), [&](std::size_t i) {
+    run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t i) {
       throw_if_interrupted("the seam pass");
       const PartOutcome outcome = stitcher.stitch(i);
-      // Written before the root hears that the part is done (the next request says so).
       write_file_atomically(files.beside(stitcher.parts_of_level()[i], kOutcomeSuffix), outcome_json(outcome).dump());
       ++stitched;
     });
   }
-  log::info("rank {}: stitched {} parts of the seam pass", cluster.rank(), stitched.load());
+  log::info("rank {}: stitched {} parts of the seam pass and measured {}", cluster.rank(), stitched.load(),
+            measured.load());
 }
 
 }  // namespace citymesh::app

@@ -10,22 +10,23 @@
 #include "citymesh/config/config.h"
 #include "citymesh/mosaic/stitch_blocks.h"
 #include "cluster.h"
+#include "mosaic_step.h"
 #include "seam_parts.h"
 
 namespace citymesh::app {
 
-/// On the root: a PartStitchRun::run_level that writes the level's plan to the work folder
-/// and shares its parts with every rank (collective: the other ranks are in
-/// help_seam_pass()). `files` and `cluster` must outlive it.
-decltype(PartStitchRun::run_level) share_seam_levels(const Config& config, Cluster& cluster,
-                                                     const SeamPartFiles& files,
-                                                     std::span<const std::uint64_t> source_sizes);
+/// On the root: the seam pass's work shared with every rank. Each step (the open boundary
+/// measured, each level stitched, the boundary measured again) writes its plan to the work
+/// folder and hands its parts out (collective: the other ranks are in help_seam_pass()).
+/// `files` and `cluster` must outlive it.
+SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files,
+                             std::span<const std::uint64_t> source_sizes);
 
-/// Removes the plan share_seam_levels() left in the work folder, once the pass is done.
+/// Removes the plan share_seam_pass() left in the work folder, once the pass is done.
 void remove_seam_plan(const Config& config);
 
-/// On every other rank, while the root runs its seam pass by blocks: stitches the parts of
-/// each level the root hands it. Collective with share_seam_levels().
+/// On every other rank, while the root runs its seam pass by blocks: measures and stitches
+/// the parts the root hands it, step by step. Collective with share_seam_pass().
 void help_seam_pass(const Config& config, Cluster& cluster);
 
 }  // namespace citymesh::app

@@ -214,21 +214,41 @@ double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<
 
 }  // namespace
 
+struct BoundaryMeasurer::Finder {
+  PartFinder finder;
+};
+
+BoundaryMeasurer::BoundaryMeasurer(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
+                                   const BlockStitchParams& blocks)
+    : parts_(parts),
+      store_(store),
+      stitched_(stitched),
+      // As the last level sees them (all stitched) or as the first does (none).
+      finder_(std::make_unique<Finder>(Finder{PartFinder(parts, blocks, stitched ? kLevels : -1)})) {}
+
+BoundaryMeasurer::~BoundaryMeasurer() = default;
+
+double BoundaryMeasurer::measure(std::size_t p) const {
+  const Box3d& box = box_for_level(parts_[p], stitched_ ? kLevels : -1);
+  if (box.empty()) return 0.0;
+  std::vector<std::shared_ptr<const KeyedPiece>> around;
+  for (const std::uint32_t q : finder_->finder.meeting(box, p)) around.push_back(store_.load(q, stitched_));
+  return own_open_boundary(*store_.load(p, stitched_), around);
+}
+
 double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
-                           const BlockStitchParams& blocks) {
-  // As the last level sees them (all stitched) or as the first does (none).
-  const int view = stitched ? kLevels : -1;
-  const PartFinder finder(parts, blocks, view);
-  std::vector<double> lengths(parts.size(), 0.0);
-  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p) {
-      const Box3d& box = box_for_level(parts[p], view);
-      if (box.empty()) continue;
-      std::vector<std::shared_ptr<const KeyedPiece>> around;
-      for (const std::uint32_t q : finder.meeting(box, p)) around.push_back(store.load(q, stitched));
-      lengths[p] = own_open_boundary(*store.load(p, stitched), around);
-    }
-  });
+                           const BlockStitchParams& blocks, const MeasureParts& measure_parts) {
+  const BoundaryMeasurer measurer(parts, store, stitched, blocks);
+  std::vector<double> lengths;
+  if (measure_parts) {
+    lengths = measure_parts(measurer);
+    if (lengths.size() != parts.size()) throw ProcessingError("open boundary by parts: lengths are missing");
+  } else {
+    lengths.assign(parts.size(), 0.0);
+    parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t p = begin; p < end; ++p) lengths[p] = measurer.measure(p);
+    });
+  }
   double total = 0;
   for (const double l : lengths) total += l;  // in part order: the same sum on any thread count
   return total;

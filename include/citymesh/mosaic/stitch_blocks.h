@@ -173,10 +173,40 @@ std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level);
 /// sets their stitched boxes. The open boundary figures are left to the caller.
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run);
 
+/// The open boundary of each part of an output, before stitching or once stitched: the length
+/// of its triangles' edges used by exactly one triangle, counted with the parts around it
+/// loaded. Any number at once, on any process whose store reads the same parts.
+class BoundaryMeasurer {
+ public:
+  /// `parts`, `store` and `blocks` (the grid of the parts) must outlive this.
+  BoundaryMeasurer(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
+                   const BlockStitchParams& blocks);
+  ~BoundaryMeasurer();
+  BoundaryMeasurer(const BoundaryMeasurer&) = delete;
+  BoundaryMeasurer& operator=(const BoundaryMeasurer&) = delete;
+
+  [[nodiscard]] std::size_t size() const { return parts_.size(); }
+  [[nodiscard]] bool stitched() const { return stitched_; }
+  [[nodiscard]] std::span<const BlockPart> parts() const { return parts_; }
+  /// Part p's open boundary, metres. Thread-safe.
+  [[nodiscard]] double measure(std::size_t p) const;
+
+ private:
+  struct Finder;
+  std::span<const BlockPart> parts_;
+  const PartStore& store_;
+  bool stitched_;
+  std::unique_ptr<Finder> finder_;
+};
+
+/// Measures every part (measurer.measure(p) for each p, anywhere) and returns the lengths in
+/// part order. Unset: on this process's threads.
+using MeasureParts = std::function<std::vector<double>(const BoundaryMeasurer&)>;
+
 /// The open boundary of the whole output the parts hold, before stitching or once stitched:
-/// the length of the edges used by exactly one triangle, each part's counted with the parts
-/// around it loaded (`blocks`: the grid of the parts).
+/// the parts' lengths (BoundaryMeasurer) summed in part order, so the same on any thread
+/// count (`blocks`: the grid of the parts).
 double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
-                           const BlockStitchParams& blocks);
+                           const BlockStitchParams& blocks, const MeasureParts& measure_parts = {});
 
 }  // namespace citymesh
