@@ -86,7 +86,7 @@ void write_plan(const Config& config, const StepPlan& plan) {
   for (const BlockPart& p : plan.parts) {
     parts.push_back({{"key", {p.key.level, p.key.x, p.key.y}}, {"box", box_bits(p.box)}, {"stitched_box", box_bits(p.stitched_box)}});
   }
-  const nlohmann::json j{{"dir", plan.dir.string()},     {"step", plan.step},   {"level", plan.level},
+  const nlohmann::json j{{"dir", std::filesystem::absolute(plan.dir).string()},     {"step", plan.step},   {"level", plan.level},
                          {"stitched", plan.stitched},     {"parts", parts},      {"source_sizes", plan.source_sizes}};
   write_file_atomically(plan_path(config), j.dump() + "\n");
 }
