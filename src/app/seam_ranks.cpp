@@ -22,10 +22,7 @@ namespace citymesh::app {
 
 namespace {
 
-/// At most this many parts per rank are stitched at a time (their memory, as on one process).
-constexpr unsigned kMaxPartsInFlight = 16;
-
-/// The plan of the level being stitched, written by the root before it shares the level.
+/// The plan of the step being shared, written by the root before it shares the step.
 std::filesystem::path plan_path(const Config& config) { return config.project.work / "seam-level.json"; }
 
 /// Doubles travel as their bits: a part's box sets its stitching frame, so it must come back
@@ -121,23 +118,25 @@ double length_from(const nlohmann::json& j) { return std::bit_cast<double>(j.at(
 
 constexpr std::string_view kLengthSuffix = "length.json";
 
-/// Reads what another rank wrote for a part (an outcome or a length) and removes the file.
-nlohmann::json take_result(const std::filesystem::path& file) {
+/// Reads what another rank wrote for a part (an outcome or a length) with `decode`, and
+/// removes the file.
+template <class Decode>
+auto take_result(const std::filesystem::path& file, Decode decode) {
   std::ifstream in(file);
   if (!in) throw ProcessingError(fmt::format("{}: missing (a part another rank did)", file.string()));
-  nlohmann::json j;
   try {
-    j = nlohmann::json::parse(in);
+    auto result = decode(nlohmann::json::parse(in));
+    in.close();
+    std::filesystem::remove(file);
+    return result;
   } catch (const nlohmann::json::exception& e) {
     throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
   }
-  in.close();
-  std::filesystem::remove(file);
-  return j;
 }
 
-/// Hands out `count` items (item i: index[i] in the parts, costs by the part's file size) to
-/// every rank's workers; `here(i)` does one on this rank. Returns once every rank is done.
+/// Hands out one item per entry of `index` (item i: part index[i]) to every rank's workers,
+/// largest part file first (once stitched, the input files are gone: then in part order);
+/// `here(i)` does one on this rank. Returns once every rank's workers are done.
 template <class Here>
 void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const std::size_t> index, Here here) {
   std::vector<std::uint64_t> costs;  // largest first, as tiles: none is left to end a step alone
@@ -145,7 +144,7 @@ void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const s
   WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(index.size()),
                         std::vector<std::uint8_t>(index.size(), 0));
   auto channel = cluster.share(&schedule, [](std::size_t) {});
-  run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t i) {
+  run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
     throw_if_interrupted("the seam pass");
     here(i);
   });
@@ -166,7 +165,7 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
     share_items(cluster, files, all, [&](std::size_t p) { here[p] = measurer.measure(p); });
     std::vector<double> lengths(all.size());
     for (std::size_t p = 0; p < all.size(); ++p) {
-      lengths[p] = here[p] ? *here[p] : length_from(take_result(files.beside(p, kLengthSuffix)));
+      lengths[p] = here[p] ? *here[p] : take_result(files.beside(p, kLengthSuffix), length_from);
     }
     return lengths;
   };
@@ -182,7 +181,7 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
         outcomes[i] = *here[i];
         continue;
       }
-      outcomes[i] = outcome_from(take_result(files.beside(level.parts_of_level()[i], kOutcomeSuffix)));
+      outcomes[i] = take_result(files.beside(level.parts_of_level()[i], kOutcomeSuffix), outcome_from);
       ++elsewhere;
     }
     log::debug("seam pass: level {}: {} of {} parts stitched by other ranks", level.level(), elsewhere, level.size());
@@ -218,7 +217,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     SeamPartFiles files(plan.dir, std::move(keys));
     if (measuring) {
       const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, run.blocks);
-      run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t p) {
+      run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t p) {
         throw_if_interrupted("the seam pass");
         // Written before the root hears that the part is done (the next request says so).
         write_file_atomically(files.beside(p, kLengthSuffix), length_json(measurer.measure(p)).dump());
@@ -229,7 +228,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     PartStitchRun level_run = run;
     level_run.source_sizes = plan.source_sizes;
     const LevelStitcher stitcher(plan.parts, plan.level, files, level_run);
-    run_workers(*channel, std::min(available_threads(), kMaxPartsInFlight), [&](std::size_t i) {
+    run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
       throw_if_interrupted("the seam pass");
       const PartOutcome outcome = stitcher.stitch(i);
       write_file_atomically(files.beside(stitcher.parts_of_level()[i], kOutcomeSuffix), outcome_json(outcome).dump());

@@ -152,10 +152,6 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   return out;
 }
 
-/// At most this many parts are cut out and stitched at a time, whatever the threads: their
-/// memory is what a level adds (the city's largest part with its surroundings: ~30 MB).
-constexpr unsigned kMaxPartsInFlight = 16;
-
 /// Stitches the parts of one level (run.run_level, or here), each part seeing the others of
 /// its level as they were before the level (never as stitched); the outcomes are summed in
 /// part order, so that the output is the same for any thread count, any number in flight and
@@ -281,7 +277,7 @@ std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level) {
   // Isolated workers: a thread waiting inside one part's parallel loops never starts another
   // part, so the parts in flight stay at most one per thread. One part's error stops the
   // others after their current part.
-  const unsigned workers = std::min(available_threads(), kMaxPartsInFlight);
+  const unsigned workers = std::min(available_threads(), kMaxSeamPartsInFlight);
   parallel_jobs(level.size(), workers, [&](std::size_t i) {
     throw_if_interrupted("the seam pass");
     outcomes[i] = level.stitch(i);

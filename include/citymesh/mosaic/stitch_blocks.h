@@ -164,6 +164,11 @@ class LevelStitcher {
   std::unique_ptr<Finder> finder_;
 };
 
+/// At most this many parts are cut out and stitched (or measured) at a time by one process,
+/// whatever its threads: their memory is what a level adds (the city's largest part with its
+/// surroundings: ~30 MB).
+inline constexpr unsigned kMaxSeamPartsInFlight = 16;
+
 /// Runs every part of the level on this process's threads, a few at a time (the default of
 /// PartStitchRun::run_level).
 std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level);
