@@ -81,60 +81,68 @@ namespace {
 /// along a row, per tile of its length, against one along a column.
 constexpr double kRowCutCost = 2.5;
 
-/// Splits `tiles` (indices into store.tiles) into `parts` subsets of about equal cost, appended
-/// to `out` in order: halves of the subset count, cut across the longer side of the tiles'
-/// extent (in grid cells), recursively. Compact subsets have short borders, and a subset redoes
-/// only the tiles across its border that it waits for.
-void bisect(const TileStore& store, std::vector<std::size_t> tiles, std::size_t parts,
-            std::vector<std::vector<std::size_t>>& out) {
-  if (parts == 1) {
-    std::sort(tiles.begin(), tiles.end());
-    out.push_back(std::move(tiles));
-    return;
+/// Of `tiles` (indices into store.tiles) split into `parts` subsets of about equal cost, the
+/// subset `wanted` (0-based): halves of the subset count, cut across the longer side of the
+/// tiles' extent (in grid cells, a row weighing kRowCutCost), recursively, following only the
+/// half that holds `wanted` (so that any subset count costs a few sorts of the tiles). Compact
+/// subsets have short borders, and a subset redoes only the tiles across its border that it
+/// waits for.
+std::vector<std::size_t> bisect(const TileStore& store, std::vector<std::size_t> tiles, std::size_t parts,
+                                std::size_t wanted) {
+  while (parts > 1 && !tiles.empty()) {
+    std::int64_t i0 = INT64_MAX, i1 = INT64_MIN, j0 = INT64_MAX, j1 = INT64_MIN;
+    double total = 0;
+    for (const std::size_t k : tiles) {
+      const TileKey key = store.tiles[k].key;
+      i0 = std::min<std::int64_t>(i0, key.i), i1 = std::max<std::int64_t>(i1, key.i);
+      j0 = std::min<std::int64_t>(j0, key.j), j1 = std::max<std::int64_t>(j1, key.j);
+      total += static_cast<double>(store.tiles[k].total());
+    }
+    // Between columns (sorted along i) when that cut is no longer than one between rows;
+    // whole cells of the other axis stay together, so the cut runs along a grid line where
+    // it can.
+    const bool along_i = kRowCutCost * static_cast<double>(i1 - i0 + 1) >= static_cast<double>(j1 - j0 + 1);
+    std::sort(tiles.begin(), tiles.end(), [&](std::size_t a, std::size_t b) {
+      const TileKey x = store.tiles[a].key, y = store.tiles[b].key;
+      return along_i ? x < y : std::pair(x.j, x.i) < std::pair(y.j, y.i);
+    });
+    const std::size_t first_parts = parts / 2;
+    const double target = total * static_cast<double>(first_parts) / static_cast<double>(parts);
+    // A tile goes to the first half when its cost's midpoint falls before the target.
+    std::size_t cut = 0;
+    double before = 0;
+    while (cut < tiles.size()) {
+      const auto cost = static_cast<double>(store.tiles[tiles[cut]].total());
+      if (before + cost / 2 > target) break;
+      before += cost;
+      ++cut;
+    }
+    const auto middle = tiles.begin() + static_cast<std::ptrdiff_t>(cut);
+    if (wanted < first_parts) {
+      tiles.erase(middle, tiles.end());
+      parts = first_parts;
+    } else {
+      tiles.erase(tiles.begin(), middle);
+      parts -= first_parts;
+      wanted -= first_parts;
+    }
   }
-  std::int64_t i0 = INT64_MAX, i1 = INT64_MIN, j0 = INT64_MAX, j1 = INT64_MIN;
-  double total = 0;
-  for (const std::size_t k : tiles) {
-    const TileKey key = store.tiles[k].key;
-    i0 = std::min<std::int64_t>(i0, key.i), i1 = std::max<std::int64_t>(i1, key.i);
-    j0 = std::min<std::int64_t>(j0, key.j), j1 = std::max<std::int64_t>(j1, key.j);
-    total += static_cast<double>(store.tiles[k].total());
-  }
-  // Along i when the extent is wider in i (ties: i, as the key order): whole cells of the
-  // other axis stay together, so the cut runs straight along a grid line where it can.
-  const bool along_i = tiles.empty() || kRowCutCost * static_cast<double>(i1 - i0 + 1) >= static_cast<double>(j1 - j0 + 1);
-  std::sort(tiles.begin(), tiles.end(), [&](std::size_t a, std::size_t b) {
-    const TileKey x = store.tiles[a].key, y = store.tiles[b].key;
-    return along_i ? x < y : std::pair(x.j, x.i) < std::pair(y.j, y.i);
-  });
-  const std::size_t first_parts = parts / 2;
-  const double target = total * static_cast<double>(first_parts) / static_cast<double>(parts);
-  // A tile goes to the first half when its cost's midpoint falls before the target.
-  std::size_t cut = 0;
-  double before = 0;
-  while (cut < tiles.size()) {
-    const auto cost = static_cast<double>(store.tiles[tiles[cut]].total());
-    if (before + cost / 2 > target) break;
-    before += cost;
-    ++cut;
-  }
-  const auto middle = tiles.begin() + static_cast<std::ptrdiff_t>(cut);
-  bisect(store, std::vector<std::size_t>(tiles.begin(), middle), first_parts, out);
-  bisect(store, std::vector<std::size_t>(middle, tiles.end()), parts - first_parts, out);
+  std::sort(tiles.begin(), tiles.end());
+  return tiles;
 }
 
 }  // namespace
 
-std::vector<std::vector<std::size_t>> all_subsets(const TileStore& store, std::size_t count) {
+std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset) {
   std::vector<std::size_t> tiles(store.tiles.size());
   for (std::size_t k = 0; k < tiles.size(); ++k) tiles[k] = k;
-  std::vector<std::vector<std::size_t>> out;
-  bisect(store, std::move(tiles), std::max<std::size_t>(count, 1), out);
-  return out;
+  return bisect(store, std::move(tiles), std::max<std::size_t>(subset.count, 1), subset.index - 1);
 }
 
-std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset) {
-  return all_subsets(store, subset.count)[subset.index - 1];
+std::vector<std::vector<std::size_t>> all_subsets(const TileStore& store, std::size_t count) {
+  std::vector<std::vector<std::size_t>> out;
+  for (std::size_t i = 1; i <= count; ++i) out.push_back(subset_tiles(store, {i, count}));
+  return out;
 }
 
 std::vector<std::size_t> with_dependencies(const TileStore& store, const std::vector<std::size_t>& tiles) {

@@ -52,7 +52,8 @@ struct Subset {
 /// empty when `count` exceeds the tiles.
 std::vector<std::vector<std::size_t>> all_subsets(const TileStore& store, std::size_t count);
 
-/// The tiles subset `subset` owns: all_subsets(store, subset.count)[subset.index - 1].
+/// The tiles subset `subset` owns: all_subsets(store, subset.count)[subset.index - 1],
+/// worked out alone (any subset count is cheap).
 std::vector<std::size_t> subset_tiles(const TileStore& store, const Subset& subset);
 
 /// `tiles` and every tile they wait for, transitively: what a subset must have before its

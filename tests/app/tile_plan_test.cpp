@@ -72,6 +72,9 @@ TEST(TilePlan, SubsetsSplitTheTilesOnceWithBalancedCost) {
     }
     for (std::size_t k = 0; k < owners.size(); ++k) EXPECT_EQ(owners[k], 1) << "tile " << k << " with " << n;
   }
+  // Any subset count is worked out alone, at once (no list of every subset is made).
+  const std::size_t huge = std::size_t{1} << 40;
+  EXPECT_LE(subset_tiles(store, {huge / 3, huge}).size(), 1u);
   // More subsets than tiles: some are empty, none overlaps.
   const std::size_t many = store.tiles.size() + 5;
   std::size_t covered = 0;
