@@ -261,11 +261,14 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   report["export"] = exported;
   report["per_tile"] = per_tile;
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
+  // Over a resumed run's time, the rate says nothing of the work the reused tiles took.
+  const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s", static_cast<double>(assembly.owned()) /
+                                                                                 std::max(wall, 1e-9) / 1e6)
+                                       : std::string("resumed: no rate");
   std::cout << fmt::format(
-      "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s "
-      "({:.2f} M triangles/s), {} rank(s), peak memory {:.0f} MiB (rank 0)\n",
-      store.tiles.size(), reused, assembly.owned(), output_triangles, wall,
-      static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6, ranks,
+      "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak memory "
+      "{:.0f} MiB (rank 0)\n",
+      store.tiles.size(), reused, assembly.owned(), output_triangles, wall, rate, ranks,
       static_cast<double>(peak_resident_bytes()) / (1 << 20));
 }
 
