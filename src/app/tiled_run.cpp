@@ -264,7 +264,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   // Over a resumed run's time, the rate says nothing of the work the reused tiles took.
   const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s", static_cast<double>(assembly.owned()) /
                                                                                  std::max(wall, 1e-9) / 1e6)
-                                       : std::string("resumed: no rate");
+                                       : std::string("no rate: tiles reused");
   std::cout << fmt::format(
       "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak memory "
       "{:.0f} MiB (rank 0)\n",
