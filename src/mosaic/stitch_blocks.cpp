@@ -52,6 +52,10 @@ const Box3d& box_for_level(const BlockPart& part, int level) {
   return part.key.level < level ? part.stitched_box : part.box;
 }
 
+}  // namespace
+
+namespace stitch_detail {
+
 /// Finds the parts whose boxes (as a level sees them) meet a box: the boxes are filed under
 /// every block cell they cover.
 class PartFinder {
@@ -101,6 +105,17 @@ class PartFinder {
   int level_;
   std::map<std::pair<std::int64_t, std::int64_t>, std::vector<std::uint32_t>> by_cell_;
 };
+
+}  // namespace stitch_detail
+
+using stitch_detail::PartFinder;
+
+namespace {
+
+/// How far around a part its surroundings reach: the run's, or the farthest its steps look.
+double part_context(const PartStitchRun& run) {
+  return run.blocks.context > 0 ? run.blocks.context : block_context(run.params);
+}
 
 /// Stitches a part cut out with its surroundings; throws ProcessingError if stitching
 /// changed them (they must come out first, unchanged, for the part to be taken back).
@@ -210,25 +225,22 @@ double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<
 
 }  // namespace
 
-struct BoundaryMeasurer::Finder {
-  PartFinder finder;
-};
-
 BoundaryMeasurer::BoundaryMeasurer(std::span<const BlockPart> parts, const PartStore& store, bool stitched,
                                    const BlockStitchParams& blocks)
     : parts_(parts),
       store_(store),
       stitched_(stitched),
       // As the last level sees them (all stitched) or as the first does (none).
-      finder_(std::make_unique<Finder>(Finder{PartFinder(parts, blocks, stitched ? kLevels : -1)})) {}
+      view_(stitched ? kLevels : -1),
+      finder_(std::make_unique<PartFinder>(parts, blocks, view_)) {}
 
 BoundaryMeasurer::~BoundaryMeasurer() = default;
 
 double BoundaryMeasurer::measure(std::size_t p) const {
-  const Box3d& box = box_for_level(parts_[p], stitched_ ? kLevels : -1);
+  const Box3d& box = box_for_level(parts_[p], view_);
   if (box.empty()) return 0.0;
   std::vector<std::shared_ptr<const KeyedPiece>> around;
-  for (const std::uint32_t q : finder_->finder.meeting(box, p)) around.push_back(store_.load(q, stitched_));
+  for (const std::uint32_t q : finder_->meeting(box, p)) around.push_back(store_.load(q, stitched_));
   return own_open_boundary(*store_.load(p, stitched_), around);
 }
 
@@ -250,17 +262,13 @@ double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& st
   return total;
 }
 
-struct LevelStitcher::Finder {
-  PartFinder finder;
-};
-
 LevelStitcher::LevelStitcher(std::span<const BlockPart> parts, int level, PartStore& store, const PartStitchRun& run)
     : parts_(parts),
       level_(level),
       store_(store),
       run_(run),
-      context_(run.blocks.context > 0 ? run.blocks.context : block_context(run.params)),
-      finder_(std::make_unique<Finder>(Finder{PartFinder(parts, run.blocks, level)})) {
+      context_(part_context(run)),
+      finder_(std::make_unique<PartFinder>(parts, run.blocks, level)) {
   for (std::size_t i = 0; i < parts.size(); ++i) {
     if (parts[i].key.level == level) of_level_.push_back(i);
   }
@@ -269,7 +277,7 @@ LevelStitcher::LevelStitcher(std::span<const BlockPart> parts, int level, PartSt
 LevelStitcher::~LevelStitcher() = default;
 
 PartOutcome LevelStitcher::stitch(std::size_t i) const {
-  return stitch_one(parts_, of_level_.at(i), level_, finder_->finder, store_, run_, context_);
+  return stitch_one(parts_, of_level_.at(i), level_, *finder_, store_, run_, context_);
 }
 
 std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level) {
@@ -314,8 +322,7 @@ double block_context(const StitchParams& params) {
 }
 
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run) {
-  const double context = run.blocks.context > 0 ? run.blocks.context : block_context(run.params);
-  check_block_layout(run.blocks, context);
+  check_block_layout(run.blocks, part_context(run));
   if (!std::is_sorted(parts.begin(), parts.end(), [](const BlockPart& a, const BlockPart& b) { return a.key < b.key; })) {
     throw ProcessingError("stitching block by block: the parts are not in key order");
   }

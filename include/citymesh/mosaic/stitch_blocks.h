@@ -109,6 +109,10 @@ struct BlockPart {
 
 class LevelStitcher;
 
+namespace stitch_detail {
+class PartFinder;  ///< which parts' boxes (as a level sees them) meet a box
+}  // namespace stitch_detail
+
 /// What stitching one part gives back.
 struct PartOutcome {
   StitchStats stats;
@@ -154,14 +158,13 @@ class LevelStitcher {
   [[nodiscard]] PartOutcome stitch(std::size_t i) const;
 
  private:
-  struct Finder;
   std::span<const BlockPart> parts_;
   int level_;
   PartStore& store_;
   const PartStitchRun& run_;
   double context_;
   std::vector<std::size_t> of_level_;
-  std::unique_ptr<Finder> finder_;
+  std::unique_ptr<stitch_detail::PartFinder> finder_;
 };
 
 /// At most this many parts are cut out and stitched (or measured) at a time by one process,
@@ -197,11 +200,11 @@ class BoundaryMeasurer {
   [[nodiscard]] double measure(std::size_t p) const;
 
  private:
-  struct Finder;
   std::span<const BlockPart> parts_;
   const PartStore& store_;
   bool stitched_;
-  std::unique_ptr<Finder> finder_;
+  int view_;  ///< the level whose view of the parts' boxes is measured
+  std::unique_ptr<stitch_detail::PartFinder> finder_;
 };
 
 /// Measures every part (measurer.measure(p) for each p, anywhere) and returns the lengths in
