@@ -7,6 +7,7 @@
 #include <atomic>
 #include <bit>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 
@@ -134,27 +135,32 @@ auto take_result(const std::filesystem::path& file, Decode decode) {
   }
 }
 
+/// This rank's workers on a step's channel: each item (a part) done by `body`, at most
+/// kMaxSeamPartsInFlight at a time, stopping between parts when interrupted.
+void run_part_workers(WorkChannel& channel, const std::function<void(std::size_t)>& body) {
+  run_workers(channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
+    throw_if_interrupted("the seam pass");
+    body(i);
+  });
+}
+
 /// Hands out one item per entry of `index` (item i: part index[i]) to every rank's workers,
 /// largest part file first (once stitched, the input files are gone: then in part order);
 /// `here(i)` does one on this rank. Returns once every rank's workers are done.
-template <class Here>
-void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const std::size_t> index, Here here) {
+void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const std::size_t> index,
+                 const std::function<void(std::size_t)>& here) {
   std::vector<std::uint64_t> costs;  // largest first, as tiles: none is left to end a step alone
   for (const std::size_t p : index) costs.push_back(files.input_bytes(p));
   WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(index.size()),
                         std::vector<std::uint8_t>(index.size(), 0));
   auto channel = cluster.share(&schedule, [](std::size_t) {});
-  run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
-    throw_if_interrupted("the seam pass");
-    here(i);
-  });
+  run_part_workers(*channel, here);
 }
 
 }  // namespace
 
-SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files,
-                             std::span<const std::uint64_t> source_sizes) {
-  const std::vector<std::uint64_t> sizes(source_sizes.begin(), source_sizes.end());
+SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files) {
+  const std::vector<std::uint64_t> sizes = files.source_sizes();
   SeamPassWork work;
   work.measure_parts = [&config, &cluster, &files, sizes](const BoundaryMeasurer& measurer) {
     const StepPlan plan{files.dir(), "measure", 0, measurer.stitched(), {measurer.parts().begin(), measurer.parts().end()}, sizes};
@@ -196,11 +202,6 @@ void remove_seam_plan(const Config& config) {
 }
 
 void help_seam_pass(const Config& config, Cluster& cluster) {
-  const PartStitchRun run{.params = stitch_params(config),
-                          .blocks = tile_grid_blocks(config),
-                          .source_sizes = {},
-                          .frame = std::nullopt,
-                          .run_level = {}};
   std::atomic<std::size_t> stitched = 0, measured = 0;
   // The root's steps: the boundary measured, the levels stitched, the boundary measured again.
   for (int step = 0; step < kBlockStitchLevels + 2; ++step) {
@@ -215,21 +216,23 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     std::vector<BlockPartKey> keys;
     for (const BlockPart& p : plan.parts) keys.push_back(p.key);
     SeamPartFiles files(plan.dir, std::move(keys));
+    // Each part's result is written before the root hears that the part is done (the
+    // worker's next request says so).
     if (measuring) {
-      const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, run.blocks);
-      run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t p) {
-        throw_if_interrupted("the seam pass");
-        // Written before the root hears that the part is done (the next request says so).
+      const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, tile_grid_blocks(config));
+      run_part_workers(*channel, [&](std::size_t p) {
         write_file_atomically(files.beside(p, kLengthSuffix), length_json(measurer.measure(p)).dump());
         ++measured;
       });
       continue;
     }
-    PartStitchRun level_run = run;
-    level_run.source_sizes = plan.source_sizes;
-    const LevelStitcher stitcher(plan.parts, plan.level, files, level_run);
-    run_workers(*channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
-      throw_if_interrupted("the seam pass");
+    const PartStitchRun run{.params = stitch_params(config),
+                            .blocks = tile_grid_blocks(config),
+                            .source_sizes = plan.source_sizes,
+                            .frame = std::nullopt,
+                            .run_level = {}};
+    const LevelStitcher stitcher(plan.parts, plan.level, files, run);
+    run_part_workers(*channel, [&](std::size_t i) {
       const PartOutcome outcome = stitcher.stitch(i);
       write_file_atomically(files.beside(stitcher.parts_of_level()[i], kOutcomeSuffix), outcome_json(outcome).dump());
       ++stitched;

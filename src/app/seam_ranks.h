@@ -5,8 +5,6 @@
 // folder on the shared filesystem.
 #pragma once
 
-#include <span>
-
 #include "citymesh/config/config.h"
 #include "citymesh/mosaic/stitch_blocks.h"
 #include "cluster.h"
@@ -18,9 +16,8 @@ namespace citymesh::app {
 /// On the root: the seam pass's work shared with every rank. Each step (the open boundary
 /// measured, each level stitched, the boundary measured again) writes its plan to the work
 /// folder and hands its parts out (collective: the other ranks are in help_seam_pass()).
-/// `files` and `cluster` must outlive it.
-SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files,
-                             std::span<const std::uint64_t> source_sizes);
+/// `files` (with the sources' sizes clipping ranks by) and `cluster` must outlive it.
+SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamPartFiles& files);
 
 /// Removes the plan share_seam_pass() left in the work folder, once the pass is done.
 void remove_seam_plan(const Config& config);

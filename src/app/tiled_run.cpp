@@ -119,7 +119,7 @@ class FinalOutput {
       const bool shared = cluster_ != nullptr && cluster_->size() > 1;
       nlohmann::json figures = stitch_parts_and_report(
           config_, parts_, *seams_, seams_->source_sizes(),
-          shared ? share_seam_pass(config_, *cluster_, *seams_, seams_->source_sizes()) : SeamPassWork{});
+          shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{});
       if (shared) remove_seam_plan(config_);
       // The outputs read the stitched output one grid tile at a time.
       leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
