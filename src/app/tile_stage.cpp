@@ -93,6 +93,13 @@ SettledSelection settled_selection(const Config& config, const TileStore& store,
   return settled;
 }
 
+/// Whether tile `key` has a finished result made with `fingerprint`: complete (the checksum
+/// covers the whole file) and decodable, its consistent pairs left undecoded (the largest
+/// section, which only the labelled PLYs read).
+bool has_finished_result(const Config& config, const TileStore& store, TileKey key, std::uint64_t fingerprint) {
+  return read_tile_result(result_path(config, key), fingerprint, store, {.pairs = false}).has_value();
+}
+
 /// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
 WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::uint64_t fingerprint,
                            const std::vector<std::size_t>& tiles, std::span<const std::uint8_t> theirs) {
@@ -109,7 +116,7 @@ WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::ui
       positions.push_back(static_cast<std::size_t>(it - tiles.begin()));
     }
     after.push_back(std::move(positions));
-    done.push_back(read_tile_result(result_path(config, store.tiles[k].key), fingerprint, store) ? 1 : 0);
+    done.push_back(has_finished_result(config, store, store.tiles[k].key, fingerprint) ? 1 : 0);
   }
   return WorkSchedule(tile_priorities(store, tiles, theirs), after, done);
 }
@@ -162,7 +169,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
     throw_if_interrupted("tile processing");
-    if (!theirs.empty() && theirs[k] != 0 && read_tile_result(result_path(config, tile.key), fingerprint, store)) {
+    if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, fingerprint)) {
       finished_elsewhere[item] = 1;  // its owner made it while this process did its own
       return;
     }
