@@ -6,9 +6,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <set>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "tileset_json.h"
@@ -133,8 +135,10 @@ DracoEncodeParams shared_lattice(const Box3d& box, const TilesetExportParams& pa
   const double levels = range / (2 * params.tolerance);
   const int bits = std::max(1, static_cast<int>(std::ceil(std::log2(levels + 1))));
   if (bits > 30) {
-    throw ConfigError(fmt::format("output.draco_tolerance {} m is too fine for an output {} m across "
-                                  "(Draco quantizes to at most 30 bits)", params.tolerance, range));
+    throw ConfigError(
+        fmt::format("output.draco_tolerance {} m is too fine for an output {} m across "
+                    "(Draco quantizes to at most 30 bits)",
+                    params.tolerance, range));
   }
   DracoEncodeParams draco;
   draco.position_bits = bits;
@@ -176,18 +180,39 @@ std::vector<TileKey> leaf_keys(const Mesh& mesh, const TileGrid& grid) {
 
 namespace {
 
+/// Writes tiles' glb files into an export's staging folder.
+class TileWriter {
+ public:
+  TileWriter(const TilesetFrame& frame, const TilesetExportParams& params)
+      : glb_{.draco = params.draco, .draco_params = frame.lattice, .acquisitions = params.acquisitions},
+        staged_(staging_directory(params.dir)) {}
+
+  /// Writes `node`'s tile (none when it has no triangles); returns its bytes.
+  std::uint64_t write(const TileNode& node) const {
+    if (node.mesh.triangles.empty()) return 0;
+    const TileMesh& m = node.mesh;
+    const std::vector<std::uint8_t> content =
+        write_glb({m.positions, m.triangles, feature_ids(m), m.intensities, m.colors}, glb_);
+    write_file_atomically(staged_ / (node.name() + ".glb"),
+                          {reinterpret_cast<const char*>(content.data()), content.size()});
+    return content.size();
+  }
+
+ private:
+  GlbParams glb_;
+  std::filesystem::path staged_;
+};
+
 /// Builds the tree with `build` (given the sink that writes each tile) and writes the tileset:
 /// the glb of every tile as the tree hands it over, then the JSON files.
-TilesetExportStats write_tileset(const Geodetic& origin, const DracoEncodeParams& lattice,
-                                 const TilesetExportParams& params,
+TilesetExportStats write_tileset(const TilesetFrame& frame, const TilesetExportParams& params,
                                  const std::function<TileTree(const TileNodeSink&)>& build) {
   Stopwatch clock;
   TilesetExportStats stats;
-  stats.origin = origin;
-  const EnuFrame frame(origin);
-  const GlbParams glb{.draco = params.draco, .draco_params = lattice, .acquisitions = params.acquisitions};
-  const double step = static_cast<double>(glb.draco_params.lattice->range) /
-                      static_cast<double>((std::uint64_t{1} << glb.draco_params.position_bits) - 1);
+  stats.origin = frame.origin;
+  const EnuFrame enu(frame.origin);
+  const double step = static_cast<double>(frame.lattice.lattice->range) /
+                      static_cast<double>((std::uint64_t{1} << frame.lattice.position_bits) - 1);
   const std::filesystem::path staged = staging_directory(params.dir);
   std::error_code ec;
   std::filesystem::remove_all(staged, ec);
@@ -195,18 +220,10 @@ TilesetExportStats write_tileset(const Geodetic& origin, const DracoEncodeParams
   if (ec) throw OutputError(fmt::format("{}: cannot create the folder: {}", staged.string(), ec.message()));
   // Each tile is written as soon as the tree is done with it, and its mesh freed: holding
   // every tile until the last was built was the peak of a city's final pass.
+  const TileWriter writer(frame, params);
   std::atomic<std::uint64_t> glb_bytes{0};
-  const auto write_tile = [&](const TileNode& node) {
-    if (node.mesh.triangles.empty()) return;
-    const TileMesh& m = node.mesh;
-    const std::vector<std::uint8_t> content =
-        write_glb({m.positions, m.triangles, feature_ids(m), m.intensities, m.colors}, glb);
-    write_file_atomically(staged / (node.name() + ".glb"),
-                          {reinterpret_cast<const char*>(content.data()), content.size()});
-    glb_bytes += content.size();
-  };
-  const TileTree tree = build(write_tile);
-  const auto files = tileset_json_files(tree, {.transform = frame.to_ecef_matrix(),
+  const TileTree tree = build([&](const TileNode& node) { glb_bytes += writer.write(node); });
+  const auto files = tileset_json_files(tree, {.transform = enu.to_ecef_matrix(),
                                                .max_tiles_per_file = params.max_tiles_per_file,
                                                .box_margin = step,
                                                .min_half_extent = 0.01});
@@ -224,10 +241,23 @@ TilesetExportStats write_tileset(const Geodetic& origin, const DracoEncodeParams
     }
   }
   stats.glb_bytes = glb_bytes.load();
-  stats.position_bits = glb.draco_params.position_bits;
+  stats.position_bits = frame.lattice.position_bits;
   stats.quantization_step = step;
   stats.seconds = clock.seconds();
   return stats;
+}
+
+LocalMapping local_mapping(const Crs& crs, const EnuFrame& frame) {
+  return [&crs, &frame](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
+}
+
+/// Every cell built here, on the pool's threads.
+std::vector<ExportedCell> cells_here(std::size_t count, const std::function<ExportedCell(std::size_t)>& here) {
+  std::vector<ExportedCell> out(count);
+  parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) out[c] = here(c);
+  });
+  return out;
 }
 
 }  // namespace
@@ -243,23 +273,23 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
   const EnuFrame frame(origin);
   // The positions in the local frame live only while the split copies them.
   const SplitMesh split = split_by_source(mesh, source.source_acq, local_positions(mesh, source.crs, frame));
-  TilesetExportStats stats =
-      write_tileset(origin, shared_lattice(positions_box(split.vertices.positions), params), params,
-                    [&](const TileNodeSink& sink) {
-                      return build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)),
-                                             params.tree, sink);
-                    });
+  TilesetExportStats stats = write_tileset(
+      {origin, shared_lattice(positions_box(split.vertices.positions), params)}, params, [&](const TileNodeSink& sink) {
+        return build_tile_tree(split.vertices, split.triangles, leaf_keys(mesh, TileGrid(params.grid)), params.tree,
+                               sink);
+      });
   stats.seconds = clock.seconds();
   return stats;
 }
 
-TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params) {
+TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params,
+                                  const ExportCells& cells) {
   Stopwatch clock;
   const std::vector<TileKey> keys = leaves.keys();
   if (keys.empty()) throw ProcessingError("3D Tiles: the output has no triangles to export");
   const Geodetic origin = crs.to_geodetic(frame_origin(leaves.box()));
-  const EnuFrame frame(origin);
-  const LocalMapping to_local = [&](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
+  const EnuFrame enu(origin);
+  const LocalMapping to_local = local_mapping(crs, enu);
   // The lattice must hold every vertex in the local frame, whose box only the leaves know: one
   // pass over them first, a leaf at a time.
   std::vector<Box3d> boxes(keys.size());
@@ -268,12 +298,51 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
   });
   Box3d box;
   for (const Box3d& b : boxes) box.extend(b);
-  TilesetExportStats stats =
-      write_tileset(origin, shared_lattice(box, params), params, [&](const TileNodeSink& sink) {
-        return build_tile_tree(keys, [&](const TileKey& key) { return leaves.leaf(key, to_local); }, params.tree, sink);
-      });
+  log::debug("3D Tiles: {} leaves mapped to the local frame in {:.2f} s", keys.size(), clock.seconds());
+  const TilesetFrame frame{origin, shared_lattice(box, params)};
+  std::uint64_t cell_bytes = 0;
+  TilesetExportStats stats = write_tileset(frame, params, [&](const TileNodeSink& sink) {
+    const LeafSource source = [&](const TileKey& key) { return leaves.leaf(key, to_local); };
+    std::set<std::pair<int, TileKey>> written;  // the cells' open nodes: export_cell wrote them
+    const TileNodeSink unless_written = [&](const TileNode& node) {
+      if (!written.contains({node.level, node.key})) sink(node);
+    };
+    const TileTreeBuild tree(keys, source, params.tree, unless_written);
+    const std::function<ExportedCell(std::size_t)> here = [&](std::size_t c) {
+      return export_cell(leaves, crs, frame, params, c);
+    };
+    Stopwatch cells_clock;
+    std::vector<ExportedCell> built = cells ? cells(frame, tree, here) : cells_here(tree.cell_count(), here);
+    log::debug("3D Tiles: {} cells built in {:.2f} s", built.size(), cells_clock.seconds());
+    std::vector<TileSubtree> subtrees;
+    for (ExportedCell& e : built) {
+      const TileNode& open = e.subtree.nodes.at(e.subtree.open);
+      written.emplace(open.level, open.key);
+      cell_bytes += e.glb_bytes;
+      subtrees.push_back(std::move(e.subtree));
+    }
+    return tree.finish(std::move(subtrees));
+  });
+  stats.glb_bytes += cell_bytes;
   stats.seconds = clock.seconds();
   return stats;
+}
+
+ExportedCell export_cell(const TilesetLeaves& leaves, const Crs& crs, const TilesetFrame& frame,
+                         const TilesetExportParams& params, std::size_t cell) {
+  const EnuFrame enu(frame.origin);
+  const LocalMapping to_local = local_mapping(crs, enu);
+  const TileWriter writer(frame, params);
+  std::atomic<std::uint64_t> bytes{0};
+  const TileNodeSink sink = [&](const TileNode& node) { bytes += writer.write(node); };
+  const LeafSource source = [&](const TileKey& key) { return leaves.leaf(key, to_local); };
+  const std::vector<TileKey> keys = leaves.keys();
+  const TileTreeBuild tree(keys, source, params.tree, sink);
+  ExportedCell out{tree.build_cell(cell), 0};
+  // The open node's mesh is final too (the levels above only read it): written here, where
+  // the cell is built, rather than by the process that builds the levels above.
+  out.glb_bytes = bytes.load() + writer.write(out.subtree.nodes.at(out.subtree.open));
+  return out;
 }
 
 Box3d TilesetLeaves::local_box(const TileKey& key, const LocalMapping& to_local) const {
@@ -289,8 +358,8 @@ TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {
 
 TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
   if (local.size() != piece.vertex_count())
-    throw ProcessingError(fmt::format("3D Tiles: {} mapped positions for a piece of {} vertices", local.size(),
-                                      piece.vertex_count()));
+    throw ProcessingError(
+        fmt::format("3D Tiles: {} mapped positions for a piece of {} vertices", local.size(), piece.vertex_count()));
   // One tile vertex per (vertex, feature) the triangles draw: a vertex shared by two sources
   // is drawn twice, each with its own feature id.
   std::vector<TileVertexKey> keys;
@@ -317,7 +386,8 @@ TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
   for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
     const std::uint16_t f = feature_of(piece.source_acq[t]);
     const Triangle& tri = piece.triangles[t];
-    m.triangles.push_back({index({piece.keys[tri[0]], f}), index({piece.keys[tri[1]], f}), index({piece.keys[tri[2]], f})});
+    m.triangles.push_back(
+        {index({piece.keys[tri[0]], f}), index({piece.keys[tri[1]], f}), index({piece.keys[tri[2]], f})});
   }
   return m;
 }

@@ -91,7 +91,8 @@ TileMesh merge(std::span<const TileMesh* const> meshes) {
   TileMesh out;
   for (const auto& [m, v] : source) out.append_vertex(*m, v);
   for (std::size_t k = 0; k < meshes.size(); ++k) {
-    for (const Triangle& t : meshes[k]->triangles) out.triangles.push_back({index[k][t[0]], index[k][t[1]], index[k][t[2]]});
+    for (const Triangle& t : meshes[k]->triangles)
+      out.triangles.push_back({index[k][t[0]], index[k][t[1]], index[k][t[2]]});
   }
   return out;
 }
@@ -160,7 +161,8 @@ void build_parent(const TreeBuild& b, std::span<const TileNode> nodes, TileNode&
     if (simplified.triangles.size() <= params.max_parent_triangles) break;
     looser.sloppy = sloppy;
     if (sloppy) looser.max_error_fraction = 1.0;
-    const std::vector<std::uint8_t> seams = sloppy ? std::vector<std::uint8_t>{} : shared_with_neighbours(b, parent, whole);
+    const std::vector<std::uint8_t> seams =
+        sloppy ? std::vector<std::uint8_t>{} : shared_with_neighbours(b, parent, whole);
     const std::size_t before = simplified.triangles.size();
     simplified = simplify_mesh(whole.positions, whole.triangles, looser, seams);
     log::debug("3D Tiles: {} of {} triangles past the cap of {}: {} -> {} triangles {}", parent.name(),
@@ -192,7 +194,6 @@ constexpr double kMaxSingleChildShare = 0.5;
 /// mesh simplifies the same way).
 bool settled_alone(const Group& g) { return g.size() == 1 && g[0].alone_is_final; }
 
-
 /// What the tree subtracts from the leaf keys. Halving never brings a negative key and a
 /// non-negative one together (-1 stays -1, 0 stays 0), so an axis whose keys have both signs
 /// (a grid origin inside the output) is counted from its smallest key; otherwise the keys are
@@ -207,10 +208,12 @@ TileKey key_offset(std::span<const TileKey> leaf_keys) {
     hi_j = std::max<std::int64_t>(hi_j, k.j);
   }
   if (hi_i - lo_i > INT32_MAX || hi_j - lo_j > INT32_MAX) {
-    throw ProcessingError(fmt::format("3D Tiles: the output spans more than 2^31 grid tiles ({} x {})",
-                                      hi_i - lo_i + 1, hi_j - lo_j + 1));
+    throw ProcessingError(fmt::format("3D Tiles: the output spans more than 2^31 grid tiles ({} x {})", hi_i - lo_i + 1,
+                                      hi_j - lo_j + 1));
   }
-  const auto from = [](std::int64_t lo, std::int64_t hi) { return lo < 0 && hi >= 0 ? static_cast<std::int32_t>(lo) : 0; };
+  const auto from = [](std::int64_t lo, std::int64_t hi) {
+    return lo < 0 && hi >= 0 ? static_cast<std::int32_t>(lo) : 0;
+  };
   return {from(lo_i, hi_i), from(lo_j, hi_j)};
 }
 
@@ -265,8 +268,8 @@ OpenNode settle(const TreeBuild& b, std::vector<TileNode>& nodes, const Group& g
 /// The subtree of the cell `key` at `level` holding the leaves `leaves` (ascending), depth
 /// first: each quarter's subtree is finished, and its nodes handed over, before the next one
 /// is read. Appends its nodes to `nodes` (children first) and returns the node left open.
-OpenNode build_cell(const TreeBuild& b, std::span<const std::uint32_t> leaves, int level, TileKey key,
-                    std::vector<TileNode>& nodes) {
+OpenNode build_cell_tree(const TreeBuild& b, std::span<const std::uint32_t> leaves, int level, TileKey key,
+                         std::vector<TileNode>& nodes) {
   if (level == 0) {
     nodes.push_back(make_leaf(b, leaves[0]));
     return {static_cast<std::uint32_t>(nodes.size() - 1), key, false};
@@ -281,7 +284,7 @@ OpenNode build_cell(const TreeBuild& b, std::span<const std::uint32_t> leaves, i
   for (const std::vector<std::uint32_t>& q : quarters) {
     if (q.empty()) continue;
     const TileKey leaf = b.leaves[q[0]];
-    members.push_back(build_cell(b, q, level - 1, {leaf.i >> (level - 1), leaf.j >> (level - 1)}, nodes));
+    members.push_back(build_cell_tree(b, q, level - 1, {leaf.i >> (level - 1), leaf.j >> (level - 1)}, nodes));
   }
   return settle(b, nodes, members, level, key);
 }
@@ -292,7 +295,7 @@ std::vector<OpenNode> add_level(const TreeBuild& b, TileTree& tree, std::span<co
   std::map<TileKey, Group> groups;
   for (const OpenNode& o : open) groups[{o.key.i >> 1, o.key.j >> 1}].push_back(o);
   const std::vector<std::pair<TileKey, Group>> listed(std::make_move_iterator(groups.begin()),
-                                                       std::make_move_iterator(groups.end()));
+                                                      std::make_move_iterator(groups.end()));
   std::vector<std::optional<TileNode>> parents(listed.size());
   parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
@@ -344,33 +347,82 @@ DepthFirstCells depth_first_cells(std::span<const TileKey> leaves, int top, std:
 
 }  // namespace
 
-TileTree build_tile_tree(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
-                         const TileNodeSink& sink) {
-  TileTree tree;
-  if (leaves.empty()) return tree;
-  const TileKey offset = key_offset(leaves);
-  TreeBuild b{.leaves = {}, .offset = offset, .source = source, .params = params, .sink = sink};
-  for (const TileKey& k : leaves) b.leaves.push_back({k.i - offset.i, k.j - offset.j});
-  const auto [split, listed] =
+struct TileTreeBuild::State {
+  TreeBuild b;
+  int split = 0;  ///< the level of the cells' tops
+  std::vector<std::pair<TileKey, std::vector<std::uint32_t>>> cells;
+};
+
+TileTreeBuild::TileTreeBuild(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
+                             const TileNodeSink& sink)
+    : state_(std::make_unique<State>(
+          State{.b = {.leaves = {}, .offset = key_offset(leaves), .source = source, .params = params, .sink = sink},
+                .split = 0,
+                .cells = {}})) {
+  TreeBuild& b = state_->b;
+  for (const TileKey& k : leaves) b.leaves.push_back({k.i - b.offset.i, k.j - b.offset.j});
+  if (b.leaves.empty()) return;
+  auto [split, listed] =
       depth_first_cells(b.leaves, top_level(b.leaves), std::max<std::size_t>(params.depth_first_cells, 1));
-  // Below `split`, cell by cell in parallel; each cell's nodes are then appended in key order.
-  std::vector<std::vector<TileNode>> subtrees(listed.size());
-  std::vector<OpenNode> open(listed.size());
-  parallel_for_blocks(listed.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) open[c] = build_cell(b, listed[c].second, split, listed[c].first, subtrees[c]);
-  });
-  for (std::size_t c = 0; c < listed.size(); ++c) {
+  state_->split = split;
+  state_->cells = std::move(listed);
+}
+
+TileTreeBuild::~TileTreeBuild() = default;
+
+std::size_t TileTreeBuild::cell_count() const { return state_->cells.size(); }
+
+std::vector<TileKey> TileTreeBuild::cell_leaves(std::size_t c) const {
+  const TreeBuild& b = state_->b;
+  std::vector<TileKey> out;
+  for (const std::uint32_t leaf : state_->cells.at(c).second) {
+    out.push_back({b.leaves[leaf].i + b.offset.i, b.leaves[leaf].j + b.offset.j});
+  }
+  return out;
+}
+
+TileSubtree TileTreeBuild::build_cell(std::size_t c) const {
+  const auto& [key, leaves] = state_->cells.at(c);
+  TileSubtree out;
+  const OpenNode open = build_cell_tree(state_->b, leaves, state_->split, key, out.nodes);
+  out.open = open.node;
+  out.open_is_final = open.alone_is_final;
+  return out;
+}
+
+TileTree TileTreeBuild::finish(std::vector<TileSubtree> cells) const {
+  const TreeBuild& b = state_->b;
+  TileTree tree;
+  if (b.leaves.empty()) return tree;
+  if (cells.size() != state_->cells.size()) {
+    throw ProcessingError(fmt::format("3D Tiles: {} subtrees for {} cells", cells.size(), state_->cells.size()));
+  }
+  // Each cell's nodes appended in key order.
+  std::vector<OpenNode> open;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
     const auto at = static_cast<std::uint32_t>(tree.nodes.size());
-    for (TileNode& node : subtrees[c]) {
+    if (cells[c].open >= cells[c].nodes.size())
+      throw ProcessingError("3D Tiles: a subtree's open node is not one of its nodes");
+    for (TileNode& node : cells[c].nodes) {
       for (std::uint32_t& child : node.children) child += at;
       tree.nodes.push_back(std::move(node));
     }
-    open[c].node += at;
+    open.push_back({cells[c].open + at, state_->cells[c].first, cells[c].open_is_final});
   }
-  // Above it, level by level.
-  for (int level = split + 1; open.size() > 1; ++level) open = add_level(b, tree, open, level);
+  // Above them, level by level.
+  for (int level = state_->split + 1; open.size() > 1; ++level) open = add_level(b, tree, open, level);
   hand_over(b, tree.nodes[open[0].node]);
   return tree;
+}
+
+TileTree build_tile_tree(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
+                         const TileNodeSink& sink) {
+  const TileTreeBuild build(leaves, source, params, sink);
+  std::vector<TileSubtree> cells(build.cell_count());
+  parallel_for_blocks(cells.size(), 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t c = begin; c < end; ++c) cells[c] = build.build_cell(c);
+  });
+  return build.finish(std::move(cells));
 }
 
 TileTree build_tile_tree(const TilesetVertices& vertices, std::span<const Triangle> triangles,

@@ -4,6 +4,8 @@
 // Reference ECEF position computed with PROJ 9.1.1 (Debian proj-bin):
 //   echo "651070 6860700 50" | cs2cs -f %.6f EPSG:2154 EPSG:4978
 //   -> 4202017.855690 171215.722181 4779232.622308
+#include "citymesh/tiles3d/export.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,7 +19,6 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/encode/glb.h"
 #include "citymesh/tiles3d/check.h"
-#include "citymesh/tiles3d/export.h"
 #include "grid_triangles.h"
 #include "test_support.h"
 
@@ -195,7 +196,8 @@ TEST(TilesetExport, RootTransformPutsAKnownPointWhereProjDoes) {
   // kKnownPoint is vertex (70, 100): tile (651070 / 25, 6860700 / 25) = (26042, 274428), or
   // its neighbour below when the triangles around it have their centroids there.
   double best = 1e9;
-  for (const char* name : {"t0_26042_274428.glb", "t0_26042_274427.glb", "t0_26041_274428.glb", "t0_26041_274427.glb"}) {
+  for (const char* name :
+       {"t0_26042_274428.glb", "t0_26042_274427.glb", "t0_26041_274428.glb", "t0_26041_274427.glb"}) {
     const DecodedMesh d = decode(tmp / "tiles" / name);
     for (const Vec3f& p : d.positions) {
       const Vec3d l(p);
@@ -209,7 +211,8 @@ TEST(TilesetExport, RootTransformPutsAKnownPointWhereProjDoes) {
 
 std::map<std::string, std::string> folder_bytes(const std::filesystem::path& dir) {
   std::map<std::string, std::string> out;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) out[e.path().filename().string()] = test::read_text(e.path());
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    out[e.path().filename().string()] = test::read_text(e.path());
   return out;
 }
 
@@ -273,15 +276,16 @@ class SceneLeaves final : public TilesetLeaves {
   [[nodiscard]] TileMesh leaf(const TileKey& key, const LocalMapping& to_local) const override {
     KeyedPiece p;
     const std::vector<std::uint32_t>& ts = by_leaf_.at(key);
-    for (const std::uint32_t t : ts) p.keys.insert(p.keys.end(), scene_.mesh.triangles[t].begin(), scene_.mesh.triangles[t].end());
+    for (const std::uint32_t t : ts)
+      p.keys.insert(p.keys.end(), scene_.mesh.triangles[t].begin(), scene_.mesh.triangles[t].end());
     std::sort(p.keys.begin(), p.keys.end());
     p.keys.erase(std::unique(p.keys.begin(), p.keys.end()), p.keys.end());
     for (const std::uint64_t v : p.keys) p.positions.push_back(scene_.mesh.world_position(static_cast<std::size_t>(v)));
     for (const std::uint32_t t : ts) {
       Triangle tri{};
       for (std::size_t k = 0; k < 3; ++k) {
-        tri[k] = static_cast<std::uint32_t>(std::lower_bound(p.keys.begin(), p.keys.end(), scene_.mesh.triangles[t][k]) -
-                                            p.keys.begin());
+        tri[k] = static_cast<std::uint32_t>(
+            std::lower_bound(p.keys.begin(), p.keys.end(), scene_.mesh.triangles[t][k]) - p.keys.begin());
       }
       p.triangles.push_back(tri);
       p.ids.push_back({});
@@ -302,10 +306,38 @@ TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
   test::TempDir tmp;
   const Scene s = scene();
   const TilesetExportStats whole = export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "whole"));
-  const TilesetExportStats leaves = export_tileset(SceneLeaves(s, params(tmp.path()).grid), lambert93(), params(tmp / "leaves"));
+  const TilesetExportStats leaves =
+      export_tileset(SceneLeaves(s, params(tmp.path()).grid), lambert93(), params(tmp / "leaves"));
   EXPECT_EQ(leaves.tiles, whole.tiles);
   EXPECT_EQ(leaves.all_triangles, whole.all_triangles);
   const auto a = folder_bytes(tmp / "whole"), b = folder_bytes(tmp / "leaves");
+  EXPECT_EQ(a.size(), b.size());
+  EXPECT_TRUE(a == b);
+}
+
+TEST(TilesetExport, CellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {
+  // As an MPI job's ranks do: each cell built from a source and a frame of its own, last cell
+  // first; the exporting process builds only the levels above them.
+  test::TempDir tmp;
+  const Scene s = scene();
+  const SceneLeaves leaves(s, params(tmp.path()).grid);
+  const TilesetExportStats here = export_tileset(leaves, lambert93(), params(tmp / "here"));
+  std::size_t cells = 0;
+  const ExportCells elsewhere = [&](const TilesetFrame& frame, const TileTreeBuild& tree,
+                                    const std::function<ExportedCell(std::size_t)>& /*here*/) {
+    const SceneLeaves other(s, params(tmp.path()).grid);
+    const TilesetFrame copied = frame;
+    std::vector<ExportedCell> out(tree.cell_count());
+    for (std::size_t c = out.size(); c-- > 0;)
+      out[c] = export_cell(other, lambert93(), copied, params(tmp / "apart"), c);
+    cells = out.size();
+    return out;
+  };
+  const TilesetExportStats apart = export_tileset(leaves, lambert93(), params(tmp / "apart"), elsewhere);
+  EXPECT_GE(cells, 4u);
+  EXPECT_EQ(apart.tiles, here.tiles);
+  EXPECT_EQ(apart.glb_bytes, here.glb_bytes);
+  const auto a = folder_bytes(tmp / "here"), b = folder_bytes(tmp / "apart");
   EXPECT_EQ(a.size(), b.size());
   EXPECT_TRUE(a == b);
 }

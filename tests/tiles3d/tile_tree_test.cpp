@@ -1,8 +1,11 @@
 // SPDX-License-Identifier: MIT
 // The level-of-detail tree: every triangle in one leaf, parents after their children, and no
 // parent that merely repeats its only child.
+#include "citymesh/tiles3d/tile_tree.h"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -10,7 +13,7 @@
 #include <set>
 #include <string>
 
-#include "citymesh/tiles3d/tile_tree.h"
+#include "citymesh/core/error.h"
 #include "grid_triangles.h"
 
 namespace citymesh {
@@ -35,7 +38,8 @@ struct Input {
   void add_wavy_grid(TileKey key, float x0, int n) {
     const auto base = static_cast<std::uint32_t>(vertices.positions.size());
     for (int i = 0; i <= n; ++i) {
-      for (int j = 0; j <= n; ++j) add_vertex({x0 + float(i), float(j), 0.4f * std::sin(1.3f * float(i)) * std::cos(0.9f * float(j))});
+      for (int j = 0; j <= n; ++j)
+        add_vertex({x0 + float(i), float(j), 0.4f * std::sin(1.3f * float(i)) * std::cos(0.9f * float(j))});
     }
     for (const Triangle& t : test::grid_triangles(n)) add({t[0] + base, t[1] + base, t[2] + base}, key);
   }
@@ -206,6 +210,84 @@ TEST(TileTree, DepthFirstCellsGiveTheSameTilesAsLevelByLevel) {
     EXPECT_EQ(view_of(tree), expected) << "depth_first_cells " << cells;
     EXPECT_EQ(tree.root().name(), reference.root().name());
   }
+}
+
+/// Each leaf's mesh as build_tile_tree(vertices, ...) makes it: its triangles' vertices
+/// ascending, keyed by their index in the buffer.
+LeafSource leaf_source(const Input& in) {
+  return [&in](const TileKey& key) {
+    std::vector<Triangle> own;
+    std::vector<std::uint32_t> used;
+    for (std::size_t t = 0; t < in.triangles.size(); ++t) {
+      if (in.keys[t] != key) continue;
+      own.push_back(in.triangles[t]);
+      used.insert(used.end(), in.triangles[t].begin(), in.triangles[t].end());
+    }
+    std::sort(used.begin(), used.end());
+    used.erase(std::unique(used.begin(), used.end()), used.end());
+    TileMesh m;
+    for (const std::uint32_t v : used) {
+      m.keys.push_back({v, in.vertices.feature_ids[v]});
+      m.positions.push_back(in.vertices.positions[v]);
+    }
+    const auto local = [&](std::uint32_t v) {
+      return static_cast<std::uint32_t>(std::lower_bound(used.begin(), used.end(), v) - used.begin());
+    };
+    for (const Triangle& t : own) m.triangles.push_back({local(t[0]), local(t[1]), local(t[2])});
+    return m;
+  };
+}
+
+TEST(TileTree, CellsBuiltApartInAnyOrderAndFinishedGiveTheTreeOfOneBuild) {
+  const Input in = scattered_leaves();
+  TileTreeParams params;
+  params.depth_first_cells = 4;
+  const TileTree reference = build_tile_tree(in.vertices, in.triangles, in.keys, params);
+  const auto expected = view_of(reference);
+  std::vector<TileKey> leaves(in.keys.begin(), in.keys.end());
+  std::sort(leaves.begin(), leaves.end());
+  leaves.erase(std::unique(leaves.begin(), leaves.end()), leaves.end());
+
+  // Every tile as a sink gets it, whichever build (a cell's or the finishing one) hands it over.
+  std::mutex mutex;
+  std::map<std::string, std::vector<Triangle>> handed;
+  const TileNodeSink sink = [&](const TileNode& node) {
+    const std::lock_guard lock(mutex);
+    EXPECT_TRUE(handed.emplace(node.name(), global_triangles(node.mesh)).second) << node.name() << " twice";
+  };
+  const LeafSource source = leaf_source(in);
+  const TileTreeBuild build(leaves, source, params, sink);
+  ASSERT_GE(build.cell_count(), 4u);
+  std::vector<TileSubtree> cells(build.cell_count());
+  std::size_t cell_leaves = 0;
+  for (std::size_t c = cells.size(); c-- > 0;) {  // backwards, each from a build of its own
+    const TileTreeBuild apart(leaves, source, params, sink);
+    cells[c] = apart.build_cell(c);
+    const std::vector<TileKey> own = build.cell_leaves(c);
+    cell_leaves += own.size();
+    EXPECT_TRUE(std::is_sorted(own.begin(), own.end()));
+    const TileNode& open = cells[c].nodes.at(cells[c].open);
+    EXPECT_FALSE(open.mesh.triangles.empty()) << "cell " << c << ": the open node's mesh was released";
+    EXPECT_FALSE(handed.contains(open.name())) << "cell " << c << ": its open node was handed over";
+  }
+  EXPECT_EQ(cell_leaves, leaves.size()) << "every leaf in one cell";
+  const TileTree tree = build.finish(std::move(cells));
+
+  ASSERT_EQ(tree.nodes.size(), reference.nodes.size());
+  for (std::size_t n = 0; n < tree.nodes.size(); ++n) {
+    const TileNode& node = tree.nodes[n];
+    EXPECT_EQ(node.name(), reference.nodes[n].name()) << "node " << n << ": another order";
+    const TileView& want = expected.at(node.name());
+    EXPECT_EQ(handed.at(node.name()), want.triangles) << node.name();
+    EXPECT_EQ(node.geometric_error, want.geometric_error) << node.name();
+    EXPECT_EQ(node.box.min, want.box_min) << node.name();
+    EXPECT_EQ(node.box.max, want.box_max) << node.name();
+    std::vector<std::string> children;
+    for (const std::uint32_t c : node.children) children.push_back(tree.nodes[c].name());
+    EXPECT_EQ(children, want.children) << node.name();
+  }
+  EXPECT_EQ(handed.size(), reference.nodes.size());
+  EXPECT_THROW((void)build.finish({}), ProcessingError) << "subtrees missing";
 }
 
 TEST(TileTree, TheSinkGetsEveryTileOnceChildrenFirstAndItsMeshIsThenReleased) {

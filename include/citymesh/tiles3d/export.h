@@ -20,9 +20,9 @@
 namespace citymesh {
 
 struct TilesetExportParams {
-  std::filesystem::path dir;  ///< replaced as a whole once every file is written
-  TileGridParams grid;        ///< the leaves are the tiles of this grid (the run's tiling)
-  double tolerance = 0.001;   ///< metres: the largest position error Draco quantization may add
+  std::filesystem::path dir;                 ///< replaced as a whole once every file is written
+  TileGridParams grid;                       ///< the leaves are the tiles of this grid (the run's tiling)
+  double tolerance = 0.001;                  ///< metres: the largest position error Draco quantization may add
   std::vector<GlbAcquisition> acquisitions;  ///< feature id k names acquisition k
   TileTreeParams tree;
   std::size_t max_tiles_per_file = 341;  ///< per tileset JSON file; deeper tiles go to external tilesets
@@ -75,9 +75,37 @@ class TilesetLeaves {
   [[nodiscard]] virtual Box3d local_box(const TileKey& key, const LocalMapping& to_local) const;
 };
 
+/// What every process writing tiles of one export agrees on once the first pass has mapped
+/// every leaf: the local frame and the Draco lattice.
+struct TilesetFrame {
+  Geodetic origin;            ///< of the local east-north-up frame
+  DracoEncodeParams lattice;  ///< shared by every tile
+};
+
+/// A cell of the export's tree (TileTreeBuild::build_cell), its tiles written, the open
+/// node's too.
+struct ExportedCell {
+  TileSubtree subtree;  ///< every node's mesh released but the open node's
+  std::uint64_t glb_bytes = 0;
+};
+
+/// Builds cell `cell` of the export of `leaves` in `frame` and writes its tiles into the
+/// export's staging folder (staging_directory(params.dir), which the export created): what
+/// another process does for its share of an export. The same tiles as on the exporting process.
+ExportedCell export_cell(const TilesetLeaves& leaves, const Crs& crs, const TilesetFrame& frame,
+                         const TilesetExportParams& params, std::size_t cell);
+
+/// How the cells of an export are built, given its frame, its tree and `here` (builds one in
+/// this process, through export_cell): every cell's result, index: cell. The default builds
+/// them all here, on the pool's threads; a cluster hands them out to its processes.
+using ExportCells = std::function<std::vector<ExportedCell>(const TilesetFrame& frame, const TileTreeBuild& tree,
+                                                            const std::function<ExportedCell(std::size_t)>& here)>;
+
 /// Writes the tileset of `leaves` as export_tileset writes a mesh's, reading each leaf twice
 /// (once for the lattice, once for the tree) and holding only the tiles the tree is building.
-TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params);
+/// The tree's cells are built by `cells` (default: here), the levels above them here.
+TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params,
+                                  const ExportCells& cells = {});
 
 /// Some triangles of the output as a tile's mesh: one vertex per (vertex key, feature id of a
 /// triangle using it; stitch triangles have none), positions mapped by `to_local`.

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -50,8 +51,8 @@ struct TileMesh {
 using LeafSource = std::function<TileMesh(const TileKey&)>;
 
 struct TileNode {
-  int level = 0;  ///< 0: leaves; a level-l tile covers 2^l x 2^l grid tiles
-  TileKey key;    ///< grid key at its level: leaf keys shifted right by `level` (see build_tile_tree)
+  int level = 0;                   ///< 0: leaves; a level-l tile covers 2^l x 2^l grid tiles
+  TileKey key;                     ///< grid key at its level: leaf keys shifted right by `level` (see build_tile_tree)
   TileMesh mesh;                   ///< empty once handed to a TileNodeSink
   std::size_t triangle_count = 0;  ///< of its mesh, kept when the mesh is released
   double geometric_error = 0.0;    ///< metres; 0 on leaves, > 0 on parents
@@ -91,17 +92,49 @@ struct TileTreeParams {
 using TileNodeSink = std::function<void(const TileNode&)>;
 
 /// Builds the tree over the leaves `leaves` (grid keys, ascending, each holding triangles),
-/// asking `source` for each leaf's mesh when its subtree is built. Level by level, the nodes without a parent are grouped by their keys one level up and each
-/// group gets a parent, except a node alone in its group whose simplification keeps more than
-/// half of it: that node is carried up unchanged (a parent would only repeat it) until it meets
-/// another, so a parent's children may lie several levels below it.
-/// Halving never brings keys of both signs together, so an axis whose leaf keys have both
-/// signs (a grid origin inside the output) is counted from its smallest key; node keys and
-/// names are then relative to it.
-/// The result depends only on the input, never on the thread count. No leaves give an empty
-/// tree. Without a sink every node keeps its mesh.
+/// asking `source` for each leaf's mesh when its subtree is built. Level by level, the nodes without a parent are
+/// grouped by their keys one level up and each group gets a parent, except a node alone in its group whose
+/// simplification keeps more than half of it: that node is carried up unchanged (a parent would only repeat it) until
+/// it meets another, so a parent's children may lie several levels below it. Halving never brings keys of both signs
+/// together, so an axis whose leaf keys have both signs (a grid origin inside the output) is counted from its smallest
+/// key; node keys and names are then relative to it. The result depends only on the input, never on the thread count.
+/// No leaves give an empty tree. Without a sink every node keeps its mesh.
 TileTree build_tile_tree(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
                          const TileNodeSink& sink = {});
+
+/// One cell of a tree's lower levels, built on its own (see TileTreeParams::depth_first_cells):
+/// its nodes, children before parents (children index this list), every one handed to the
+/// sink but the one left open above the cell, whose mesh the levels above still need.
+struct TileSubtree {
+  std::vector<TileNode> nodes;
+  std::uint32_t open = 0;
+  bool open_is_final = false;  ///< the open node is a single child that would not simplify alone
+};
+
+/// build_tile_tree() in steps, for work shared between processes: the cells below the split
+/// level are independent (build_cell() on any thread or process, each with its own sink),
+/// and finish() builds the levels above from their subtrees. The same nodes, in the same
+/// order, as build_tile_tree(). `source`, `params` and `sink` must outlive it.
+class TileTreeBuild {
+ public:
+  TileTreeBuild(std::span<const TileKey> leaves, const LeafSource& source, const TileTreeParams& params,
+                const TileNodeSink& sink = {});
+  ~TileTreeBuild();
+  TileTreeBuild(const TileTreeBuild&) = delete;
+  TileTreeBuild& operator=(const TileTreeBuild&) = delete;
+
+  [[nodiscard]] std::size_t cell_count() const;
+  /// The leaves (grid keys, ascending) of cell `c`.
+  [[nodiscard]] std::vector<TileKey> cell_leaves(std::size_t c) const;
+  /// Cell `c`'s subtree; its nodes go to the sink as they are done. Thread-safe.
+  [[nodiscard]] TileSubtree build_cell(std::size_t c) const;
+  /// The tree from every cell's subtree (index: cell), built level by level above them.
+  [[nodiscard]] TileTree finish(std::vector<TileSubtree> cells) const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 /// The same from one vertex buffer: the triangles (its vertex indices) and each one's leaf
 /// key. A leaf's vertices are keyed by their index in the buffer (and its feature id).
