@@ -8,6 +8,7 @@
 #include <fstream>
 #include <numeric>
 
+#include "byte_arrays.h"
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
@@ -46,20 +47,6 @@ std::uint64_t payload_size(std::uint32_t flags, std::uint64_t n, std::uint64_t t
   if ((flags & kColors) != 0) per_vertex += sizeof(Rgb8);
   const std::uint64_t per_triangle = sizeof(Triangle) + sizeof(TriangleId) + 2 * sizeof(std::int32_t);
   return n * per_vertex + t * per_triangle;
-}
-
-template <class T>
-void put(std::string& out, const std::vector<T>& values) {
-  if (values.empty()) return;  // an empty vector's data() may be null
-  out.append(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(T));
-}
-
-template <class T>
-void take(std::string_view& in, std::vector<T>& values, std::size_t count) {
-  values.resize(count);
-  if (count == 0) return;  // no bytes, and data() may be null
-  std::memcpy(values.data(), in.data(), count * sizeof(T));
-  in.remove_prefix(count * sizeof(T));
 }
 
 void write_scratch_file(const std::filesystem::path& path, std::string_view bytes) {
@@ -102,7 +89,8 @@ KeyedPiece in_input_order(const KeyedPiece& piece) {
   std::vector<std::uint32_t> order(piece.triangle_count());
   std::iota(order.begin(), order.end(), 0u);
   std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-    return std::pair{piece.source_acq[a], piece.source_triangle[a]} < std::pair{piece.source_acq[b], piece.source_triangle[b]};
+    return std::pair{piece.source_acq[a], piece.source_triangle[a]} <
+           std::pair{piece.source_acq[b], piece.source_triangle[b]};
   });
   return subset(piece, order);
 }
@@ -121,16 +109,16 @@ std::string encode_keyed_piece(const KeyedPiece& p) {
   h.triangles = p.triangle_count();
   std::string payload;
   payload.reserve(payload_size(h.flags, h.vertices, h.triangles));
-  put(payload, p.keys);
-  put(payload, p.positions);
-  put(payload, p.sensors);
-  put(payload, p.times);
-  put(payload, p.intensities);
-  put(payload, p.colors);
-  put(payload, p.triangles);
-  put(payload, p.ids);
-  put(payload, p.source_acq);
-  put(payload, p.source_triangle);
+  put_array(payload, p.keys);
+  put_array(payload, p.positions);
+  put_array(payload, p.sensors);
+  put_array(payload, p.times);
+  put_array(payload, p.intensities);
+  put_array(payload, p.colors);
+  put_array(payload, p.triangles);
+  put_array(payload, p.ids);
+  put_array(payload, p.source_acq);
+  put_array(payload, p.source_triangle);
   h.checksum = bulk_checksum(payload.data(), payload.size());
   std::string out(reinterpret_cast<const char*>(&h), sizeof(h));
   return out + payload;
@@ -154,16 +142,16 @@ KeyedPiece decode_keyed_piece(std::string_view bytes, std::string_view source) {
   const auto n = static_cast<std::size_t>(h.vertices), t = static_cast<std::size_t>(h.triangles);
   const auto optional = [&](std::uint32_t flag) { return (h.flags & flag) != 0 ? n : 0; };
   KeyedPiece p;
-  take(in, p.keys, n);
-  take(in, p.positions, n);
-  take(in, p.sensors, optional(kSensors));
-  take(in, p.times, optional(kTimes));
-  take(in, p.intensities, optional(kIntensities));
-  take(in, p.colors, optional(kColors));
-  take(in, p.triangles, t);
-  take(in, p.ids, t);
-  take(in, p.source_acq, t);
-  take(in, p.source_triangle, t);
+  take_array(in, p.keys, n);
+  take_array(in, p.positions, n);
+  take_array(in, p.sensors, optional(kSensors));
+  take_array(in, p.times, optional(kTimes));
+  take_array(in, p.intensities, optional(kIntensities));
+  take_array(in, p.colors, optional(kColors));
+  take_array(in, p.triangles, t);
+  take_array(in, p.ids, t);
+  take_array(in, p.source_acq, t);
+  take_array(in, p.source_triangle, t);
   p.check(source);
   return p;
 }
@@ -297,8 +285,8 @@ struct Share {
 
 /// Each stitched part's triangles split by the grid tile holding their centroid and written
 /// to `dir`, the parts in parallel; per part, its shares.
-std::vector<std::vector<Share>> file_shares(const std::filesystem::path& dir, const TileGrid& grid,
-                                            std::size_t parts, const PartStore& store) {
+std::vector<std::vector<Share>> file_shares(const std::filesystem::path& dir, const TileGrid& grid, std::size_t parts,
+                                            const PartStore& store) {
   std::vector<std::vector<Share>> shares(parts);
   parallel_for_blocks(parts, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t p = begin; p < end; ++p) {
@@ -348,13 +336,18 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
     }
   }
   // Each tile's shares in one file, read once per output.
-  files_.resize(leaves_.size());
   parallel_for_blocks(leaves_.size(), 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t l = begin; l < end; ++l) {
-      files_[l] = dir_ / fmt::format("{}.leaf", leaves_[l].key.name());
-      write_scratch_file(files_[l], encode_keyed_piece(merge_and_remove(fragments[l])));
+      write_scratch_file(leaf_file(leaves_[l]), encode_keyed_piece(merge_and_remove(fragments[l])));
     }
   });
+}
+
+OutputLeaves::OutputLeaves(std::filesystem::path dir, std::vector<OutputLeaf> leaves)
+    : dir_(std::move(dir)), leaves_(std::move(leaves)), owned_(false) {}
+
+std::filesystem::path OutputLeaves::leaf_file(const OutputLeaf& leaf) const {
+  return dir_ / fmt::format("{}.leaf", leaf.key.name());
 }
 
 void OutputLeaves::count_sources(std::span<const std::int32_t> sources) {
@@ -386,10 +379,11 @@ Box3d OutputLeaves::box() const {
 }
 
 OutputLeaves::~OutputLeaves() {
+  if (!owned_) return;
   std::error_code ec;
   std::filesystem::remove_all(dir_, ec);  // best effort: scratch of this pass
 }
 
-KeyedPiece OutputLeaves::load(std::size_t leaf) const { return read_piece(files_.at(leaf)); }
+KeyedPiece OutputLeaves::load(std::size_t leaf) const { return read_piece(leaf_file(leaves_.at(leaf))); }
 
 }  // namespace citymesh::app

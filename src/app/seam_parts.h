@@ -99,6 +99,9 @@ class OutputLeaves {
   /// removed with this); reads each part once.
   OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
                const PartStore& store);
+  /// The tiles `leaves` (keys ascending) of another process's folder `dir` (an MPI rank
+  /// helping the root's export): reads them there, never creates nor removes the folder.
+  OutputLeaves(std::filesystem::path dir, std::vector<OutputLeaf> leaves);
   ~OutputLeaves();
   OutputLeaves(const OutputLeaves&) = delete;
   OutputLeaves& operator=(const OutputLeaves&) = delete;
@@ -117,15 +120,18 @@ class OutputLeaves {
   void keep(std::size_t leaf, std::string_view name, std::string_view bytes) const;
   /// What keep() kept; throws ProcessingError when it is gone.
   [[nodiscard]] std::string kept(std::size_t leaf, std::string_view name) const;
+  [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
 
  private:
   std::filesystem::path dir_;
   std::vector<OutputLeaf> leaves_;
   void count_sources(std::span<const std::int32_t> sources);
 
-  std::vector<std::filesystem::path> files_;  ///< per leaf
+  [[nodiscard]] std::filesystem::path leaf_file(const OutputLeaf& leaf) const;
+
   std::vector<std::uint64_t> per_source_;
   std::uint64_t stitched_ = 0;
+  bool owned_ = true;  ///< the folder is this object's: made empty, removed with it
 };
 
 }  // namespace citymesh::app

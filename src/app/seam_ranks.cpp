@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <bit>
 #include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
@@ -16,6 +15,7 @@
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
+#include "json_bits.h"
 #include "mosaic_step.h"
 #include "work_schedule.h"
 
@@ -25,22 +25,6 @@ namespace {
 
 /// The plan of the step being shared, written by the root before it shares the step.
 std::filesystem::path plan_path(const Config& config) { return config.project.work / "seam-level.json"; }
-
-/// Doubles travel as their bits: a part's box sets its stitching frame, so it must come back
-/// exactly (and an empty box is infinite).
-nlohmann::json box_bits(const Box3d& b) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const double v : {b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z}) out.push_back(std::bit_cast<std::uint64_t>(v));
-  return out;
-}
-
-Box3d box_from_bits(const nlohmann::json& j) {
-  const auto at = [&](std::size_t k) { return std::bit_cast<double>(j.at(k).get<std::uint64_t>()); };
-  Box3d b;
-  b.min = {at(0), at(1), at(2)};
-  b.max = {at(3), at(4), at(5)};
-  return b;
-}
 
 /// The counts stitch_parts() adds up, the part's stitched box and its size with surroundings.
 nlohmann::json outcome_json(const PartOutcome& o) {
@@ -72,8 +56,8 @@ constexpr std::string_view kOutcomeSuffix = "outcome.json";
 /// their open boundary (before or after stitching) or stitch those of one level.
 struct StepPlan {
   std::filesystem::path dir;
-  std::string step;  ///< "measure" or "stitch"
-  int level = 0;     ///< stitch: the level
+  std::string step;       ///< "measure" or "stitch"
+  int level = 0;          ///< stitch: the level
   bool stitched = false;  ///< measure: after stitching
   std::vector<BlockPart> parts;
   std::vector<std::uint64_t> source_sizes;
@@ -82,10 +66,16 @@ struct StepPlan {
 void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json parts = nlohmann::json::array();
   for (const BlockPart& p : plan.parts) {
-    parts.push_back({{"key", {p.key.level, p.key.x, p.key.y}}, {"box", box_bits(p.box)}, {"stitched_box", box_bits(p.stitched_box)}});
+    parts.push_back({{"key", {p.key.level, p.key.x, p.key.y}},
+                     {"box", box_bits(p.box)},
+                     {"stitched_box", box_bits(p.stitched_box)}});
   }
-  const nlohmann::json j{{"dir", std::filesystem::absolute(plan.dir).string()},     {"step", plan.step},   {"level", plan.level},
-                         {"stitched", plan.stitched},     {"parts", parts},      {"source_sizes", plan.source_sizes}};
+  const nlohmann::json j{{"dir", std::filesystem::absolute(plan.dir).string()},
+                         {"step", plan.step},
+                         {"level", plan.level},
+                         {"stitched", plan.stitched},
+                         {"parts", parts},
+                         {"source_sizes", plan.source_sizes}};
   write_file_atomically(plan_path(config), j.dump() + "\n");
 }
 
@@ -114,8 +104,8 @@ StepPlan read_plan(const Config& config) {
 }
 
 /// A part's open boundary as its bits (the sum must come out the same as on one process).
-nlohmann::json length_json(double metres) { return {{"bits", std::bit_cast<std::uint64_t>(metres)}}; }
-double length_from(const nlohmann::json& j) { return std::bit_cast<double>(j.at("bits").get<std::uint64_t>()); }
+nlohmann::json length_json(double metres) { return {{"bits", double_bits(metres)}}; }
+double length_from(const nlohmann::json& j) { return double_from_bits(j.at("bits")); }
 
 constexpr std::string_view kLengthSuffix = "length.json";
 
@@ -163,7 +153,8 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
   const std::vector<std::uint64_t> sizes = files.source_sizes();
   SeamPassWork work;
   work.measure_parts = [&config, &cluster, &files, sizes](const BoundaryMeasurer& measurer) {
-    const StepPlan plan{files.dir(), "measure", 0, measurer.stitched(), {measurer.parts().begin(), measurer.parts().end()}, sizes};
+    const StepPlan plan{
+        files.dir(), "measure", 0, measurer.stitched(), {measurer.parts().begin(), measurer.parts().end()}, sizes};
     write_plan(config, plan);
     std::vector<std::size_t> all(measurer.size());
     for (std::size_t p = 0; p < all.size(); ++p) all[p] = p;
@@ -176,7 +167,8 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
     return lengths;
   };
   work.run_level = [&config, &cluster, &files, sizes](const LevelStitcher& level) {
-    const StepPlan plan{files.dir(), "stitch", level.level(), false, {level.parts().begin(), level.parts().end()}, sizes};
+    const StepPlan plan{files.dir(), "stitch", level.level(), false, {level.parts().begin(), level.parts().end()},
+                        sizes};
     write_plan(config, plan);
     std::vector<std::optional<PartOutcome>> here(level.size());
     share_items(cluster, files, level.parts_of_level(), [&](std::size_t i) { here[i] = level.stitch(i); });

@@ -16,6 +16,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_reader.h"
 #include "detect_output.h"
+#include "export_ranks.h"
 #include "leaf_outputs.h"
 #include "leftovers.h"
 #include "mosaic_output.h"
@@ -117,9 +118,9 @@ class FinalOutput {
   nlohmann::json stitch() {
     if (seams_) {
       const bool shared = cluster_ != nullptr && cluster_->size() > 1;
-      nlohmann::json figures = stitch_parts_and_report(
-          config_, parts_, *seams_, seams_->source_sizes(),
-          shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{});
+      nlohmann::json figures =
+          stitch_parts_and_report(config_, parts_, *seams_, seams_->source_sizes(),
+                                  shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{});
       if (shared) remove_seam_plan(config_);
       // The outputs read the stitched output one grid tile at a time.
       leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
@@ -143,8 +144,13 @@ class FinalOutput {
 
   /// The 3D Tiles and per-tile PLYs; then the pass's files go.
   nlohmann::json export_tiles() {
+    if (!leaves_) return write_tileset_outputs(config_, merged_);
+    // The other ranks, done with the seam pass, build cells of the tree until the root ends
+    // the export (help_export).
+    const bool shared = cluster_ != nullptr && cluster_->size() > 1;
     const nlohmann::json exported =
-        leaves_ ? write_tileset_outputs(config_, *leaves_) : write_tileset_outputs(config_, merged_);
+        write_tileset_outputs(config_, *leaves_, shared ? share_export(config_, *cluster_, *leaves_) : ExportCells{});
+    if (shared) end_shared_export(config_, *cluster_);
     leaves_.reset();
     seams_.reset();
     return exported;
@@ -262,8 +268,8 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   report["per_tile"] = per_tile;
   write_file_atomically(config.project.output / "run.json", report.dump(1) + "\n");
   // Over a resumed run's time, the rate says nothing of the work the reused tiles took.
-  const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s", static_cast<double>(assembly.owned()) /
-                                                                                 std::max(wall, 1e-9) / 1e6)
+  const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s",
+                                                     static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6)
                                        : std::string("no rate: tiles reused");
   std::cout << fmt::format(
       "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak memory "
@@ -324,6 +330,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
     write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, &cluster);
   } else if (seam_pass_in_blocks(config)) {
     help_seam_pass(config, cluster);
+    help_export(config, cluster);
   }
   cluster.barrier();
 }

@@ -36,11 +36,12 @@ TilesetExportParams export_params(const Config& config) {
 
 /// Prints the export's line and returns its figures for the run report.
 nlohmann::json report_3d_tiles(const TilesetExportStats& s, const TilesetExportParams& params) {
-  std::cout << fmt::format("3D Tiles: {} tiles ({} leaves, {} levels) of {} triangles, {:.1f} bytes per leaf triangle, "
-                           "{}-bit positions ({:.2f} mm step), {:.2f} s -> {}\n",
-                           s.tiles, s.leaves, s.levels, s.leaf_triangles,
-                           static_cast<double>(s.glb_bytes) / static_cast<double>(std::max<std::uint64_t>(s.all_triangles, 1)),
-                           s.position_bits, s.quantization_step * 1e3, s.seconds, (params.dir / "tileset.json").string());
+  std::cout << fmt::format(
+      "3D Tiles: {} tiles ({} leaves, {} levels) of {} triangles, {:.1f} bytes per leaf triangle, "
+      "{}-bit positions ({:.2f} mm step), {:.2f} s -> {}\n",
+      s.tiles, s.leaves, s.levels, s.leaf_triangles,
+      static_cast<double>(s.glb_bytes) / static_cast<double>(std::max<std::uint64_t>(s.all_triangles, 1)),
+      s.position_bits, s.quantization_step * 1e3, s.seconds, (params.dir / "tileset.json").string());
   return {{"tiles", s.tiles},
           {"leaves", s.leaves},
           {"levels", s.levels},
@@ -168,11 +169,11 @@ std::filesystem::path find_tileset(const std::filesystem::path& given) {
   for (const std::filesystem::path& candidate : {given / "tiles" / "tileset.json", given / "tileset.json", given}) {
     if (std::filesystem::is_regular_file(candidate)) return candidate;
   }
-  throw InputError(fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)",
-                               given.string()));
+  throw InputError(
+      fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)", given.string()));
 }
 
-nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves) {
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportCells& cells) {
   nlohmann::json report = nlohmann::json::object();
   if (leaves.leaves().empty()) {
     if (config.output.tiles_3d || config.output.ply) log::warn("the output has no triangles: no tileset written");
@@ -180,10 +181,15 @@ nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& l
   }
   if (config.output.tiles_3d) {
     const TilesetExportParams params = export_params(config);
-    report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params), params);
+    report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, cells), params);
   }
   if (config.output.ply) report["ply"] = write_tile_plys(config, leaves);
   return report;
+}
+
+ExportedCell export_leaves_cell(const Config& config, const OutputLeaves& leaves, const TilesetFrame& frame,
+                                std::size_t cell) {
+  return export_cell(LeavesToExport(leaves), config.crs(), frame, export_params(config), cell);
 }
 
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged) {

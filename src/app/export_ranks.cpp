@@ -1,0 +1,304 @@
+// SPDX-License-Identifier: MIT
+#include "export_ranks.h"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <optional>
+
+#include "byte_arrays.h"
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/read_file.h"
+#include "json_bits.h"
+#include "tileset_output.h"
+#include "work_schedule.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// The plan of the export step being shared, written by the root before it shares the step.
+std::filesystem::path plan_path(const Config& config) { return config.project.work / "export-step.json"; }
+
+/// What another rank needs to build cells: the output's tiles (their folder and keys) and the
+/// frame every tile is written in. An empty `dir` ends the export.
+struct ExportPlan {
+  std::filesystem::path dir;
+  std::vector<TileKey> leaves;
+  TilesetFrame frame;
+};
+
+nlohmann::json float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
+float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.get<std::uint32_t>()); }
+
+void write_plan(const Config& config, const ExportPlan& plan) {
+  nlohmann::json leaves = nlohmann::json::array();
+  for (const TileKey& k : plan.leaves) leaves.push_back({k.i, k.j});
+  const TilesetFrame& f = plan.frame;
+  nlohmann::json lattice = nlohmann::json::array();
+  if (f.lattice.lattice) {
+    for (const float v : f.lattice.lattice->origin) lattice.push_back(float_bits(v));
+    lattice.push_back(float_bits(f.lattice.lattice->range));
+  }
+  const nlohmann::json j{
+      {"dir", plan.dir.empty() ? std::string() : std::filesystem::absolute(plan.dir).string()},
+      {"leaves", leaves},
+      {"origin", {double_bits(f.origin.lat), double_bits(f.origin.lon), double_bits(f.origin.height)}},
+      {"position_bits", f.lattice.position_bits},
+      {"speed", f.lattice.speed},
+      {"lattice", lattice}};
+  write_file_atomically(plan_path(config), j.dump() + "\n");
+}
+
+ExportPlan read_plan(const Config& config) {
+  const std::filesystem::path file = plan_path(config);
+  std::ifstream in(file);
+  if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of the 3D Tiles export)", file.string()));
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    ExportPlan plan;
+    plan.dir = j.at("dir").get<std::string>();
+    for (const auto& k : j.at("leaves"))
+      plan.leaves.push_back({k.at(0).get<std::int32_t>(), k.at(1).get<std::int32_t>()});
+    const auto& o = j.at("origin");
+    plan.frame.origin = {double_from_bits(o.at(0)), double_from_bits(o.at(1)), double_from_bits(o.at(2))};
+    plan.frame.lattice.position_bits = j.at("position_bits").get<int>();
+    plan.frame.lattice.speed = j.at("speed").get<int>();
+    const auto& l = j.at("lattice");
+    if (!l.empty()) {
+      plan.frame.lattice.lattice = DracoLattice{
+          {float_from_bits(l.at(0)), float_from_bits(l.at(1)), float_from_bits(l.at(2))}, float_from_bits(l.at(3))};
+    }
+    return plan;
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
+  }
+}
+
+// A cell built on another rank comes back as two files beside the output's tiles: its nodes
+// (JSON, doubles as bits) and the mesh of its open node (binary: the levels above read it).
+
+std::filesystem::path cell_file(const std::filesystem::path& dir, std::size_t cell, std::string_view suffix) {
+  return dir / fmt::format("cell-{}.{}", cell, suffix);
+}
+
+constexpr std::string_view kMeshMagic = "CMCELL01";
+constexpr std::uint32_t kIntensities = 1, kColors = 2;
+
+/// What precedes the open mesh's arrays.
+struct MeshHeader {
+  char magic[8];
+  std::uint32_t flags;
+  std::uint32_t reserved;
+  std::uint64_t vertices, triangles, checksum;
+};
+static_assert(sizeof(MeshHeader) == 40 && sizeof(Vec3f) == 12 && sizeof(Rgb8) == 3 && sizeof(Triangle) == 12);
+
+std::uint64_t mesh_payload_size(std::uint32_t flags, std::uint64_t n, std::uint64_t t) {
+  std::uint64_t per_vertex = sizeof(std::uint64_t) + sizeof(std::uint16_t) + sizeof(Vec3f);
+  if ((flags & kIntensities) != 0) per_vertex += sizeof(float);
+  if ((flags & kColors) != 0) per_vertex += sizeof(Rgb8);
+  return n * per_vertex + t * sizeof(Triangle);
+}
+
+std::string encode_tile_mesh(const TileMesh& m) {
+  MeshHeader h{};
+  std::memcpy(h.magic, kMeshMagic.data(), sizeof(h.magic));
+  h.flags = (m.intensities.empty() ? 0u : kIntensities) | (m.colors.empty() ? 0u : kColors);
+  h.vertices = m.vertex_count();
+  h.triangles = m.triangles.size();
+  std::vector<std::uint64_t> vertices;
+  std::vector<std::uint16_t> features;
+  for (const TileVertexKey& k : m.keys) {
+    vertices.push_back(k.vertex);
+    features.push_back(k.feature);
+  }
+  std::string payload;
+  payload.reserve(mesh_payload_size(h.flags, h.vertices, h.triangles));
+  put_array(payload, vertices);
+  put_array(payload, features);
+  put_array(payload, m.positions);
+  put_array(payload, m.intensities);
+  put_array(payload, m.colors);
+  put_array(payload, m.triangles);
+  h.checksum = bulk_checksum(payload.data(), payload.size());
+  return std::string(reinterpret_cast<const char*>(&h), sizeof(h)) + payload;
+}
+
+TileMesh decode_tile_mesh(std::string_view bytes, const std::filesystem::path& source) {
+  const auto refuse = [&](std::string_view why) {
+    return ProcessingError(fmt::format("{}: not a 3D Tiles cell's mesh ({})", source.string(), why));
+  };
+  MeshHeader h{};
+  if (bytes.size() < sizeof(h)) throw refuse("too short");
+  std::memcpy(&h, bytes.data(), sizeof(h));
+  if (std::string_view(h.magic, sizeof(h.magic)) != kMeshMagic) throw refuse("another magic");
+  std::string_view in = bytes.substr(sizeof(h));
+  // Counts are checked against the size before anything is allocated from them.
+  if (h.vertices > in.size() || h.triangles > in.size() ||
+      mesh_payload_size(h.flags, h.vertices, h.triangles) != in.size()) {
+    throw refuse("its counts disagree with its size");
+  }
+  if (bulk_checksum(in.data(), in.size()) != h.checksum) throw refuse("its checksum does not match");
+  const auto n = static_cast<std::size_t>(h.vertices);
+  std::vector<std::uint64_t> vertices;
+  std::vector<std::uint16_t> features;
+  TileMesh m;
+  take_array(in, vertices, n);
+  take_array(in, features, n);
+  take_array(in, m.positions, n);
+  take_array(in, m.intensities, (h.flags & kIntensities) != 0 ? n : 0);
+  take_array(in, m.colors, (h.flags & kColors) != 0 ? n : 0);
+  take_array(in, m.triangles, static_cast<std::size_t>(h.triangles));
+  for (std::size_t v = 0; v < n; ++v) m.keys.push_back({vertices[v], features[v]});
+  for (const Triangle& t : m.triangles) {
+    if (t[0] >= n || t[1] >= n || t[2] >= n) throw refuse("a triangle's corner is not one of its vertices");
+  }
+  return m;
+}
+
+nlohmann::json nodes_json(const ExportedCell& cell) {
+  nlohmann::json nodes = nlohmann::json::array();
+  for (const TileNode& n : cell.subtree.nodes) {
+    nodes.push_back({{"level", n.level},
+                     {"key", {n.key.i, n.key.j}},
+                     {"triangles", n.triangle_count},
+                     {"error", double_bits(n.geometric_error)},
+                     {"box", box_bits(n.box)},
+                     {"children", n.children}});
+  }
+  return {{"nodes", nodes},
+          {"open", cell.subtree.open},
+          {"open_is_final", cell.subtree.open_is_final},
+          {"glb_bytes", cell.glb_bytes}};
+}
+
+/// Writes a cell built here for the root: the open node's mesh first, then the nodes (the
+/// root reads them once this rank reports the cell done).
+void write_cell(const std::filesystem::path& dir, std::size_t c, const ExportedCell& cell) {
+  write_file_atomically(cell_file(dir, c, "mesh"), encode_tile_mesh(cell.subtree.nodes.at(cell.subtree.open).mesh));
+  write_file_atomically(cell_file(dir, c, "json"), nodes_json(cell).dump());
+}
+
+/// Reads, and removes, a cell another rank built.
+ExportedCell take_cell(const std::filesystem::path& dir, std::size_t c) {
+  const std::filesystem::path json_file = cell_file(dir, c, "json"), mesh_file = cell_file(dir, c, "mesh");
+  std::ifstream in(json_file);
+  if (!in)
+    throw ProcessingError(
+        fmt::format("{}: missing (a cell of the 3D Tiles export another rank built)", json_file.string()));
+  ExportedCell cell;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& n : j.at("nodes")) {
+      TileNode node;
+      node.level = n.at("level").get<int>();
+      node.key = {n.at("key").at(0).get<std::int32_t>(), n.at("key").at(1).get<std::int32_t>()};
+      node.triangle_count = n.at("triangles").get<std::size_t>();
+      node.geometric_error = double_from_bits(n.at("error"));
+      node.box = box_from_bits(n.at("box"));
+      node.children = n.at("children").get<std::vector<std::uint32_t>>();
+      cell.subtree.nodes.push_back(std::move(node));
+    }
+    cell.subtree.open = j.at("open").get<std::uint32_t>();
+    cell.subtree.open_is_final = j.at("open_is_final").get<bool>();
+    cell.glb_bytes = j.at("glb_bytes").get<std::uint64_t>();
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", json_file.string(), e.what()));
+  }
+  if (cell.subtree.open >= cell.subtree.nodes.size()) {
+    throw ProcessingError(fmt::format("{}: its open node is not one of its nodes", json_file.string()));
+  }
+  const std::optional<std::string> bytes = read_file_bytes(mesh_file);
+  if (!bytes)
+    throw ProcessingError(
+        fmt::format("{}: missing (a cell of the 3D Tiles export another rank built)", mesh_file.string()));
+  cell.subtree.nodes[cell.subtree.open].mesh = decode_tile_mesh(*bytes, mesh_file);
+  in.close();
+  std::filesystem::remove(json_file);
+  std::filesystem::remove(mesh_file);
+  return cell;
+}
+
+/// Shares one step with every rank: `cells` items (none ends the export), `here(c)` done by
+/// this rank's workers. Returns once every rank's workers are done.
+void share_cells(Cluster& cluster, std::vector<std::uint64_t> costs, const std::function<void(std::size_t)>& here) {
+  const std::size_t n = costs.size();
+  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
+  auto channel = cluster.share(&schedule, [](std::size_t) {});
+  run_workers(*channel, available_threads(), here);
+}
+
+}  // namespace
+
+ExportCells share_export(const Config& config, Cluster& cluster, const OutputLeaves& leaves) {
+  return [&config, &cluster, &leaves](const TilesetFrame& frame, const TileTreeBuild& tree,
+                                      const std::function<ExportedCell(std::size_t)>& here) {
+    ExportPlan plan{leaves.dir(), {}, frame};
+    std::map<TileKey, std::uint64_t> triangles;
+    for (const OutputLeaf& leaf : leaves.leaves()) {
+      plan.leaves.push_back(leaf.key);
+      triangles[leaf.key] = leaf.triangles;
+    }
+    write_plan(config, plan);
+    // Largest cell first, so that none is left to end the step alone.
+    std::vector<std::uint64_t> costs(tree.cell_count(), 0);
+    for (std::size_t c = 0; c < costs.size(); ++c) {
+      for (const TileKey& k : tree.cell_leaves(c)) costs[c] += triangles.at(k);
+    }
+    std::vector<std::optional<ExportedCell>> mine(costs.size());
+    share_cells(cluster, costs, [&](std::size_t c) {
+      throw_if_interrupted("the 3D Tiles export");
+      mine[c] = here(c);
+    });
+    std::vector<ExportedCell> out(mine.size());
+    std::size_t elsewhere = 0;
+    for (std::size_t c = 0; c < out.size(); ++c) {
+      if (mine[c]) {
+        out[c] = std::move(*mine[c]);
+        continue;
+      }
+      out[c] = take_cell(leaves.dir(), c);
+      ++elsewhere;
+    }
+    log::debug("3D Tiles: {} of {} cells built by other ranks", elsewhere, out.size());
+    return out;
+  };
+}
+
+void end_shared_export(const Config& config, Cluster& cluster) {
+  write_plan(config, {});
+  share_cells(cluster, {}, [](std::size_t) {});
+  std::error_code ec;
+  std::filesystem::remove(plan_path(config), ec);
+}
+
+void help_export(const Config& config, Cluster& cluster) {
+  std::atomic<std::size_t> built = 0;
+  for (;;) {
+    // The root writes the plan before it shares the step, and sharing starts with a barrier.
+    auto channel = cluster.share(nullptr, {});
+    const ExportPlan plan = read_plan(config);
+    if (plan.dir.empty()) break;
+    std::vector<OutputLeaf> leaves;
+    for (const TileKey& k : plan.leaves) leaves.push_back({k, {}, 0});
+    const OutputLeaves attached(plan.dir, std::move(leaves));
+    run_workers(*channel, available_threads(), [&](std::size_t c) {
+      throw_if_interrupted("the 3D Tiles export");
+      write_cell(plan.dir, c, export_leaves_cell(config, attached, plan.frame, c));
+      ++built;
+    });
+  }
+  log::info("rank {}: built {} cells of the 3D Tiles export", cluster.rank(), built.load());
+}
+
+}  // namespace citymesh::app

@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: MIT
+#include "json_bits.h"
+
+#include <bit>
+#include <cstdint>
+
+namespace citymesh::app {
+
+nlohmann::json double_bits(double v) { return std::bit_cast<std::uint64_t>(v); }
+
+double double_from_bits(const nlohmann::json& j) { return std::bit_cast<double>(j.get<std::uint64_t>()); }
+
+nlohmann::json box_bits(const Box3d& b) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const double v : {b.min.x, b.min.y, b.min.z, b.max.x, b.max.y, b.max.z}) out.push_back(double_bits(v));
+  return out;
+}
+
+Box3d box_from_bits(const nlohmann::json& j) {
+  const auto at = [&](std::size_t k) { return double_from_bits(j.at(k)); };
+  Box3d b;
+  b.min = {at(0), at(1), at(2)};
+  b.max = {at(3), at(4), at(5)};
+  return b;
+}
+
+}  // namespace citymesh::app
