@@ -8,6 +8,7 @@
 #include <cstring>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <optional>
 
 #include "byte_arrays.h"
@@ -29,9 +30,11 @@ namespace {
 /// The plan of the export step being shared, written by the root before it shares the step.
 std::filesystem::path plan_path(const Config& config) { return config.project.work / "export-step.json"; }
 
-/// What another rank needs to build cells: the output's tiles (their folder and keys) and the
-/// frame every tile is written in. An empty `dir` ends the export.
+/// What another rank needs for one step of the export: map leaves ("boxes": the frame's
+/// origin is set) or build cells ("cells": the whole frame), reading the output's tiles (their
+/// folder and keys); "end" lets it go.
 struct ExportPlan {
+  std::string step;
   std::filesystem::path dir;
   std::vector<TileKey> leaves;
   TilesetFrame frame;
@@ -50,6 +53,7 @@ void write_plan(const Config& config, const ExportPlan& plan) {
     lattice.push_back(float_bits(f.lattice.lattice->range));
   }
   const nlohmann::json j{
+      {"step", plan.step},
       {"dir", plan.dir.empty() ? std::string() : std::filesystem::absolute(plan.dir).string()},
       {"leaves", leaves},
       {"origin", {double_bits(f.origin.lat), double_bits(f.origin.lon), double_bits(f.origin.height)}},
@@ -66,6 +70,7 @@ ExportPlan read_plan(const Config& config) {
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
     ExportPlan plan;
+    plan.step = j.at("step").get<std::string>();
     plan.dir = j.at("dir").get<std::string>();
     for (const auto& k : j.at("leaves"))
       plan.leaves.push_back({k.at(0).get<std::int32_t>(), k.at(1).get<std::int32_t>()});
@@ -229,9 +234,27 @@ ExportedCell take_cell(const std::filesystem::path& dir, std::size_t c) {
   return cell;
 }
 
-/// Shares one step with every rank: `cells` items (none ends the export), `here(c)` done by
-/// this rank's workers. Returns once every rank's workers are done.
-void share_cells(Cluster& cluster, std::vector<std::uint64_t> costs, const std::function<void(std::size_t)>& here) {
+/// A leaf's box another rank mapped: beside the leaf, as bits.
+std::filesystem::path box_file(const std::filesystem::path& dir, const TileKey& key) {
+  return dir / fmt::format("{}.box", key.name());
+}
+
+Box3d take_box(const std::filesystem::path& dir, const TileKey& key) {
+  const std::filesystem::path file = box_file(dir, key);
+  const std::optional<std::string> text = read_file_bytes(file);
+  if (!text) throw ProcessingError(fmt::format("{}: missing (a leaf another rank mapped)", file.string()));
+  try {
+    const Box3d box = box_from_bits(nlohmann::json::parse(*text));
+    std::filesystem::remove(file);
+    return box;
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
+  }
+}
+
+/// Shares one step with every rank: one item per cost (none for "end"), `here(i)` done by
+/// this rank's workers, largest cost first. Returns once every rank's workers are done.
+void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const std::function<void(std::size_t)>& here) {
   const std::size_t n = costs.size();
   WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
   auto channel = cluster.share(&schedule, [](std::size_t) {});
@@ -240,23 +263,42 @@ void share_cells(Cluster& cluster, std::vector<std::uint64_t> costs, const std::
 
 }  // namespace
 
-ExportCells share_export(const Config& config, Cluster& cluster, const OutputLeaves& leaves) {
-  return [&config, &cluster, &leaves](const TilesetFrame& frame, const TileTreeBuild& tree,
-                                      const std::function<ExportedCell(std::size_t)>& here) {
-    ExportPlan plan{leaves.dir(), {}, frame};
-    std::map<TileKey, std::uint64_t> triangles;
-    for (const OutputLeaf& leaf : leaves.leaves()) {
-      plan.leaves.push_back(leaf.key);
-      triangles[leaf.key] = leaf.triangles;
+ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeaves& leaves) {
+  // Each leaf's triangles: what mapping it costs, and with its cell's, building the cell.
+  auto triangles = std::make_shared<std::map<TileKey, std::uint64_t>>();
+  std::vector<TileKey> keys;
+  for (const OutputLeaf& leaf : leaves.leaves()) {
+    (*triangles)[leaf.key] = leaf.triangles;
+    keys.push_back(leaf.key);
+  }
+  ExportWork work;
+  work.boxes = [&config, &cluster, &leaves, triangles, keys](const Geodetic& origin, std::span<const TileKey> asked,
+                                                             const std::function<Box3d(std::size_t)>& here) {
+    if (!std::equal(asked.begin(), asked.end(), keys.begin(), keys.end())) {
+      throw ProcessingError("3D Tiles: the export asks for other leaves than the output's");
     }
-    write_plan(config, plan);
+    write_plan(config, {"boxes", leaves.dir(), keys, {origin, {}}});
+    std::vector<std::uint64_t> costs;
+    for (const TileKey& k : keys) costs.push_back(triangles->at(k));
+    std::vector<std::optional<Box3d>> mine(keys.size());
+    share_items(cluster, costs, [&](std::size_t k) {
+      throw_if_interrupted("the 3D Tiles export");
+      mine[k] = here(k);
+    });
+    std::vector<Box3d> boxes(keys.size());
+    for (std::size_t k = 0; k < keys.size(); ++k) boxes[k] = mine[k] ? *mine[k] : take_box(leaves.dir(), keys[k]);
+    return boxes;
+  };
+  work.cells = [&config, &cluster, &leaves, triangles, keys](const TilesetFrame& frame, const TileTreeBuild& tree,
+                                                             const std::function<ExportedCell(std::size_t)>& here) {
+    write_plan(config, {"cells", leaves.dir(), keys, frame});
     // Largest cell first, so that none is left to end the step alone.
     std::vector<std::uint64_t> costs(tree.cell_count(), 0);
     for (std::size_t c = 0; c < costs.size(); ++c) {
-      for (const TileKey& k : tree.cell_leaves(c)) costs[c] += triangles.at(k);
+      for (const TileKey& k : tree.cell_leaves(c)) costs[c] += triangles->at(k);
     }
     std::vector<std::optional<ExportedCell>> mine(costs.size());
-    share_cells(cluster, costs, [&](std::size_t c) {
+    share_items(cluster, costs, [&](std::size_t c) {
       throw_if_interrupted("the 3D Tiles export");
       mine[c] = here(c);
     });
@@ -273,32 +315,51 @@ ExportCells share_export(const Config& config, Cluster& cluster, const OutputLea
     log::debug("3D Tiles: {} of {} cells built by other ranks", elsewhere, out.size());
     return out;
   };
+  return work;
 }
 
 void end_shared_export(const Config& config, Cluster& cluster) {
-  write_plan(config, {});
-  share_cells(cluster, {}, [](std::size_t) {});
+  write_plan(config, {"end", {}, {}, {}});
+  share_items(cluster, {}, [](std::size_t) {});
   std::error_code ec;
   std::filesystem::remove(plan_path(config), ec);
 }
 
 void help_export(const Config& config, Cluster& cluster) {
-  std::atomic<std::size_t> built = 0;
+  std::atomic<std::size_t> mapped = 0, built = 0;
+  const Crs crs = config.crs();
+  const TilesetExportParams params = tileset_export_params(config);
   for (;;) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.
     auto channel = cluster.share(nullptr, {});
     const ExportPlan plan = read_plan(config);
-    if (plan.dir.empty()) break;
+    if (plan.step == "end") break;
     std::vector<OutputLeaf> leaves;
     for (const TileKey& k : plan.leaves) leaves.push_back({k, {}, 0});
     const OutputLeaves attached(plan.dir, std::move(leaves));
-    run_workers(*channel, available_threads(), [&](std::size_t c) {
-      throw_if_interrupted("the 3D Tiles export");
-      write_cell(plan.dir, c, export_leaves_cell(config, attached, plan.frame, c));
-      ++built;
-    });
+    const std::unique_ptr<TilesetLeaves> view = export_view(attached);
+    // Each result is written before the root hears that the item is done (the worker's next
+    // request says so).
+    if (plan.step == "boxes") {
+      run_workers(*channel, available_threads(), [&](std::size_t k) {
+        throw_if_interrupted("the 3D Tiles export");
+        const Box3d box = export_leaf_box(*view, crs, plan.frame.origin, plan.leaves.at(k));
+        write_file_atomically(box_file(plan.dir, plan.leaves[k]), box_bits(box).dump());
+        ++mapped;
+      });
+    } else if (plan.step == "cells") {
+      run_workers(*channel, available_threads(), [&](std::size_t c) {
+        throw_if_interrupted("the 3D Tiles export");
+        write_cell(plan.dir, c, export_cell(*view, crs, plan.frame, params, c));
+        ++built;
+      });
+    } else {
+      throw ProcessingError(
+          fmt::format("{}: unknown step '{}' of the 3D Tiles export", plan_path(config).string(), plan.step));
+    }
   }
-  log::info("rank {}: built {} cells of the 3D Tiles export", cluster.rank(), built.load());
+  log::info("rank {}: mapped {} leaves and built {} cells of the 3D Tiles export", cluster.rank(), mapped.load(),
+            built.load());
 }
 
 }  // namespace citymesh::app

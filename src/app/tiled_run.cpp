@@ -145,11 +145,11 @@ class FinalOutput {
   /// The 3D Tiles and per-tile PLYs; then the pass's files go.
   nlohmann::json export_tiles() {
     if (!leaves_) return write_tileset_outputs(config_, merged_);
-    // The other ranks, done with the seam pass, build cells of the tree until the root ends
-    // the export (help_export).
+    // The other ranks, done with the seam pass, map leaves and build cells of the tree until
+    // the root ends the export (help_export).
     const bool shared = cluster_ != nullptr && cluster_->size() > 1;
     const nlohmann::json exported =
-        write_tileset_outputs(config_, *leaves_, shared ? share_export(config_, *cluster_, *leaves_) : ExportCells{});
+        write_tileset_outputs(config_, *leaves_, shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{});
     if (shared) end_shared_export(config_, *cluster_);
     leaves_.reset();
     seams_.reset();

@@ -25,15 +25,6 @@ TileGridParams grid_params(const Config& config) {
   return {.tile_size = config.tiling.tile_size, .halo = config.tiling.halo, .origin = config.tiling.origin};
 }
 
-TilesetExportParams export_params(const Config& config) {
-  TilesetExportParams params;
-  params.dir = config.project.output / "tiles";
-  params.grid = grid_params(config);
-  params.tolerance = config.output.draco_tolerance;
-  for (const AcquisitionEntry& a : config.acquisitions) params.acquisitions.push_back({a.name, format_iso8601(a.time)});
-  return params;
-}
-
 /// Prints the export's line and returns its figures for the run report.
 nlohmann::json report_3d_tiles(const TilesetExportStats& s, const TilesetExportParams& params) {
   std::cout << fmt::format(
@@ -74,7 +65,7 @@ Mesh sub_mesh(const Mesh& mesh, std::span<const std::uint32_t> keep) {
 }
 
 nlohmann::json write_3d_tiles(const Config& config, const MergedMesh& merged) {
-  const TilesetExportParams params = export_params(config);
+  const TilesetExportParams params = tileset_export_params(config);
   const Crs crs = config.crs();
   return report_3d_tiles(export_tileset({merged.mesh, merged.source_acq, crs}, params), params);
 }
@@ -173,23 +164,31 @@ std::filesystem::path find_tileset(const std::filesystem::path& given) {
       fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)", given.string()));
 }
 
-nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportCells& cells) {
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work) {
   nlohmann::json report = nlohmann::json::object();
   if (leaves.leaves().empty()) {
     if (config.output.tiles_3d || config.output.ply) log::warn("the output has no triangles: no tileset written");
     return report;
   }
   if (config.output.tiles_3d) {
-    const TilesetExportParams params = export_params(config);
-    report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, cells), params);
+    const TilesetExportParams params = tileset_export_params(config);
+    report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, work), params);
   }
   if (config.output.ply) report["ply"] = write_tile_plys(config, leaves);
   return report;
 }
 
-ExportedCell export_leaves_cell(const Config& config, const OutputLeaves& leaves, const TilesetFrame& frame,
-                                std::size_t cell) {
-  return export_cell(LeavesToExport(leaves), config.crs(), frame, export_params(config), cell);
+TilesetExportParams tileset_export_params(const Config& config) {
+  TilesetExportParams params;
+  params.dir = config.project.output / "tiles";
+  params.grid = grid_params(config);
+  params.tolerance = config.output.draco_tolerance;
+  for (const AcquisitionEntry& a : config.acquisitions) params.acquisitions.push_back({a.name, format_iso8601(a.time)});
+  return params;
+}
+
+std::unique_ptr<TilesetLeaves> export_view(const OutputLeaves& leaves) {
+  return std::make_unique<LeavesToExport>(leaves);
 }
 
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged) {

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/config/config.h"
@@ -21,12 +22,15 @@ std::filesystem::path find_tileset(const std::filesystem::path& given);
 /// Writes what [output] asks for; returns figures for the run report ({} when nothing).
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged);
 /// The same from the output's tiles in files (a tiled run's seam pass block by block), the
-/// cells of the 3D Tiles tree built by `cells` (default: here; an MPI job's ranks share them).
-nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportCells& cells = {});
+/// 3D Tiles export's leaves mapped and cells built as `work` says (default: here; an MPI
+/// job's ranks share them).
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work = {});
 
-/// Cell `cell` of the 3D Tiles export of `leaves` in `frame`, its tiles written: a rank's share
-/// of the export write_tileset_outputs() runs on the root.
-ExportedCell export_leaves_cell(const Config& config, const OutputLeaves& leaves, const TilesetFrame& frame,
-                                std::size_t cell);
+/// The 3D Tiles export's settings from the config.
+TilesetExportParams tileset_export_params(const Config& config);
+
+/// `leaves` as the 3D Tiles export reads them (each leaf's positions, once mapped, kept beside
+/// it): what a rank sharing the root's export (export_leaf_box, export_cell) reads.
+std::unique_ptr<TilesetLeaves> export_view(const OutputLeaves& leaves);
 
 }  // namespace citymesh::app

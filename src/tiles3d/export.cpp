@@ -251,9 +251,10 @@ LocalMapping local_mapping(const Crs& crs, const EnuFrame& frame) {
   return [&crs, &frame](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
 }
 
-/// Every cell built here, on the pool's threads.
-std::vector<ExportedCell> cells_here(std::size_t count, const std::function<ExportedCell(std::size_t)>& here) {
-  std::vector<ExportedCell> out(count);
+/// here(i) for every i < count, on the pool's threads (leaves mapped, cells built).
+template <class T>
+std::vector<T> all_here(std::size_t count, const std::function<T(std::size_t)>& here) {
+  std::vector<T> out(count);
   parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t c = begin; c < end; ++c) out[c] = here(c);
   });
@@ -283,7 +284,7 @@ TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExpo
 }
 
 TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params,
-                                  const ExportCells& cells) {
+                                  const ExportWork& work) {
   Stopwatch clock;
   const std::vector<TileKey> keys = leaves.keys();
   if (keys.empty()) throw ProcessingError("3D Tiles: the output has no triangles to export");
@@ -292,10 +293,11 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
   const LocalMapping to_local = local_mapping(crs, enu);
   // The lattice must hold every vertex in the local frame, whose box only the leaves know: one
   // pass over them first, a leaf at a time.
-  std::vector<Box3d> boxes(keys.size());
-  parallel_for_blocks(keys.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) boxes[k] = leaves.local_box(keys[k], to_local);
-  });
+  const std::function<Box3d(std::size_t)> map_here = [&](std::size_t k) { return leaves.local_box(keys[k], to_local); };
+  const std::vector<Box3d> boxes = work.boxes ? work.boxes(origin, keys, map_here) : all_here(keys.size(), map_here);
+  if (boxes.size() != keys.size()) {
+    throw ProcessingError(fmt::format("3D Tiles: {} boxes for {} leaves", boxes.size(), keys.size()));
+  }
   Box3d box;
   for (const Box3d& b : boxes) box.extend(b);
   log::debug("3D Tiles: {} leaves mapped to the local frame in {:.2f} s", keys.size(), clock.seconds());
@@ -312,7 +314,7 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       return export_cell(leaves, crs, frame, params, c);
     };
     Stopwatch cells_clock;
-    std::vector<ExportedCell> built = cells ? cells(frame, tree, here) : cells_here(tree.cell_count(), here);
+    std::vector<ExportedCell> built = work.cells ? work.cells(frame, tree, here) : all_here(tree.cell_count(), here);
     log::debug("3D Tiles: {} cells built in {:.2f} s", built.size(), cells_clock.seconds());
     std::vector<TileSubtree> subtrees;
     for (ExportedCell& e : built) {
@@ -321,11 +323,19 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       cell_bytes += e.glb_bytes;
       subtrees.push_back(std::move(e.subtree));
     }
-    return tree.finish(std::move(subtrees));
+    Stopwatch levels_clock;
+    TileTree finished = tree.finish(std::move(subtrees));
+    log::debug("3D Tiles: the levels above the cells built in {:.2f} s", levels_clock.seconds());
+    return finished;
   });
   stats.glb_bytes += cell_bytes;
   stats.seconds = clock.seconds();
   return stats;
+}
+
+Box3d export_leaf_box(const TilesetLeaves& leaves, const Crs& crs, const Geodetic& origin, const TileKey& key) {
+  const EnuFrame enu(origin);
+  return leaves.local_box(key, local_mapping(crs, enu));
 }
 
 ExportedCell export_cell(const TilesetLeaves& leaves, const Crs& crs, const TilesetFrame& frame,

@@ -315,25 +315,35 @@ TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
   EXPECT_TRUE(a == b);
 }
 
-TEST(TilesetExport, CellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {
-  // As an MPI job's ranks do: each cell built from a source and a frame of its own, last cell
-  // first; the exporting process builds only the levels above them.
+TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {
+  // As an MPI job's ranks do: each leaf mapped and each cell built from a source and a frame
+  // of its own, last first; the exporting process builds only the levels above the cells.
   test::TempDir tmp;
   const Scene s = scene();
   const SceneLeaves leaves(s, params(tmp.path()).grid);
   const TilesetExportStats here = export_tileset(leaves, lambert93(), params(tmp / "here"));
-  std::size_t cells = 0;
-  const ExportCells elsewhere = [&](const TilesetFrame& frame, const TileTreeBuild& tree,
-                                    const std::function<ExportedCell(std::size_t)>& /*here*/) {
-    const SceneLeaves other(s, params(tmp.path()).grid);
+  const SceneLeaves other(s, params(tmp.path()).grid);
+  std::size_t mapped = 0, cells = 0;
+  ExportWork elsewhere;
+  elsewhere.boxes = [&](const Geodetic& origin, std::span<const TileKey> keys,
+                        const std::function<Box3d(std::size_t)>& /*here*/) {
+    std::vector<Box3d> out(keys.size());
+    for (std::size_t k = out.size(); k-- > 0;) out[k] = export_leaf_box(other, lambert93(), origin, keys[k]);
+    mapped = out.size();
+    return out;
+  };
+  elsewhere.cells = [&](const TilesetFrame& frame, const TileTreeBuild& tree,
+                        const std::function<ExportedCell(std::size_t)>& /*here*/) {
     const TilesetFrame copied = frame;
     std::vector<ExportedCell> out(tree.cell_count());
-    for (std::size_t c = out.size(); c-- > 0;)
+    for (std::size_t c = out.size(); c-- > 0;) {
       out[c] = export_cell(other, lambert93(), copied, params(tmp / "apart"), c);
+    }
     cells = out.size();
     return out;
   };
   const TilesetExportStats apart = export_tileset(leaves, lambert93(), params(tmp / "apart"), elsewhere);
+  EXPECT_EQ(mapped, here.leaves);
   EXPECT_GE(cells, 4u);
   EXPECT_EQ(apart.tiles, here.tiles);
   EXPECT_EQ(apart.glb_bytes, here.glb_bytes);

@@ -101,11 +101,28 @@ ExportedCell export_cell(const TilesetLeaves& leaves, const Crs& crs, const Tile
 using ExportCells = std::function<std::vector<ExportedCell>(const TilesetFrame& frame, const TileTreeBuild& tree,
                                                             const std::function<ExportedCell(std::size_t)>& here)>;
 
+/// Maps leaf `key` of `leaves` to the local frame at `origin` (TilesetLeaves::local_box):
+/// what another process does for its share of the export's first pass.
+Box3d export_leaf_box(const TilesetLeaves& leaves, const Crs& crs, const Geodetic& origin, const TileKey& key);
+
+/// How the export's first pass maps the leaves, given the frame's origin, the leaves' keys and
+/// `here` (maps leaf k in this process, through export_leaf_box): every leaf's box in the
+/// local frame, index: leaf. The default maps them all here, on the pool's threads.
+using ExportBoxes = std::function<std::vector<Box3d>(const Geodetic& origin, std::span<const TileKey> keys,
+                                                     const std::function<Box3d(std::size_t)>& here)>;
+
+/// The export's work that other processes can share; empty members: done here.
+struct ExportWork {
+  ExportBoxes boxes;
+  ExportCells cells;
+};
+
 /// Writes the tileset of `leaves` as export_tileset writes a mesh's, reading each leaf twice
 /// (once for the lattice, once for the tree) and holding only the tiles the tree is building.
-/// The tree's cells are built by `cells` (default: here), the levels above them here.
+/// The leaves are mapped by `work.boxes` and the tree's cells built by `work.cells` (default:
+/// here); the levels above the cells are built here.
 TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, const TilesetExportParams& params,
-                                  const ExportCells& cells = {});
+                                  const ExportWork& work = {});
 
 /// Some triangles of the output as a tile's mesh: one vertex per (vertex key, feature id of a
 /// triangle using it; stitch triangles have none), positions mapped by `to_local`.
