@@ -209,8 +209,9 @@ std::filesystem::path SeamPartFiles::part_file(const BlockPartKey& key, bool sti
   return dir_ / fmt::format("{}.{}.part", key.name(), stitched ? "stitched" : "input");
 }
 
-void SeamPartFiles::add_tile(TileKey key, const std::vector<TilePiece>& selected) {
+SeamPartFiles::FiledTile SeamPartFiles::file_tile(TileKey key, const std::vector<TilePiece>& selected) const {
   throw_if_interrupted("the seam pass");
+  FiledTile out;
   std::map<BlockPartKey, std::vector<KeyedPiece>> by_part;
   for (const TilePiece& tile_piece : selected) {
     if (tile_piece.triangle_count() == 0) continue;
@@ -221,8 +222,8 @@ void SeamPartFiles::add_tile(TileKey key, const std::vector<TilePiece>& selected
       const Vec3d centroid = (piece.positions[tri[0]] + piece.positions[tri[1]] + piece.positions[tri[2]]) / 3.0;
       triangles[block_part_of(centroid, blocks_)].push_back(t);
       const auto a = static_cast<std::size_t>(piece.source_acq[t]);
-      if (source_sizes_.size() <= a) source_sizes_.resize(a + 1, 0);
-      ++source_sizes_[a];
+      if (out.source_sizes.size() <= a) out.source_sizes.resize(a + 1, 0);
+      ++out.source_sizes[a];
     }
     for (const auto& [part, ts] : triangles) by_part[part].push_back(subset(piece, ts));
   }
@@ -230,11 +231,21 @@ void SeamPartFiles::add_tile(TileKey key, const std::vector<TilePiece>& selected
     std::vector<const KeyedPiece*> all;
     for (const KeyedPiece& p : pieces) all.push_back(&p);
     const KeyedPiece fragment = merge_pieces(all);
-    boxes_[part].extend(fragment.box());
-    const std::filesystem::path file = dir_ / fmt::format("{}.{}.tile", part.name(), key.name());
-    write_scratch_file(file, encode_keyed_piece(fragment));
-    fragments_[part].push_back(file);
+    out.parts.push_back(part);
+    out.boxes.push_back(fragment.box());
+    out.files.push_back(dir_ / fmt::format("{}.{}.tile", part.name(), key.name()));
+    write_scratch_file(out.files.back(), encode_keyed_piece(fragment));
   }
+  return out;
+}
+
+void SeamPartFiles::add_filed(const FiledTile& tile) {
+  for (std::size_t k = 0; k < tile.parts.size(); ++k) {
+    boxes_[tile.parts[k]].extend(tile.boxes[k]);
+    fragments_[tile.parts[k]].push_back(tile.files[k]);
+  }
+  if (source_sizes_.size() < tile.source_sizes.size()) source_sizes_.resize(tile.source_sizes.size(), 0);
+  for (std::size_t a = 0; a < tile.source_sizes.size(); ++a) source_sizes_[a] += tile.source_sizes[a];
 }
 
 std::vector<BlockPart> SeamPartFiles::finish() {

@@ -52,8 +52,20 @@ class SeamPartFiles final : public PartStore {
   SeamPartFiles(const SeamPartFiles&) = delete;
   SeamPartFiles& operator=(const SeamPartFiles&) = delete;
 
-  /// Files the selected triangles of tile `key` under their parts. Tiles come one at a time.
-  void add_tile(TileKey key, const std::vector<TilePiece>& selected);
+  /// A tile's selected triangles written under their parts, not yet added.
+  struct FiledTile {
+    std::vector<BlockPartKey> parts;           ///< ascending
+    std::vector<std::filesystem::path> files;  ///< per part: its fragment's file
+    std::vector<Box3d> boxes;                  ///< per part: its fragment's box
+    std::vector<std::uint64_t> source_sizes;   ///< per source acquisition
+  };
+  /// Writes the selected triangles of tile `key` under their parts; safe from several
+  /// threads for different tiles.
+  [[nodiscard]] FiledTile file_tile(TileKey key, const std::vector<TilePiece>& selected) const;
+  /// Adds a tile file_tile() wrote. Tiles come one at a time, in the order of the output.
+  void add_filed(const FiledTile& tile);
+  /// Both at once.
+  void add_tile(TileKey key, const std::vector<TilePiece>& selected) { add_filed(file_tile(key, selected)); }
   /// Puts each part's tiles together, its triangles in input order (acquisition, then
   /// triangle); the parts in key order with their boxes. Called once, after the last tile.
   [[nodiscard]] std::vector<BlockPart> finish();

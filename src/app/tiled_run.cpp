@@ -92,12 +92,17 @@ class FinalOutput {
     }
   }
 
-  /// Takes a tile's selected triangles before its result goes to the assembly (by blocks;
-  /// whole, the assembly keeps them).
-  void add_tile(TileKey key, TileResult& result) {
-    if (!seams_) return;
-    seams_->add_tile(key, result.selected);
+  /// Writes a tile's selected triangles under their parts and takes them out of its result
+  /// before it goes to the assembly (by blocks; whole, the assembly keeps them). Safe from
+  /// several threads for different tiles; add_filed() then adds them, in tile order.
+  std::optional<SeamPartFiles::FiledTile> file_tile(TileKey key, TileResult& result) const {
+    if (!seams_) return std::nullopt;
+    SeamPartFiles::FiledTile filed = seams_->file_tile(key, result.selected);
     result.selected.clear();
+    return filed;
+  }
+  void add_filed(const std::optional<SeamPartFiles::FiledTile>& filed) {
+    if (filed) seams_->add_filed(*filed);
   }
 
   /// After the last tile: the assembled mesh, or the parts. Returns the triangles selected.
@@ -173,23 +178,26 @@ class FinalOutput {
 };
 
 /// Reads every tile's result (checked) into the assembly and the final output, a few at a
-/// time in parallel, then added in tile order: a read result is several times the piece the
-/// assembly keeps of it, so not all at once.
+/// time in parallel (each filed under the seam pass's parts there too), then added in tile
+/// order: a read result is several times the piece the assembly keeps of it, so not all at
+/// once.
 void read_tile_results(const Config& config, const TileStore& store, std::uint64_t fingerprint,
                        const TileStageReport& tiles, TileAssembly& assembly, FinalOutput& output,
                        std::vector<nlohmann::json>& per_tile) {
   constexpr std::size_t kBatch = 4;
   std::vector<std::optional<TileResult>> batch(kBatch);
+  std::vector<std::optional<SeamPartFiles::FiledTile>> filed(kBatch);
   for (std::size_t first = 0; first < store.tiles.size(); first += kBatch) {
     const std::size_t count = std::min(kBatch, store.tiles.size() - first);
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
-        batch[i] = read_tile_result(result_path(config, store.tiles[first + i].key), fingerprint, store,
-                                    {.pairs = config.output.labels});
+        const TileKey key = store.tiles[first + i].key;
+        batch[i] = read_tile_result(result_path(config, key), fingerprint, store, {.pairs = config.output.labels});
+        filed[i] = batch[i] ? output.file_tile(key, *batch[i]) : std::nullopt;
       }
     });
     for (std::size_t i = 0; i < count; ++i) {
-      if (batch[i]) output.add_tile(store.tiles[first + i].key, *batch[i]);
+      output.add_filed(filed[i]);
       add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0, std::move(batch[i]), assembly,
                       per_tile);
     }

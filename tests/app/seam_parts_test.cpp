@@ -2,6 +2,8 @@
 // The seam pass in files: parts written and read back whole (damaged ones refused), tiles
 // filed under their parts whatever the tiling, and stitching from files giving what
 // stitching in memory gives.
+#include "seam_parts.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -12,7 +14,6 @@
 #include "citymesh/core/error.h"
 #include "face_table.h"
 #include "leaf_outputs.h"
-#include "seam_parts.h"
 #include "test_support.h"
 
 namespace citymesh::app {
@@ -166,8 +167,13 @@ TEST(SeamParts, TilesAreFiledUnderTheirPartsWhateverTheTiling) {
   one.add_tile({0, 0}, tile_pieces(m, [](std::uint32_t) { return true; }));
   // Cut along x = 1.5: triangles on both sides share vertices, which must come out once.
   const auto west = [&](std::uint32_t t) { return m.mesh.positions[m.mesh.triangles[t][0]].x < 1.5f; };
-  two.add_tile({0, 0}, tile_pieces(m, west));
-  two.add_tile({1, 0}, tile_pieces(m, [&](std::uint32_t t) { return !west(t); }));
+  // As the final pass reads results: filed in any order (threads), added in tile order.
+  const SeamPartFiles::FiledTile east_filed =
+      two.file_tile({1, 0}, tile_pieces(m, [&](std::uint32_t t) { return !west(t); }));
+  const SeamPartFiles::FiledTile west_filed = two.file_tile({0, 0}, tile_pieces(m, west));
+  EXPECT_TRUE(std::is_sorted(west_filed.parts.begin(), west_filed.parts.end()));
+  two.add_filed(west_filed);
+  two.add_filed(east_filed);
   const std::vector<BlockPart> a = one.finish(), b = two.finish();
   ASSERT_EQ(a.size(), b.size());
   EXPECT_GT(a.size(), 9u);
@@ -183,7 +189,8 @@ TEST(SeamParts, TilesAreFiledUnderTheirPartsWhateverTheTiling) {
     // In input order, each in the part holding its centroid.
     for (std::size_t t = 0; t < x->triangle_count(); ++t) {
       if (t > 0) {
-        EXPECT_LT(std::pair(x->source_acq[t - 1], x->source_triangle[t - 1]), std::pair(x->source_acq[t], x->source_triangle[t]));
+        EXPECT_LT(std::pair(x->source_acq[t - 1], x->source_triangle[t - 1]),
+                  std::pair(x->source_acq[t], x->source_triangle[t]));
       }
       const Triangle& tri = x->triangles[t];
       const Vec3d c = (x->positions[tri[0]] + x->positions[tri[1]] + x->positions[tri[2]]) / 3.0;
@@ -202,7 +209,8 @@ TEST(SeamParts, StitchingFromFilesGivesWhatStitchingInMemoryGives) {
   SeamPartFiles files(dir / "seams", blocks());
   files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
   std::vector<BlockPart> parts = files.finish();
-  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = Vec3d{}, .run_level = {}};
+  PartStitchRun run{
+      .params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = Vec3d{}, .run_level = {}};
   run.blocks.context = block_context(kParams);
   const double before = parts_open_boundary(parts, files, false, run.blocks);
   const BlockStitchStats s = stitch_parts(parts, files, run);
@@ -250,11 +258,16 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   SeamPartFiles files(dir / "seams", blocks());
   files.add_tile({0, 0}, tile_pieces(test::four_source_scene(), [](std::uint32_t) { return true; }));
   std::vector<BlockPart> parts = files.finish();
-  PartStitchRun run{.params = kParams, .blocks = blocks(), .source_sizes = files.source_sizes(), .frame = std::nullopt, .run_level = {}};
+  PartStitchRun run{.params = kParams,
+                    .blocks = blocks(),
+                    .source_sizes = files.source_sizes(),
+                    .frame = std::nullopt,
+                    .run_level = {}};
   (void)stitch_parts(parts, files, run);
   const MergedMesh gathered = gather_stitched_parts(parts, files);
   // Tiles of 1 m: vertices shared by up to four tiles, some by tiles that meet at a corner only.
-  const OutputLeaves leaves(dir / "tiles", TileGrid({.tile_size = 1.0, .halo = 0.1, .origin = {0.3, 0.3}}), parts, files);
+  const OutputLeaves leaves(dir / "tiles", TileGrid({.tile_size = 1.0, .halo = 0.1, .origin = {0.3, 0.3}}), parts,
+                            files);
   EXPECT_GT(leaves.leaves().size(), 12u);
   write_leaves_ply(dir / "mosaic.ply", leaves);
 
