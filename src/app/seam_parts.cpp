@@ -283,75 +283,84 @@ void SeamPartFiles::save_stitched(std::size_t part, KeyedPiece stitched) {
   write_scratch_file(part_file(keys_.at(part), true), encode_keyed_piece(stitched));
 }
 
-namespace {
-
-/// One part's triangles in one grid tile, in a file of their own.
-struct Share {
-  TileKey key;
-  Box3d box;
-  std::uint64_t triangles;
-  std::filesystem::path file;
-  std::vector<std::int32_t> sources;  ///< of its triangles
-};
-
-/// Each stitched part's triangles split by the grid tile holding their centroid and written
-/// to `dir`, the parts in parallel; per part, its shares.
-std::vector<std::vector<Share>> file_shares(const std::filesystem::path& dir, const TileGrid& grid, std::size_t parts,
-                                            const PartStore& store) {
-  std::vector<std::vector<Share>> shares(parts);
-  parallel_for_blocks(parts, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t p = begin; p < end; ++p) {
-      throw_if_interrupted("the seam pass");
-      const std::shared_ptr<const KeyedPiece> piece = store.load(p, true);
-      std::map<TileKey, std::vector<std::uint32_t>> by_tile;
-      for (std::uint32_t t = 0; t < piece->triangle_count(); ++t) {
-        const Triangle& tri = piece->triangles[t];
-        by_tile[grid.owner((piece->positions[tri[0]] + piece->positions[tri[1]] + piece->positions[tri[2]]) / 3.0)]
-            .push_back(t);
+std::vector<OutputShare> file_part_shares(const std::filesystem::path& dir, const TileGrid& grid,
+                                          const PartStore& store, std::size_t part) {
+  throw_if_interrupted("the seam pass");
+  const std::shared_ptr<const KeyedPiece> piece = store.load(part, true);
+  std::map<TileKey, std::vector<std::uint32_t>> by_tile;
+  for (std::uint32_t t = 0; t < piece->triangle_count(); ++t) {
+    const Triangle& tri = piece->triangles[t];
+    by_tile[grid.owner((piece->positions[tri[0]] + piece->positions[tri[1]] + piece->positions[tri[2]]) / 3.0)]
+        .push_back(t);
+  }
+  std::vector<OutputShare> shares;
+  for (const auto& [key, ts] : by_tile) {
+    const KeyedPiece share = subset(*piece, ts);
+    OutputShare& out = shares.emplace_back();
+    out.key = key;
+    out.box = share.box();
+    out.triangles = ts.size();
+    out.file = dir / fmt::format("{}.{}.share", key.name(), part);
+    for (const std::int32_t a : share.source_acq) {
+      if (a < 0) {
+        ++out.stitched;
+        continue;
       }
-      for (const auto& [key, ts] : by_tile) {
-        const KeyedPiece share = subset(*piece, ts);
-        const std::filesystem::path file = dir / fmt::format("{}.{}.share", key.name(), p);
-        write_scratch_file(file, encode_keyed_piece(share));
-        shares[p].push_back({key, share.box(), ts.size(), file, share.source_acq});
-      }
+      if (out.per_source.size() <= static_cast<std::size_t>(a))
+        out.per_source.resize(static_cast<std::size_t>(a) + 1, 0);
+      ++out.per_source[static_cast<std::size_t>(a)];
     }
-  });
+    write_scratch_file(out.file, encode_keyed_piece(share));
+  }
   return shares;
 }
 
-}  // namespace
+void merge_leaf_file(const std::filesystem::path& leaf_file, std::span<const std::filesystem::path> shares) {
+  write_scratch_file(leaf_file, encode_keyed_piece(merge_and_remove(shares)));
+}
 
 OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
-                           const PartStore& store)
+                           const PartStore& store, const LeafFilingWork& work)
     : dir_(std::move(dir)) {
   make_empty_folder(dir_, "the output's tiles");
-  const std::vector<std::vector<Share>> shares = file_shares(dir_, grid, parts.size(), store);
+  const std::function<std::vector<OutputShare>(std::size_t)> split_here = [&](std::size_t p) {
+    return file_part_shares(dir_, grid, store, p);
+  };
+  const std::vector<std::vector<OutputShare>> shares =
+      work.split ? work.split(parts.size(), split_here) : parallel_map(parts.size(), split_here);
+  if (shares.size() != parts.size()) throw ProcessingError("the seam pass: a part was not filed by grid tile");
   // The tiles in key order, each with its shares in part order.
   std::map<TileKey, std::size_t> index;
-  for (const std::vector<Share>& of_part : shares) {
-    for (const Share& s : of_part) index.try_emplace(s.key, 0);
+  for (const std::vector<OutputShare>& of_part : shares) {
+    for (const OutputShare& s : of_part) index.try_emplace(s.key, 0);
   }
   for (auto& [key, i] : index) {
     i = leaves_.size();
     leaves_.push_back({key, {}, 0});
   }
   std::vector<std::vector<std::filesystem::path>> fragments(leaves_.size());
-  for (const std::vector<Share>& of_part : shares) {
-    for (const Share& s : of_part) {
+  for (const std::vector<OutputShare>& of_part : shares) {
+    for (const OutputShare& s : of_part) {
       OutputLeaf& leaf = leaves_[index.at(s.key)];
       leaf.box.extend(s.box);
       leaf.triangles += s.triangles;
       fragments[index.at(s.key)].push_back(s.file);
-      count_sources(s.sources);
+      if (per_source_.size() < s.per_source.size()) per_source_.resize(s.per_source.size(), 0);
+      for (std::size_t a = 0; a < s.per_source.size(); ++a) per_source_[a] += s.per_source[a];
+      stitched_ += s.stitched;
     }
   }
   // Each tile's shares in one file, read once per output.
-  parallel_for_blocks(leaves_.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t l = begin; l < end; ++l) {
-      write_scratch_file(leaf_file(leaves_[l]), encode_keyed_piece(merge_and_remove(fragments[l])));
-    }
-  });
+  std::vector<std::filesystem::path> files;
+  for (const OutputLeaf& leaf : leaves_) files.push_back(leaf_file(leaf));
+  const std::function<void(std::size_t)> merge_here = [&](std::size_t l) { merge_leaf_file(files[l], fragments[l]); };
+  if (work.merge) {
+    work.merge(files, fragments, merge_here);
+  } else {
+    parallel_for_blocks(leaves_.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t l = begin; l < end; ++l) merge_here(l);
+    });
+  }
 }
 
 OutputLeaves::OutputLeaves(std::filesystem::path dir, std::vector<OutputLeaf> leaves)
@@ -359,17 +368,6 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, std::vector<OutputLeaf> le
 
 std::filesystem::path OutputLeaves::leaf_file(const OutputLeaf& leaf) const {
   return dir_ / fmt::format("{}.leaf", leaf.key.name());
-}
-
-void OutputLeaves::count_sources(std::span<const std::int32_t> sources) {
-  for (const std::int32_t a : sources) {
-    if (a < 0) {
-      ++stitched_;
-      continue;
-    }
-    if (per_source_.size() <= static_cast<std::size_t>(a)) per_source_.resize(static_cast<std::size_t>(a) + 1, 0);
-    ++per_source_[static_cast<std::size_t>(a)];
-  }
 }
 
 void OutputLeaves::keep(std::size_t leaf, std::string_view name, std::string_view bytes) const {

@@ -6,8 +6,10 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -96,6 +98,38 @@ class SeamPartFiles final : public PartStore {
   bool owned_ = true;  ///< the folder is this object's: made empty, removed with it
 };
 
+/// One stitched part's triangles in one grid tile of the output, in a file of their own.
+struct OutputShare {
+  TileKey key;
+  Box3d box;
+  std::uint64_t triangles = 0;
+  std::filesystem::path file;
+  std::vector<std::uint64_t> per_source;  ///< its triangles per source acquisition
+  std::uint64_t stitched = 0;             ///< and stitching's
+};
+
+/// Stitched part `part` of `store` split by the grid tile holding each triangle's centroid,
+/// each share written to `dir`: safe from several threads (or processes) for different parts.
+std::vector<OutputShare> file_part_shares(const std::filesystem::path& dir, const TileGrid& grid,
+                                          const PartStore& store, std::size_t part);
+
+/// Writes `leaf_file` from the shares in `shares` (in order), which are removed.
+void merge_leaf_file(const std::filesystem::path& leaf_file, std::span<const std::filesystem::path> shares);
+
+/// How OutputLeaves files the output: each step given its item count and `here` (one item
+/// done in this process); empty members: done here, on the pool's threads.
+struct LeafFilingWork {
+  /// Every stitched part split by grid tile (file_part_shares), index: part.
+  std::function<std::vector<std::vector<OutputShare>>(std::size_t parts,
+                                                      const std::function<std::vector<OutputShare>(std::size_t)>& here)>
+      split;
+  /// Every leaf's file written from its shares (merge_leaf_file): `files[l]` from `shares[l]`.
+  std::function<void(std::span<const std::filesystem::path> files,
+                     std::span<const std::vector<std::filesystem::path>> shares,
+                     const std::function<void(std::size_t)>& here)>
+      merge;
+};
+
 /// A grid tile of the output: its key and what its triangles span.
 struct OutputLeaf {
   TileKey key;
@@ -108,9 +142,10 @@ struct OutputLeaf {
 class OutputLeaves {
  public:
   /// Files the triangles of the stitched `parts` under their tiles, in `dir` (created empty,
-  /// removed with this); reads each part once.
+  /// removed with this); reads each part once. `work` may share the filing with other
+  /// processes.
   OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std::span<const BlockPart> parts,
-               const PartStore& store);
+               const PartStore& store, const LeafFilingWork& work = {});
   /// The tiles `leaves` (keys ascending) of another process's folder `dir` (an MPI rank
   /// helping the root's export): reads them there, never creates nor removes the folder.
   OutputLeaves(std::filesystem::path dir, std::vector<OutputLeaf> leaves);
@@ -137,7 +172,6 @@ class OutputLeaves {
  private:
   std::filesystem::path dir_;
   std::vector<OutputLeaf> leaves_;
-  void count_sources(std::span<const std::int32_t> sources);
 
   [[nodiscard]] std::filesystem::path leaf_file(const OutputLeaf& leaf) const;
 

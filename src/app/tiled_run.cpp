@@ -16,11 +16,11 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_reader.h"
 #include "detect_output.h"
-#include "export_ranks.h"
 #include "leaf_outputs.h"
 #include "leftovers.h"
 #include "mosaic_output.h"
 #include "mosaic_step.h"
+#include "output_ranks.h"
 #include "run_stages.h"
 #include "run_state.h"
 #include "seam_parts.h"
@@ -128,9 +128,12 @@ class FinalOutput {
                                   shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{});
       if (shared) remove_seam_plan(config_);
       // The outputs read the stitched output one grid tile at a time.
-      leaves_.emplace(seam_parts_folder(config_.project.work) / "tiles",
-                      TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}), parts_,
-                      *seams_);
+      std::vector<BlockPartKey> keys;
+      for (const BlockPart& p : parts_) keys.push_back(p.key);
+      leaves_.emplace(
+          seams_->dir() / "tiles", TileGrid({config_.tiling.tile_size, config_.tiling.halo, config_.tiling.origin}),
+          parts_, *seams_,
+          shared ? share_leaf_filing(config_, *cluster_, seams_->dir(), std::move(keys)) : LeafFilingWork{});
       seams_->release_stitched();
       return figures;
     }
@@ -150,12 +153,12 @@ class FinalOutput {
   /// The 3D Tiles and per-tile PLYs; then the pass's files go.
   nlohmann::json export_tiles() {
     if (!leaves_) return write_tileset_outputs(config_, merged_);
-    // The other ranks, done with the seam pass, map leaves and build cells of the tree until
-    // the root ends the export (help_export).
+    // The other ranks, done with the seam pass and the filing by grid tile, map leaves and
+    // build cells of the tree until the root ends (help_outputs).
     const bool shared = cluster_ != nullptr && cluster_->size() > 1;
     const nlohmann::json exported =
         write_tileset_outputs(config_, *leaves_, shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{});
-    if (shared) end_shared_export(config_, *cluster_);
+    if (shared) end_shared_outputs(config_, *cluster_);
     leaves_.reset();
     seams_.reset();
     return exported;
@@ -338,7 +341,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
     write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, &cluster);
   } else if (seam_pass_in_blocks(config)) {
     help_seam_pass(config, cluster);
-    help_export(config, cluster);
+    help_outputs(config, cluster);
   }
   cluster.barrier();
 }

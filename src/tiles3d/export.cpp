@@ -251,16 +251,6 @@ LocalMapping local_mapping(const Crs& crs, const EnuFrame& frame) {
   return [&crs, &frame](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
 }
 
-/// here(i) for every i < count, on the pool's threads (leaves mapped, cells built).
-template <class T>
-std::vector<T> all_here(std::size_t count, const std::function<T(std::size_t)>& here) {
-  std::vector<T> out(count);
-  parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t c = begin; c < end; ++c) out[c] = here(c);
-  });
-  return out;
-}
-
 }  // namespace
 
 TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params) {
@@ -294,7 +284,8 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
   // The lattice must hold every vertex in the local frame, whose box only the leaves know: one
   // pass over them first, a leaf at a time.
   const std::function<Box3d(std::size_t)> map_here = [&](std::size_t k) { return leaves.local_box(keys[k], to_local); };
-  const std::vector<Box3d> boxes = work.boxes ? work.boxes(origin, keys, map_here) : all_here(keys.size(), map_here);
+  const std::vector<Box3d> boxes =
+      work.boxes ? work.boxes(origin, keys, map_here) : parallel_map(keys.size(), map_here);
   if (boxes.size() != keys.size()) {
     throw ProcessingError(fmt::format("3D Tiles: {} boxes for {} leaves", boxes.size(), keys.size()));
   }
@@ -314,7 +305,8 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       return export_cell(leaves, crs, frame, params, c);
     };
     Stopwatch cells_clock;
-    std::vector<ExportedCell> built = work.cells ? work.cells(frame, tree, here) : all_here(tree.cell_count(), here);
+    std::vector<ExportedCell> built =
+        work.cells ? work.cells(frame, tree, here) : parallel_map(tree.cell_count(), here);
     log::debug("3D Tiles: {} cells built in {:.2f} s", built.size(), cells_clock.seconds());
     std::vector<TileSubtree> subtrees;
     for (ExportedCell& e : built) {

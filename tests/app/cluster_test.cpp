@@ -74,7 +74,7 @@ TEST_F(ClusterRun, ThreeMpiRanksGiveTheBytesOfOneProcess) {
   EXPECT_EQ(report["reused_tiles"], 0);
 }
 
-TEST_F(ClusterRun, ThreeMpiRanksShareTheSeamPassAndTheExportAndGiveTheBytesOfOneProcess) {
+TEST_F(ClusterRun, ThreeMpiRanksShareTheFinalPassAndGiveTheBytesOfOneProcess) {
   if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
   // 20 m tiles take the seam pass by blocks (10 m ones are too narrow for its bands).
   const std::string blocks = " --set tiling.tile_size=20 --set run.seam_pass=blocks --threads 1";
@@ -98,12 +98,13 @@ TEST_F(ClusterRun, ThreeMpiRanksShareTheSeamPassAndTheExportAndGiveTheBytesOfOne
   EXPECT_EQ(lines, 2u) << log;
   EXPECT_GT(remote, 0u) << log;
   EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "seam-level.json")) << "the plan was left behind";
-  // They then map leaves and build cells of the 3D Tiles tree (the tiles are among the bytes compared above)
-  // until rank 0 ends the export; how many each gets depends on timing.
+  // They then file the output by grid tile, map leaves and build cells of the 3D Tiles tree
+  // (the tiles are among the bytes compared above) until rank 0 ends; how many each gets
+  // depends on timing.
   for (const int rank : {1, 2}) {
-    EXPECT_NE(log.find(fmt::format("rank {}: mapped ", rank)), std::string::npos) << log;
+    EXPECT_NE(log.find(fmt::format("rank {}: filed ", rank)), std::string::npos) << log;
   }
-  EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "export-step.json")) << "the plan was left behind";
+  EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "output-step.json")) << "the plan was left behind";
 }
 
 TEST_F(ClusterRun, AKilledRankLosesOnlyItsWorkInFlight) {

@@ -8,6 +8,7 @@
 #include <memory>
 #include <span>
 #include <utility>
+#include <vector>
 
 namespace citymesh {
 
@@ -32,6 +33,17 @@ class ThreadLimit {
 /// that are then combined in block order gives the same bytes on 1 or N threads.
 void parallel_for_blocks(std::size_t count, std::size_t grain,
                          const std::function<void(std::size_t, std::size_t)>& body);
+
+/// `item(i)` for every i < count, one item at a time on the pool's threads, in a vector
+/// indexed by i.
+template <class Result>
+std::vector<Result> parallel_map(std::size_t count, const std::function<Result(std::size_t)>& item) {
+  std::vector<Result> out(count);
+  parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) out[i] = item(i);
+  });
+  return out;
+}
 
 /// Sorts `values` ascending on the pool. Plain integers: the result is the same on 1 or N
 /// threads.

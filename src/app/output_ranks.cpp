@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-#include "export_ranks.h"
+#include "output_ranks.h"
 
 #include <fmt/format.h>
 
@@ -27,23 +27,42 @@ namespace citymesh::app {
 
 namespace {
 
-/// The plan of the export step being shared, written by the root before it shares the step.
-std::filesystem::path plan_path(const Config& config) { return config.project.work / "export-step.json"; }
+/// The plan of the step being shared, written by the root before it shares the step.
+std::filesystem::path plan_path(const Config& config) { return config.project.work / "output-step.json"; }
 
-/// What another rank needs for one step of the export: map leaves ("boxes": the frame's
-/// origin is set) or build cells ("cells": the whole frame), reading the output's tiles (their
-/// folder and keys); "end" lets it go.
-struct ExportPlan {
+/// What another rank needs for one step:
+/// - "split": file the stitched parts `parts` of `parts_dir` by grid tile into `dir`;
+/// - "merge": write each leaf file `leaf_files[l]` from its shares `shares[l]`;
+/// - "boxes": map the output's tiles (`leaves`, in `dir`) to the frame at `frame.origin`;
+/// - "cells": build the export's cells in `frame`, from the same tiles;
+/// - "end": nothing more.
+struct StepPlan {
   std::string step;
   std::filesystem::path dir;
+  std::filesystem::path parts_dir;
+  std::vector<BlockPartKey> parts;
+  std::vector<std::filesystem::path> leaf_files;
+  std::vector<std::vector<std::filesystem::path>> shares;
   std::vector<TileKey> leaves;
   TilesetFrame frame;
 };
 
+/// A plan of step `step` reading the output's tiles in `dir` (or nothing).
+StepPlan plan_of(std::string step, std::filesystem::path dir = {}) {
+  StepPlan plan;
+  plan.step = std::move(step);
+  plan.dir = std::move(dir);
+  return plan;
+}
+
+std::string absolute_or_empty(const std::filesystem::path& p) {
+  return p.empty() ? std::string() : std::filesystem::absolute(p).string();
+}
+
 nlohmann::json float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
 float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.get<std::uint32_t>()); }
 
-void write_plan(const Config& config, const ExportPlan& plan) {
+void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json leaves = nlohmann::json::array();
   for (const TileKey& k : plan.leaves) leaves.push_back({k.i, k.j});
   const TilesetFrame& f = plan.frame;
@@ -52,9 +71,22 @@ void write_plan(const Config& config, const ExportPlan& plan) {
     for (const float v : f.lattice.lattice->origin) lattice.push_back(float_bits(v));
     lattice.push_back(float_bits(f.lattice.lattice->range));
   }
+  nlohmann::json parts = nlohmann::json::array();
+  for (const BlockPartKey& k : plan.parts) parts.push_back({k.level, k.x, k.y});
+  nlohmann::json leaf_files = nlohmann::json::array(), shares = nlohmann::json::array();
+  for (const std::filesystem::path& file : plan.leaf_files) leaf_files.push_back(absolute_or_empty(file));
+  for (const auto& of_leaf : plan.shares) {
+    nlohmann::json files = nlohmann::json::array();
+    for (const std::filesystem::path& file : of_leaf) files.push_back(absolute_or_empty(file));
+    shares.push_back(files);
+  }
   const nlohmann::json j{
       {"step", plan.step},
-      {"dir", plan.dir.empty() ? std::string() : std::filesystem::absolute(plan.dir).string()},
+      {"dir", absolute_or_empty(plan.dir)},
+      {"parts_dir", absolute_or_empty(plan.parts_dir)},
+      {"parts", parts},
+      {"leaf_files", leaf_files},
+      {"shares", shares},
       {"leaves", leaves},
       {"origin", {double_bits(f.origin.lat), double_bits(f.origin.lon), double_bits(f.origin.height)}},
       {"position_bits", f.lattice.position_bits},
@@ -63,15 +95,24 @@ void write_plan(const Config& config, const ExportPlan& plan) {
   write_file_atomically(plan_path(config), j.dump() + "\n");
 }
 
-ExportPlan read_plan(const Config& config) {
+StepPlan read_plan(const Config& config) {
   const std::filesystem::path file = plan_path(config);
   std::ifstream in(file);
-  if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of the 3D Tiles export)", file.string()));
+  if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of a step of the final pass)", file.string()));
   try {
     const nlohmann::json j = nlohmann::json::parse(in);
-    ExportPlan plan;
+    StepPlan plan;
     plan.step = j.at("step").get<std::string>();
     plan.dir = j.at("dir").get<std::string>();
+    plan.parts_dir = j.at("parts_dir").get<std::string>();
+    for (const auto& k : j.at("parts")) {
+      plan.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
+    }
+    for (const auto& f : j.at("leaf_files")) plan.leaf_files.emplace_back(f.get<std::string>());
+    for (const auto& of_leaf : j.at("shares")) {
+      plan.shares.emplace_back();
+      for (const auto& f : of_leaf) plan.shares.back().emplace_back(f.get<std::string>());
+    }
     for (const auto& k : j.at("leaves"))
       plan.leaves.push_back({k.at(0).get<std::int32_t>(), k.at(1).get<std::int32_t>()});
     const auto& o = j.at("origin");
@@ -234,6 +275,46 @@ ExportedCell take_cell(const std::filesystem::path& dir, std::size_t c) {
   return cell;
 }
 
+/// A part's shares another rank filed: beside them, in JSON.
+std::filesystem::path shares_file(const std::filesystem::path& dir, std::size_t part) {
+  return dir / fmt::format("part-{}.shares", part);
+}
+
+nlohmann::json shares_json(const std::vector<OutputShare>& shares) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const OutputShare& s : shares) {
+    out.push_back({{"key", {s.key.i, s.key.j}},
+                   {"box", box_bits(s.box)},
+                   {"triangles", s.triangles},
+                   {"file", s.file.string()},
+                   {"per_source", s.per_source},
+                   {"stitched", s.stitched}});
+  }
+  return out;
+}
+
+std::vector<OutputShare> take_shares(const std::filesystem::path& dir, std::size_t part) {
+  const std::filesystem::path file = shares_file(dir, part);
+  const std::optional<std::string> text = read_file_bytes(file);
+  if (!text) throw ProcessingError(fmt::format("{}: missing (a part another rank filed)", file.string()));
+  try {
+    std::vector<OutputShare> shares;
+    for (const auto& j : nlohmann::json::parse(*text)) {
+      OutputShare& s = shares.emplace_back();
+      s.key = {j.at("key").at(0).get<std::int32_t>(), j.at("key").at(1).get<std::int32_t>()};
+      s.box = box_from_bits(j.at("box"));
+      s.triangles = j.at("triangles").get<std::uint64_t>();
+      s.file = j.at("file").get<std::string>();
+      s.per_source = j.at("per_source").get<std::vector<std::uint64_t>>();
+      s.stitched = j.at("stitched").get<std::uint64_t>();
+    }
+    std::filesystem::remove(file);
+    return shares;
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
+  }
+}
+
 /// A leaf's box another rank mapped: beside the leaf, as bits.
 std::filesystem::path box_file(const std::filesystem::path& dir, const TileKey& key) {
   return dir / fmt::format("{}.box", key.name());
@@ -263,6 +344,37 @@ void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const std::
 
 }  // namespace
 
+LeafFilingWork share_leaf_filing(const Config& config, Cluster& cluster, const std::filesystem::path& parts_dir,
+                                 std::vector<BlockPartKey> parts) {
+  LeafFilingWork work;
+  work.split = [&config, &cluster, parts_dir, parts](std::size_t count,
+                                                     const std::function<std::vector<OutputShare>(std::size_t)>& here) {
+    if (count != parts.size()) throw ProcessingError("the seam pass: other parts to file than those stitched");
+    const std::filesystem::path dir = parts_dir / "tiles";
+    StepPlan plan = plan_of("split", dir);
+    plan.parts_dir = parts_dir;
+    plan.parts = parts;
+    write_plan(config, plan);
+    std::vector<std::optional<std::vector<OutputShare>>> mine(count);
+    share_items(cluster, std::vector<std::uint64_t>(count, 1), [&](std::size_t p) { mine[p] = here(p); });
+    std::vector<std::vector<OutputShare>> shares(count);
+    for (std::size_t p = 0; p < count; ++p) shares[p] = mine[p] ? std::move(*mine[p]) : take_shares(dir, p);
+    return shares;
+  };
+  work.merge = [&config, &cluster](std::span<const std::filesystem::path> files,
+                                   std::span<const std::vector<std::filesystem::path>> shares,
+                                   const std::function<void(std::size_t)>& here) {
+    StepPlan plan = plan_of("merge");
+    plan.leaf_files.assign(files.begin(), files.end());
+    plan.shares.assign(shares.begin(), shares.end());
+    write_plan(config, plan);
+    std::vector<std::uint64_t> costs;  // the shares to read: largest leaf first
+    for (const auto& of_leaf : shares) costs.push_back(of_leaf.size());
+    share_items(cluster, std::move(costs), here);
+  };
+  return work;
+}
+
 ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeaves& leaves) {
   // Each leaf's triangles: what mapping it costs, and with its cell's, building the cell.
   auto triangles = std::make_shared<std::map<TileKey, std::uint64_t>>();
@@ -277,7 +389,10 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
     if (!std::equal(asked.begin(), asked.end(), keys.begin(), keys.end())) {
       throw ProcessingError("3D Tiles: the export asks for other leaves than the output's");
     }
-    write_plan(config, {"boxes", leaves.dir(), keys, {origin, {}}});
+    StepPlan plan = plan_of("boxes", leaves.dir());
+    plan.leaves = keys;
+    plan.frame.origin = origin;
+    write_plan(config, plan);
     std::vector<std::uint64_t> costs;
     for (const TileKey& k : keys) costs.push_back(triangles->at(k));
     std::vector<std::optional<Box3d>> mine(keys.size());
@@ -291,7 +406,10 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
   };
   work.cells = [&config, &cluster, &leaves, triangles, keys](const TilesetFrame& frame, const TileTreeBuild& tree,
                                                              const std::function<ExportedCell(std::size_t)>& here) {
-    write_plan(config, {"cells", leaves.dir(), keys, frame});
+    StepPlan plan = plan_of("cells", leaves.dir());
+    plan.leaves = keys;
+    plan.frame = frame;
+    write_plan(config, plan);
     // Largest cell first, so that none is left to end the step alone.
     std::vector<std::uint64_t> costs(tree.cell_count(), 0);
     for (std::size_t c = 0; c < costs.size(); ++c) {
@@ -318,48 +436,70 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
   return work;
 }
 
-void end_shared_export(const Config& config, Cluster& cluster) {
-  write_plan(config, {"end", {}, {}, {}});
+void end_shared_outputs(const Config& config, Cluster& cluster) {
+  write_plan(config, plan_of("end"));
   share_items(cluster, {}, [](std::size_t) {});
   std::error_code ec;
   std::filesystem::remove(plan_path(config), ec);
 }
 
-void help_export(const Config& config, Cluster& cluster) {
-  std::atomic<std::size_t> mapped = 0, built = 0;
+void help_outputs(const Config& config, Cluster& cluster) {
+  std::atomic<std::size_t> filed = 0, merged = 0, mapped = 0, built = 0;
   const Crs crs = config.crs();
   const TilesetExportParams params = tileset_export_params(config);
+  const TileGrid grid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin});
   for (;;) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.
     auto channel = cluster.share(nullptr, {});
-    const ExportPlan plan = read_plan(config);
+    const StepPlan plan = read_plan(config);
     if (plan.step == "end") break;
+    // Each result is written before the root hears that the item is done (the worker's next
+    // request says so).
+    const auto work = [&](const std::function<void(std::size_t)>& body) {
+      run_workers(*channel, available_threads(), [&](std::size_t i) {
+        throw_if_interrupted("the final pass");
+        body(i);
+      });
+    };
+    if (plan.step == "split") {
+      const SeamPartFiles parts(plan.parts_dir, plan.parts);
+      work([&](std::size_t p) {
+        const std::vector<OutputShare> shares = file_part_shares(plan.dir, grid, parts, p);
+        write_file_atomically(shares_file(plan.dir, p), shares_json(shares).dump());
+        ++filed;
+      });
+      continue;
+    }
+    if (plan.step == "merge") {
+      work([&](std::size_t l) {
+        merge_leaf_file(plan.leaf_files.at(l), plan.shares.at(l));
+        ++merged;
+      });
+      continue;
+    }
     std::vector<OutputLeaf> leaves;
     for (const TileKey& k : plan.leaves) leaves.push_back({k, {}, 0});
     const OutputLeaves attached(plan.dir, std::move(leaves));
     const std::unique_ptr<TilesetLeaves> view = export_view(attached);
-    // Each result is written before the root hears that the item is done (the worker's next
-    // request says so).
     if (plan.step == "boxes") {
-      run_workers(*channel, available_threads(), [&](std::size_t k) {
-        throw_if_interrupted("the 3D Tiles export");
+      work([&](std::size_t k) {
         const Box3d box = export_leaf_box(*view, crs, plan.frame.origin, plan.leaves.at(k));
         write_file_atomically(box_file(plan.dir, plan.leaves[k]), box_bits(box).dump());
         ++mapped;
       });
     } else if (plan.step == "cells") {
-      run_workers(*channel, available_threads(), [&](std::size_t c) {
-        throw_if_interrupted("the 3D Tiles export");
+      work([&](std::size_t c) {
         write_cell(plan.dir, c, export_cell(*view, crs, plan.frame, params, c));
         ++built;
       });
     } else {
       throw ProcessingError(
-          fmt::format("{}: unknown step '{}' of the 3D Tiles export", plan_path(config).string(), plan.step));
+          fmt::format("{}: unknown step '{}' of the final pass", plan_path(config).string(), plan.step));
     }
   }
-  log::info("rank {}: mapped {} leaves and built {} cells of the 3D Tiles export", cluster.rank(), mapped.load(),
-            built.load());
+  log::info(
+      "rank {}: filed {} parts and {} tiles of the output; mapped {} leaves and built {} cells of the 3D Tiles export",
+      cluster.rank(), filed.load(), merged.load(), mapped.load(), built.load());
 }
 
 }  // namespace citymesh::app
