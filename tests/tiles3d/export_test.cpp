@@ -6,6 +6,7 @@
 //   -> 4202017.855690 171215.722181 4779232.622308
 #include "citymesh/tiles3d/export.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -350,6 +351,30 @@ TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOnePr
   const auto a = folder_bytes(tmp / "here"), b = folder_bytes(tmp / "apart");
   EXPECT_EQ(a.size(), b.size());
   EXPECT_TRUE(a == b);
+}
+
+TEST(TilesetExport, AnyDepthFirstSplitGivesTheSameFiles) {
+  // The cells a cluster shares: how many there are changes which process builds what and the
+  // order of the tree's nodes, never a file.
+  test::TempDir tmp;
+  const Scene s = scene();
+  const SceneLeaves leaves(s, params(tmp.path()).grid);
+  std::map<std::string, std::string> reference;
+  for (const std::size_t cells : {std::size_t{16}, std::size_t{1}, std::size_t{4}, std::size_t{64}, SIZE_MAX}) {
+    TilesetExportParams p = params(tmp / fmt::format("cells-{}", cells));
+    p.tree.depth_first_cells = cells;
+    p.max_tiles_per_file = 5;  // external tilesets too
+    export_tileset(leaves, lambert93(), p);
+    const auto bytes = folder_bytes(p.dir);
+    if (reference.empty()) {
+      reference = bytes;
+      const auto json_files =
+          std::count_if(bytes.begin(), bytes.end(), [](const auto& f) { return f.first.ends_with(".json"); });
+      EXPECT_GT(json_files, 1) << "no external tileset";
+    }
+    EXPECT_EQ(bytes.size(), reference.size()) << cells << " cells";
+    EXPECT_TRUE(bytes == reference) << cells << " cells";
+  }
 }
 
 TEST(TilesetExport, ReExportReplacesTheWholeFolder) {
