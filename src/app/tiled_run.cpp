@@ -270,7 +270,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
   report["peak_rss_bytes"] = peak_resident_bytes();
   report["seconds"] = seconds;
   report["seconds"]["total"] = wall;
-  report["triangles_per_second"] = static_cast<double>(assembly.owned()) / std::max(wall, 1e-9);
+  // Over a resumed run's time, a rate says nothing of the work the reused tiles took: null.
+  report["triangles_per_second"] =
+      reused == 0 ? nlohmann::json(static_cast<double>(assembly.owned()) / std::max(wall, 1e-9)) : nlohmann::json();
   report["tiling"] = {{"halo_copies", store.stats.halo_copies},
                       {"empty_space_copies", store.stats.empty_space_copies},
                       {"bytes_written", store.stats.bytes_written},
