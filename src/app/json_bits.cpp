@@ -24,4 +24,8 @@ Box3d box_from_bits(const nlohmann::json& j) {
   return b;
 }
 
+nlohmann::json tile_key_json(const TileKey& k) { return {k.i, k.j}; }
+
+TileKey tile_key_from(const nlohmann::json& j) { return {j.at(0).get<std::int32_t>(), j.at(1).get<std::int32_t>()}; }
+
 }  // namespace citymesh::app

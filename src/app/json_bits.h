@@ -1,12 +1,22 @@
 // SPDX-License-Identifier: MIT
-// Doubles and boxes in the JSON files MPI ranks hand each other, as their bits: a box or a
-// frame must come back exactly (an empty box is infinite, and a sum over ranks must equal one
-// process's).
+// The JSON files MPI ranks hand each other: doubles and boxes as their bits (a box or a frame
+// must come back exactly, an empty box is infinite, and a sum over ranks must equal one
+// process's), grid keys, and reading such a file with a clear error when it is missing or
+// not what was expected.
 #pragma once
 
-#include <nlohmann/json.hpp>
+#include <fmt/format.h>
 
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include "citymesh/core/error.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/vec.h"
+#include "citymesh/tiler/tile_grid.h"
 
 namespace citymesh::app {
 
@@ -15,5 +25,29 @@ double double_from_bits(const nlohmann::json& j);
 
 nlohmann::json box_bits(const Box3d& b);
 Box3d box_from_bits(const nlohmann::json& j);
+
+nlohmann::json tile_key_json(const TileKey& k);
+TileKey tile_key_from(const nlohmann::json& j);
+
+/// `decode(the JSON in file)`; throws ProcessingError naming the file when it is missing
+/// ("missing (`what`)") or holds something `decode` does not expect ("malformed").
+template <class Decode>
+auto decode_json_file(const std::filesystem::path& file, std::string_view what, Decode decode) {
+  const std::optional<std::string> text = read_file_bytes(file);
+  if (!text) throw ProcessingError(fmt::format("{}: missing ({})", file.string(), what));
+  try {
+    return decode(nlohmann::json::parse(*text));
+  } catch (const nlohmann::json::exception& e) {
+    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
+  }
+}
+
+/// decode_json_file(), then the file is removed: what another rank left for this one.
+template <class Decode>
+auto take_json_file(const std::filesystem::path& file, std::string_view what, Decode decode) {
+  auto result = decode_json_file(file, what, decode);
+  std::filesystem::remove(file);
+  return result;
+}
 
 }  // namespace citymesh::app

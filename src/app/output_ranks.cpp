@@ -64,7 +64,7 @@ float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.g
 
 void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json leaves = nlohmann::json::array();
-  for (const TileKey& k : plan.leaves) leaves.push_back({k.i, k.j});
+  for (const TileKey& k : plan.leaves) leaves.push_back(tile_key_json(k));
   const TilesetFrame& f = plan.frame;
   nlohmann::json lattice = nlohmann::json::array();
   if (f.lattice.lattice) {
@@ -96,11 +96,7 @@ void write_plan(const Config& config, const StepPlan& plan) {
 }
 
 StepPlan read_plan(const Config& config) {
-  const std::filesystem::path file = plan_path(config);
-  std::ifstream in(file);
-  if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of a step of the final pass)", file.string()));
-  try {
-    const nlohmann::json j = nlohmann::json::parse(in);
+  return decode_json_file(plan_path(config), "rank 0's plan of a step of the final pass", [](const nlohmann::json& j) {
     StepPlan plan;
     plan.step = j.at("step").get<std::string>();
     plan.dir = j.at("dir").get<std::string>();
@@ -113,8 +109,7 @@ StepPlan read_plan(const Config& config) {
       plan.shares.emplace_back();
       for (const auto& f : of_leaf) plan.shares.back().emplace_back(f.get<std::string>());
     }
-    for (const auto& k : j.at("leaves"))
-      plan.leaves.push_back({k.at(0).get<std::int32_t>(), k.at(1).get<std::int32_t>()});
+    for (const auto& k : j.at("leaves")) plan.leaves.push_back(tile_key_from(k));
     const auto& o = j.at("origin");
     plan.frame.origin = {double_from_bits(o.at(0)), double_from_bits(o.at(1)), double_from_bits(o.at(2))};
     plan.frame.lattice.position_bits = j.at("position_bits").get<int>();
@@ -125,9 +120,7 @@ StepPlan read_plan(const Config& config) {
           {float_from_bits(l.at(0)), float_from_bits(l.at(1)), float_from_bits(l.at(2))}, float_from_bits(l.at(3))};
     }
     return plan;
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
+  });
 }
 
 // A cell built on another rank comes back as two files beside the output's tiles: its nodes
@@ -216,7 +209,7 @@ nlohmann::json nodes_json(const ExportedCell& cell) {
   nlohmann::json nodes = nlohmann::json::array();
   for (const TileNode& n : cell.subtree.nodes) {
     nodes.push_back({{"level", n.level},
-                     {"key", {n.key.i, n.key.j}},
+                     {"key", tile_key_json(n.key)},
                      {"triangles", n.triangle_count},
                      {"error", double_bits(n.geometric_error)},
                      {"box", box_bits(n.box)},
@@ -237,40 +230,30 @@ void write_cell(const std::filesystem::path& dir, std::size_t c, const ExportedC
 
 /// Reads, and removes, a cell another rank built.
 ExportedCell take_cell(const std::filesystem::path& dir, std::size_t c) {
+  constexpr std::string_view kWhat = "a cell of the 3D Tiles export another rank built";
   const std::filesystem::path json_file = cell_file(dir, c, "json"), mesh_file = cell_file(dir, c, "mesh");
-  std::ifstream in(json_file);
-  if (!in)
-    throw ProcessingError(
-        fmt::format("{}: missing (a cell of the 3D Tiles export another rank built)", json_file.string()));
-  ExportedCell cell;
-  try {
-    const nlohmann::json j = nlohmann::json::parse(in);
+  ExportedCell cell = take_json_file(json_file, kWhat, [](const nlohmann::json& j) {
+    ExportedCell out;
     for (const auto& n : j.at("nodes")) {
-      TileNode node;
+      TileNode& node = out.subtree.nodes.emplace_back();
       node.level = n.at("level").get<int>();
-      node.key = {n.at("key").at(0).get<std::int32_t>(), n.at("key").at(1).get<std::int32_t>()};
+      node.key = tile_key_from(n.at("key"));
       node.triangle_count = n.at("triangles").get<std::size_t>();
       node.geometric_error = double_from_bits(n.at("error"));
       node.box = box_from_bits(n.at("box"));
       node.children = n.at("children").get<std::vector<std::uint32_t>>();
-      cell.subtree.nodes.push_back(std::move(node));
     }
-    cell.subtree.open = j.at("open").get<std::uint32_t>();
-    cell.subtree.open_is_final = j.at("open_is_final").get<bool>();
-    cell.glb_bytes = j.at("glb_bytes").get<std::uint64_t>();
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", json_file.string(), e.what()));
-  }
+    out.subtree.open = j.at("open").get<std::uint32_t>();
+    out.subtree.open_is_final = j.at("open_is_final").get<bool>();
+    out.glb_bytes = j.at("glb_bytes").get<std::uint64_t>();
+    return out;
+  });
   if (cell.subtree.open >= cell.subtree.nodes.size()) {
     throw ProcessingError(fmt::format("{}: its open node is not one of its nodes", json_file.string()));
   }
   const std::optional<std::string> bytes = read_file_bytes(mesh_file);
-  if (!bytes)
-    throw ProcessingError(
-        fmt::format("{}: missing (a cell of the 3D Tiles export another rank built)", mesh_file.string()));
+  if (!bytes) throw ProcessingError(fmt::format("{}: missing ({})", mesh_file.string(), kWhat));
   cell.subtree.nodes[cell.subtree.open].mesh = decode_tile_mesh(*bytes, mesh_file);
-  in.close();
-  std::filesystem::remove(json_file);
   std::filesystem::remove(mesh_file);
   return cell;
 }
@@ -283,7 +266,7 @@ std::filesystem::path shares_file(const std::filesystem::path& dir, std::size_t 
 nlohmann::json shares_json(const std::vector<OutputShare>& shares) {
   nlohmann::json out = nlohmann::json::array();
   for (const OutputShare& s : shares) {
-    out.push_back({{"key", {s.key.i, s.key.j}},
+    out.push_back({{"key", tile_key_json(s.key)},
                    {"box", box_bits(s.box)},
                    {"triangles", s.triangles},
                    {"file", s.file.string()},
@@ -294,25 +277,19 @@ nlohmann::json shares_json(const std::vector<OutputShare>& shares) {
 }
 
 std::vector<OutputShare> take_shares(const std::filesystem::path& dir, std::size_t part) {
-  const std::filesystem::path file = shares_file(dir, part);
-  const std::optional<std::string> text = read_file_bytes(file);
-  if (!text) throw ProcessingError(fmt::format("{}: missing (a part another rank filed)", file.string()));
-  try {
+  return take_json_file(shares_file(dir, part), "a part another rank filed", [](const nlohmann::json& list) {
     std::vector<OutputShare> shares;
-    for (const auto& j : nlohmann::json::parse(*text)) {
+    for (const auto& j : list) {
       OutputShare& s = shares.emplace_back();
-      s.key = {j.at("key").at(0).get<std::int32_t>(), j.at("key").at(1).get<std::int32_t>()};
+      s.key = tile_key_from(j.at("key"));
       s.box = box_from_bits(j.at("box"));
       s.triangles = j.at("triangles").get<std::uint64_t>();
       s.file = j.at("file").get<std::string>();
       s.per_source = j.at("per_source").get<std::vector<std::uint64_t>>();
       s.stitched = j.at("stitched").get<std::uint64_t>();
     }
-    std::filesystem::remove(file);
     return shares;
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
+  });
 }
 
 /// A leaf's box another rank mapped: beside the leaf, as bits.
@@ -321,16 +298,7 @@ std::filesystem::path box_file(const std::filesystem::path& dir, const TileKey& 
 }
 
 Box3d take_box(const std::filesystem::path& dir, const TileKey& key) {
-  const std::filesystem::path file = box_file(dir, key);
-  const std::optional<std::string> text = read_file_bytes(file);
-  if (!text) throw ProcessingError(fmt::format("{}: missing (a leaf another rank mapped)", file.string()));
-  try {
-    const Box3d box = box_from_bits(nlohmann::json::parse(*text));
-    std::filesystem::remove(file);
-    return box;
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
+  return take_json_file(box_file(dir, key), "a leaf another rank mapped", box_from_bits);
 }
 
 /// Shares one step with every rank: one item per cost (none for "end"), `here(i)` done by
@@ -339,7 +307,32 @@ void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const std::
   const std::size_t n = costs.size();
   WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
   auto channel = cluster.share(&schedule, [](std::size_t) {});
-  run_workers(*channel, available_threads(), here);
+  run_workers(*channel, available_threads(), [&](std::size_t i) {
+    throw_if_interrupted("the final pass");
+    here(i);
+  });
+}
+
+/// share_items() for items with a result: each item's, from `here(i)` where this rank did
+/// it, else from `theirs(i)` (what another rank left for it). Logs how many others did.
+template <class Result>
+std::vector<Result> share_and_gather(Cluster& cluster, std::vector<std::uint64_t> costs, std::string_view what,
+                                     const std::function<Result(std::size_t)>& here,
+                                     const std::function<Result(std::size_t)>& theirs) {
+  std::vector<std::optional<Result>> mine(costs.size());
+  share_items(cluster, std::move(costs), [&](std::size_t i) { mine[i] = here(i); });
+  std::vector<Result> out(mine.size());
+  std::size_t elsewhere = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    if (mine[i]) {
+      out[i] = std::move(*mine[i]);
+    } else {
+      out[i] = theirs(i);
+      ++elsewhere;
+    }
+  }
+  log::debug("final pass: {} of {} {} by other ranks", elsewhere, out.size(), what);
+  return out;
 }
 
 }  // namespace
@@ -355,11 +348,9 @@ LeafFilingWork share_leaf_filing(const Config& config, Cluster& cluster, const s
     plan.parts_dir = parts_dir;
     plan.parts = parts;
     write_plan(config, plan);
-    std::vector<std::optional<std::vector<OutputShare>>> mine(count);
-    share_items(cluster, std::vector<std::uint64_t>(count, 1), [&](std::size_t p) { mine[p] = here(p); });
-    std::vector<std::vector<OutputShare>> shares(count);
-    for (std::size_t p = 0; p < count; ++p) shares[p] = mine[p] ? std::move(*mine[p]) : take_shares(dir, p);
-    return shares;
+    return share_and_gather<std::vector<OutputShare>>(cluster, std::vector<std::uint64_t>(count, 1),
+                                                      "parts filed by grid tile", here,
+                                                      [&](std::size_t p) { return take_shares(dir, p); });
   };
   work.merge = [&config, &cluster](std::span<const std::filesystem::path> files,
                                    std::span<const std::vector<std::filesystem::path>> shares,
@@ -395,14 +386,8 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
     write_plan(config, plan);
     std::vector<std::uint64_t> costs;
     for (const TileKey& k : keys) costs.push_back(triangles->at(k));
-    std::vector<std::optional<Box3d>> mine(keys.size());
-    share_items(cluster, costs, [&](std::size_t k) {
-      throw_if_interrupted("the 3D Tiles export");
-      mine[k] = here(k);
-    });
-    std::vector<Box3d> boxes(keys.size());
-    for (std::size_t k = 0; k < keys.size(); ++k) boxes[k] = mine[k] ? *mine[k] : take_box(leaves.dir(), keys[k]);
-    return boxes;
+    return share_and_gather<Box3d>(cluster, std::move(costs), "leaves mapped", here,
+                                   [&](std::size_t k) { return take_box(leaves.dir(), keys[k]); });
   };
   work.cells = [&config, &cluster, &leaves, triangles, keys](const TilesetFrame& frame, const TileTreeBuild& tree,
                                                              const std::function<ExportedCell(std::size_t)>& here) {
@@ -415,23 +400,8 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
     for (std::size_t c = 0; c < costs.size(); ++c) {
       for (const TileKey& k : tree.cell_leaves(c)) costs[c] += triangles->at(k);
     }
-    std::vector<std::optional<ExportedCell>> mine(costs.size());
-    share_items(cluster, costs, [&](std::size_t c) {
-      throw_if_interrupted("the 3D Tiles export");
-      mine[c] = here(c);
-    });
-    std::vector<ExportedCell> out(mine.size());
-    std::size_t elsewhere = 0;
-    for (std::size_t c = 0; c < out.size(); ++c) {
-      if (mine[c]) {
-        out[c] = std::move(*mine[c]);
-        continue;
-      }
-      out[c] = take_cell(leaves.dir(), c);
-      ++elsewhere;
-    }
-    log::debug("3D Tiles: {} of {} cells built by other ranks", elsewhere, out.size());
-    return out;
+    return share_and_gather<ExportedCell>(cluster, std::move(costs), "3D Tiles cells built", here,
+                                          [&](std::size_t c) { return take_cell(leaves.dir(), c); });
   };
   return work;
 }

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -80,11 +79,7 @@ void write_plan(const Config& config, const StepPlan& plan) {
 }
 
 StepPlan read_plan(const Config& config) {
-  const std::filesystem::path file = plan_path(config);
-  std::ifstream in(file);
-  if (!in) throw ProcessingError(fmt::format("{}: missing (rank 0's plan of the seam pass)", file.string()));
-  try {
-    const nlohmann::json j = nlohmann::json::parse(in);
+  return decode_json_file(plan_path(config), "rank 0's plan of the seam pass", [](const nlohmann::json& j) {
     StepPlan plan;
     plan.dir = j.at("dir").get<std::string>();
     plan.step = j.at("step").get<std::string>();
@@ -98,9 +93,7 @@ StepPlan read_plan(const Config& config) {
     }
     plan.source_sizes = j.at("source_sizes").get<std::vector<std::uint64_t>>();
     return plan;
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
+  });
 }
 
 /// A part's open boundary as its bits (the sum must come out the same as on one process).
@@ -108,22 +101,6 @@ nlohmann::json length_json(double metres) { return {{"bits", double_bits(metres)
 double length_from(const nlohmann::json& j) { return double_from_bits(j.at("bits")); }
 
 constexpr std::string_view kLengthSuffix = "length.json";
-
-/// Reads what another rank wrote for a part (an outcome or a length) with `decode`, and
-/// removes the file.
-template <class Decode>
-auto take_result(const std::filesystem::path& file, Decode decode) {
-  std::ifstream in(file);
-  if (!in) throw ProcessingError(fmt::format("{}: missing (a part another rank did)", file.string()));
-  try {
-    auto result = decode(nlohmann::json::parse(in));
-    in.close();
-    std::filesystem::remove(file);
-    return result;
-  } catch (const nlohmann::json::exception& e) {
-    throw ProcessingError(fmt::format("{}: malformed ({})", file.string(), e.what()));
-  }
-}
 
 /// This rank's workers on a step's channel: each item (a part) done by `body`, at most
 /// kMaxSeamPartsInFlight at a time, stopping between parts when interrupted.
@@ -162,7 +139,9 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
     share_items(cluster, files, all, [&](std::size_t p) { here[p] = measurer.measure(p); });
     std::vector<double> lengths(all.size());
     for (std::size_t p = 0; p < all.size(); ++p) {
-      lengths[p] = here[p] ? *here[p] : take_result(files.beside(p, kLengthSuffix), length_from);
+      lengths[p] = here[p]
+                       ? *here[p]
+                       : take_json_file(files.beside(p, kLengthSuffix), "a part another rank measured", length_from);
     }
     return lengths;
   };
@@ -179,7 +158,8 @@ SeamPassWork share_seam_pass(const Config& config, Cluster& cluster, const SeamP
         outcomes[i] = *here[i];
         continue;
       }
-      outcomes[i] = take_result(files.beside(level.parts_of_level()[i], kOutcomeSuffix), outcome_from);
+      outcomes[i] = take_json_file(files.beside(level.parts_of_level()[i], kOutcomeSuffix),
+                                   "a part another rank stitched", outcome_from);
       ++elsewhere;
     }
     log::debug("seam pass: level {}: {} of {} parts stitched by other ranks", level.level(), elsewhere, level.size());

@@ -217,6 +217,13 @@ std::map<std::string, std::string> folder_bytes(const std::filesystem::path& dir
   return out;
 }
 
+/// Every file of the two folders, byte for byte.
+void expect_same_files(const std::filesystem::path& a, const std::filesystem::path& b) {
+  const auto x = folder_bytes(a), y = folder_bytes(b);
+  EXPECT_EQ(x.size(), y.size());
+  EXPECT_TRUE(x == y) << a << " and " << b << " differ";
+}
+
 TEST(TilesetExport, LargeTreesAreSplitIntoExternalTilesets) {
   test::TempDir tmp;
   const Scene s = scene();
@@ -252,9 +259,7 @@ TEST(TilesetExport, SameBytesOnOneAndTwoThreads) {
     const ThreadLimit two(2);
     export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "two"));
   }
-  const auto a = folder_bytes(tmp / "one"), b = folder_bytes(tmp / "two");
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_TRUE(a == b);
+  expect_same_files(tmp / "one", tmp / "two");
 }
 
 /// The scene given a leaf at a time, each leaf's triangles keyed by the scene's vertex indices.
@@ -311,9 +316,7 @@ TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
       export_tileset(SceneLeaves(s, params(tmp.path()).grid), lambert93(), params(tmp / "leaves"));
   EXPECT_EQ(leaves.tiles, whole.tiles);
   EXPECT_EQ(leaves.all_triangles, whole.all_triangles);
-  const auto a = folder_bytes(tmp / "whole"), b = folder_bytes(tmp / "leaves");
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_TRUE(a == b);
+  expect_same_files(tmp / "whole", tmp / "leaves");
 }
 
 TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {
@@ -348,9 +351,7 @@ TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOnePr
   EXPECT_GE(cells, 4u);
   EXPECT_EQ(apart.tiles, here.tiles);
   EXPECT_EQ(apart.glb_bytes, here.glb_bytes);
-  const auto a = folder_bytes(tmp / "here"), b = folder_bytes(tmp / "apart");
-  EXPECT_EQ(a.size(), b.size());
-  EXPECT_TRUE(a == b);
+  expect_same_files(tmp / "here", tmp / "apart");
 }
 
 TEST(TilesetExport, AnyDepthFirstSplitGivesTheSameFiles) {
