@@ -237,6 +237,10 @@ std::vector<KeyDef> make_keys() {
       [](auto& c) -> auto& { return c.mosaic.seen_through_quality; }, 0, 1));
   keys.push_back(count_key(mosaic, "sweeps", "sweeps of group moves at most (each re-solves every acquisition against what is kept)",
       [](auto& c) -> auto& { return c.mosaic.sweeps; }, 1, 100));
+  keys.push_back(count_key(mosaic, "later_sweep_reach",
+      "sweeps after the first re-solve each acquisition only within this many terms of a seam, where the first sweep's "
+      "pieces meet (0: everywhere)",
+      [](auto& c) -> auto& { return c.mosaic.later_sweep_reach; }, 0, 100000));
   keys.push_back(real_key(mosaic, "stitch_reach",
       "stitching joins boundaries of pieces from different sources closer than this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.stitch_reach; }, 0.1, 100));

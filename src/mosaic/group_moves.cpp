@@ -11,8 +11,10 @@
 
 namespace citymesh {
 
+using mosaic_detail::grow_region;
 using mosaic_detail::PairIndex;
 using mosaic_detail::restricted;
+using mosaic_detail::seam_region;
 using mosaic_detail::split_by_slab;
 
 namespace {
@@ -69,7 +71,8 @@ std::vector<std::uint32_t> slab_of_variables(std::span<const float> coordinate, 
   for (std::uint32_t s = 1; s < slabs; ++s) bounds.push_back(sorted[sorted.size() * s / slabs]);
   std::vector<std::uint32_t> slab(coordinate.size());
   for (std::size_t v = 0; v < slab.size(); ++v) {
-    slab[v] = static_cast<std::uint32_t>(std::upper_bound(bounds.begin(), bounds.end(), coordinate[v]) - bounds.begin());
+    slab[v] =
+        static_cast<std::uint32_t>(std::upper_bound(bounds.begin(), bounds.end(), coordinate[v]) - bounds.begin());
   }
   return slab;
 }
@@ -95,34 +98,21 @@ struct Mover {
     return {index.ends.data() + index.offsets[v], index.ends.data() + index.offsets[v + 1]};
   }
 
-  /// The border variables and the open variables up to border_hops terms from them.
-  std::vector<std::uint32_t> border_region(std::vector<std::uint32_t> region) {
-    for (const std::uint32_t v : region) mark[v] = 1;
-    std::size_t ring_begin = 0;
-    for (std::uint32_t hop = 0; hop < params.border_hops; ++hop) {
-      const std::size_t ring_end = region.size();
-      for (std::size_t r = ring_begin; r < ring_end; ++r) {
-        for (const std::uint32_t end : ends_of(region[r])) {
-          const std::uint32_t o = PairIndex::variable(end);
-          if (open[o] == 0 || mark[o] != 0) continue;
-          mark[o] = 1;
-          region.push_back(o);
-        }
-      }
-      ring_begin = ring_end;
-    }
-    for (const std::uint32_t v : region) mark[v] = 0;
-    std::sort(region.begin(), region.end());
-    return region;
-  }
-
   /// Re-solves group k against the variables at 1 (x changes only where that lowers the
-  /// energy); nullopt when no variable is open.
-  std::optional<SolveOutcome> move(std::uint32_t k, std::vector<std::int8_t>& x, GroupMoveStats& stats) {
+  /// energy), with `near_seams` only those within later_sweep_hops terms of a seam of x;
+  /// nullopt when no variable is open.
+  std::optional<SolveOutcome> move(std::uint32_t k, std::vector<std::int8_t>& x, GroupMoveStats& stats,
+                                   bool near_seams) {
     std::vector<std::uint32_t> all;
     for (std::uint32_t v = 0; v < e.size(); ++v) {
       open[v] = group[v] == k || x[v] == 1 ? 1 : 0;
       if (open[v] != 0) all.push_back(v);
+    }
+    if (near_seams) {
+      std::vector<std::uint32_t> region = seam_region(index, x, all, open, params.later_sweep_hops, mark);
+      for (const std::uint32_t v : all) open[v] = 0;
+      for (const std::uint32_t v : region) open[v] = 1;
+      all = std::move(region);
     }
     if (all.empty()) return std::nullopt;
     SolveOutcome out;
@@ -143,9 +133,11 @@ struct Mover {
     auto [interior, border] = split_by_slab(index, all, open, slab, static_cast<std::uint32_t>(to_local.size()));
     std::vector<SolveOutcome> outcomes(interior.size() + 1);
     parallel_for_blocks(interior.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t s = begin; s < end; ++s) outcomes[s] = solve_subset(e, index, interior[s], group, k, x, to_local[s]);
+      for (std::size_t s = begin; s < end; ++s)
+        outcomes[s] = solve_subset(e, index, interior[s], group, k, x, to_local[s]);
     });
-    outcomes.back() = solve_subset(e, index, border_region(std::move(border)), group, k, x, to_local[0]);
+    outcomes.back() = solve_subset(e, index, grow_region(index, std::move(border), open, params.border_hops, mark),
+                                   group, k, x, to_local[0]);
     stats.solves += outcomes.size();
     SolveOutcome out{true, false};
     for (const SolveOutcome& o : outcomes) {
@@ -168,7 +160,7 @@ GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std
     ++stats.sweeps;
     bool changed = false;
     for (std::uint32_t k = 0; k < groups; ++k) {
-      const std::optional<SolveOutcome> o = mover.move(k, x, stats);
+      const std::optional<SolveOutcome> o = mover.move(k, x, stats, sweep > 0 && params.later_sweep_hops > 0);
       if (!o) continue;  // nothing open: no move
       ++stats.moves;
       stats.exact_moves += o->exact ? 1 : 0;

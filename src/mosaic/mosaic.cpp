@@ -181,7 +181,8 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   for (std::size_t a = 0; a < edges.size(); ++a) {
     for (const auto& s : edges[a].shared) {
       const std::uint32_t va = variable_of[index.offsets[a] + s.a], vb = variable_of[index.offsets[a] + s.b];
-      const double w = params.seam_weight * s.length / unit * seam_factor(shapes[va].winding, shapes[vb].winding, crease);
+      const double w =
+          params.seam_weight * s.length / unit * seam_factor(shapes[va].winding, shapes[vb].winding, crease);
       out.energy.pairs.push_back({va, vb, 0, w, w, 0});
     }
   }
@@ -245,6 +246,7 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
     moves.max_sweeps = std::max(1, params.sweeps);
     moves.coordinate = e.coordinate;
     moves.slabs = slab_count(x.size());
+    moves.later_sweep_hops = static_cast<std::uint32_t>(std::max(0, params.later_sweep_reach));
     out.stats.moves = improve_by_group_moves(e.energy, group, x, moves);
   }
   out.stats.seconds_solve = clock.restart();

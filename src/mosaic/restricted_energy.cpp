@@ -1,6 +1,9 @@
 // SPDX-License-Identifier: MIT
 #include "restricted_energy.h"
 
+#include <algorithm>
+#include <iterator>
+
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
 
@@ -28,8 +31,8 @@ PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
   parallel_for_blocks(values.size(), 1 << 16, [&](std::size_t begin, std::size_t end) {
     for (std::size_t entry = begin; entry < end; ++entry) {
       const auto& p = e.pairs[pairs[entry]];
-      values[entry] = (ends[entry] & kAtJ) == 0 ? std::array{p.e00, p.e01, p.e10, p.e11}
-                                                : std::array{p.e00, p.e10, p.e01, p.e11};
+      values[entry] =
+          (ends[entry] & kAtJ) == 0 ? std::array{p.e00, p.e01, p.e10, p.e11} : std::array{p.e00, p.e10, p.e01, p.e11};
     }
   });
 }
@@ -58,6 +61,44 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
   }
   for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;
   return r;
+}
+
+std::vector<std::uint32_t> grow_region(const PairIndex& index, std::vector<std::uint32_t> seeds,
+                                       std::span<const std::uint8_t> open, std::uint32_t hops,
+                                       std::vector<std::uint8_t>& mark) {
+  std::vector<std::uint32_t> region = std::move(seeds);
+  for (const std::uint32_t v : region) mark[v] = 1;
+  std::size_t ring_begin = 0;
+  for (std::uint32_t hop = 0; hop < hops && ring_begin < region.size(); ++hop) {
+    const std::size_t ring_end = region.size();
+    for (std::size_t r = ring_begin; r < ring_end; ++r) {
+      for (std::uint32_t entry = index.offsets[region[r]]; entry < index.offsets[region[r] + 1]; ++entry) {
+        const std::uint32_t o = PairIndex::variable(index.ends[entry]);
+        if (open[o] == 0 || mark[o] != 0) continue;
+        mark[o] = 1;
+        region.push_back(o);
+      }
+    }
+    ring_begin = ring_end;
+  }
+  for (const std::uint32_t v : region) mark[v] = 0;
+  std::sort(region.begin(), region.end());
+  return region;
+}
+
+std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const std::int8_t> x,
+                                       std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
+                                       std::uint32_t hops, std::vector<std::uint8_t>& mark) {
+  const auto on_seam = [&](std::uint32_t v) {
+    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
+      const auto& w = index.values[entry];
+      if (w[1] + w[2] > w[0] + w[3] && x[PairIndex::variable(index.ends[entry])] != x[v]) return true;
+    }
+    return false;
+  };
+  std::vector<std::uint32_t> seeds;
+  std::copy_if(all.begin(), all.end(), std::back_inserter(seeds), on_seam);
+  return grow_region(index, std::move(seeds), open, hops, mark);
 }
 
 SlabSplit split_by_slab(const PairIndex& index, std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,

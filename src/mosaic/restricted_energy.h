@@ -37,6 +37,20 @@ struct PairIndex {
 BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x,
                         std::span<const std::uint32_t> open, std::vector<std::uint32_t>& to_local);
 
+/// `seeds` (distinct) and the variables flagged in `open` up to `hops` terms from them, through
+/// flagged variables; ascending. `mark` is scratch: one zero per variable, left so.
+std::vector<std::uint32_t> grow_region(const PairIndex& index, std::vector<std::uint32_t> seeds,
+                                       std::span<const std::uint8_t> open, std::uint32_t hops,
+                                       std::vector<std::uint8_t>& mark);
+
+/// The variables of `all` (flagged in `open`) within `hops` terms of a seam of x: a variable
+/// of `all` joined by a term that costs disagreement (e01 + e10 > e00 + e11) to a variable of
+/// the other label is on a seam; the region grows from those through flagged variables.
+/// Ascending. `mark` as for grow_region.
+std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const std::int8_t> x,
+                                       std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
+                                       std::uint32_t hops, std::vector<std::uint8_t>& mark);
+
 /// The variables `all` (flagged in `open`, one flag per variable) cut by `slab` (one per
 /// variable, < slabs): per slab its interior, the variables with no pair term reaching an
 /// open variable of another slab, and the border, all the others. No term joins the

@@ -2,8 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "citymesh/core/parallel.h"
@@ -207,30 +209,57 @@ StreetEnergy street_energy(std::mt19937& rng, std::size_t n) {
   return street;
 }
 
+/// Group moves from the empty start on 1 and on 2 threads: both labellings, and the stats of
+/// the run on 2. Expects the same labels on both and every move exact.
+struct ThreadRuns {
+  std::array<std::vector<std::int8_t>, 2> x;
+  GroupMoveStats stats;
+};
+ThreadRuns on_one_and_two_threads(const BinaryEnergy& e, std::span<const std::uint32_t> group,
+                                  const GroupMoveParams& params) {
+  ThreadRuns out;
+  for (const unsigned threads : {1u, 2u}) {
+    const ThreadLimit limit(threads);
+    std::vector<std::int8_t>& x = out.x[threads - 1];
+    x.assign(e.size(), 0);
+    out.stats = improve_by_group_moves(e, group, x, params);
+  }
+  EXPECT_EQ(out.x[0], out.x[1]) << "the thread count changed the labels";
+  EXPECT_EQ(out.stats.exact_moves, out.stats.moves);
+  return out;
+}
+
 TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThreadCount) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {
     const auto [e, group, coordinate] = street_energy(rng, 600);
     std::vector<std::int8_t> whole(e.size(), 0);
     improve_by_group_moves(e, group, whole, sweeps(3));
-    std::vector<std::vector<std::int8_t>> split;
-    for (const unsigned threads : {1u, 2u}) {
-      const ThreadLimit limit(threads);
-      std::vector<std::int8_t> x(e.size(), 0);
-      GroupMoveParams params = sweeps(3);
-      params.coordinate = coordinate;
-      params.slabs = 4;
-      params.border_hops = 2;
-      const GroupMoveStats stats = improve_by_group_moves(e, group, x, params);
-      ASSERT_EQ(stats.exact_moves, stats.moves) << "trial " << trial;
-      ASSERT_GT(stats.solves, stats.moves);  // slabs and borders, not one cut per move
-      ASSERT_LE(e.evaluate(x), 0.0);         // never above the empty start
-      split.push_back(x);
-    }
-    ASSERT_EQ(split[0], split[1]) << "trial " << trial;
+    GroupMoveParams params = sweeps(3);
+    params.coordinate = coordinate;
+    params.slabs = 4;
+    params.border_hops = 2;
+    const ThreadRuns split = on_one_and_two_threads(e, group, params);
+    ASSERT_GT(split.stats.solves, split.stats.moves);  // slabs and borders, not one cut per move
+    ASSERT_LE(e.evaluate(split.x[0]), 0.0);            // never above the empty start
     // Holding the borders fixed costs little against one cut per move.
-    EXPECT_LE(e.evaluate(split[0]), e.evaluate(whole) + 0.02 * std::abs(e.evaluate(whole))) << "trial " << trial;
+    EXPECT_LE(e.evaluate(split.x[0]), e.evaluate(whole) + 0.02 * std::abs(e.evaluate(whole))) << "trial " << trial;
   }
+}
+
+/// Each of n variables open unless rng says 0 modulo `one_in`: the flags and the open ones.
+struct OpenSet {
+  std::vector<std::uint8_t> flags;
+  std::vector<std::uint32_t> list;
+};
+OpenSet random_open(std::mt19937& rng, std::size_t n, unsigned one_in) {
+  OpenSet out;
+  out.flags.resize(n);
+  for (std::uint32_t v = 0; v < n; ++v) {
+    out.flags[v] = rng() % one_in != 0 ? 1 : 0;
+    if (out.flags[v] != 0) out.list.push_back(v);
+  }
+  return out;
 }
 
 TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
@@ -238,11 +267,9 @@ TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
   for (int trial = 0; trial < 20; ++trial) {
     const auto [e, group, coordinate] = street_energy(rng, 400);
     const mosaic_detail::PairIndex index(e);
-    std::vector<std::uint8_t> open(e.size());
-    std::vector<std::uint32_t> all, slab(e.size());
+    const auto [open, all] = random_open(rng, e.size(), 3);
+    std::vector<std::uint32_t> slab(e.size());
     for (std::uint32_t v = 0; v < e.size(); ++v) {
-      open[v] = rng() % 3 != 0 ? 1 : 0;
-      if (open[v] != 0) all.push_back(v);
       slab[v] = static_cast<std::uint32_t>(coordinate[v] / 10.0f);  // 4 slabs along the street
     }
     const mosaic_detail::SlabSplit split = mosaic_detail::split_by_slab(index, all, open, slab, 4);
@@ -284,6 +311,68 @@ TEST(Qpbo, ThreeMutuallyOverlappingTrianglesCannotBeFlipped) {
   EXPECT_FALSE(stats.exact);
   EXPECT_EQ(stats.unlabelled_after_qpbo, 3u);  // the symmetric odd cycle defeats roof duality
   EXPECT_DOUBLE_EQ(e.evaluate(x), -1.0);       // keep exactly one
+}
+
+TEST(GroupMoves, TheSeamRegionIsTheOpenVariablesWithinHopsOfADisagreement) {
+  // Against distances relaxed over the pair list until nothing changes (Bellman-Ford), not
+  // the pair index the region is grown on.
+  std::mt19937 rng(31);
+  for (int trial = 0; trial < 30; ++trial) {
+    const auto [e, group, coordinate] = street_energy(rng, 300);
+    const mosaic_detail::PairIndex index(e);
+    std::vector<std::int8_t> x(e.size());
+    for (std::int8_t& label : x) label = static_cast<std::int8_t>(rng() % 2);
+    const auto [open, all] = random_open(rng, e.size(), 4);
+    std::vector<std::uint8_t> mark(e.size(), 0);
+    const auto hops = static_cast<std::uint32_t>(trial % 4);
+    const std::vector<std::uint32_t> region = mosaic_detail::seam_region(index, x, all, open, hops, mark);
+    constexpr std::uint32_t kFar = UINT32_MAX;
+    std::vector<std::uint32_t> distance(e.size(), kFar);
+    for (const auto& p : e.pairs) {  // seams: only terms that cost disagreement (seam terms here)
+      if (p.e01 + p.e10 <= p.e00 + p.e11 || x[p.i] == x[p.j]) continue;
+      if (open[p.i] != 0) distance[p.i] = 0;
+      if (open[p.j] != 0) distance[p.j] = 0;
+    }
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (const auto& p : e.pairs) {
+        for (const auto& [from, to] : {std::pair{p.i, p.j}, std::pair{p.j, p.i}}) {
+          if (distance[from] == kFar || open[to] == 0 || distance[to] <= distance[from] + 1) continue;
+          distance[to] = distance[from] + 1;
+          changed = true;
+        }
+      }
+    }
+    std::vector<std::uint32_t> expected;
+    for (std::uint32_t v = 0; v < e.size(); ++v) {
+      if (distance[v] <= hops) expected.push_back(v);
+    }
+    ASSERT_FALSE(expected.empty());
+    ASSERT_EQ(region, expected) << "trial " << trial << ", " << hops << " hops";
+    ASSERT_EQ(std::count(mark.begin(), mark.end(), 1), 0);  // the scratch is left clean
+  }
+}
+
+TEST(GroupMoves, LaterSweepsNearTheSeamsNeverRaiseTheEnergyAndDoNotDependOnTheThreadCount) {
+  std::mt19937 rng(13);
+  int lower = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const auto [e, group, coordinate] = street_energy(rng, 600);
+    GroupMoveParams params = sweeps(3);
+    params.coordinate = coordinate;
+    params.slabs = 2;
+    params.later_sweep_hops = 2;
+    const ThreadRuns near = on_one_and_two_threads(e, group, params);
+    // The same first sweep (slabs aside), then moves that only keep what lowers the energy.
+    std::vector<std::int8_t> first_slabs(e.size(), 0);
+    GroupMoveParams one = sweeps(1);
+    one.coordinate = coordinate;
+    one.slabs = 2;
+    improve_by_group_moves(e, group, first_slabs, one);
+    ASSERT_LE(e.evaluate(near.x[0]), e.evaluate(first_slabs) + 1e-9) << "trial " << trial;
+    lower += e.evaluate(near.x[0]) < e.evaluate(first_slabs) - 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(lower, 0) << "the later sweeps never improved anything: the test says nothing";
 }
 
 }  // namespace

@@ -68,8 +68,8 @@ std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::spa
 std::vector<std::int8_t> qpbo(const BinaryEnergy& e);
 
 struct ImproveParams {
-  int rounds = 3;             ///< random orders tried
-  std::uint64_t seed = 1;     ///< fixed: the same input gives the same labelling
+  int rounds = 3;          ///< random orders tried
+  std::uint64_t seed = 1;  ///< fixed: the same input gives the same labelling
 };
 
 /// QPBO-I (Rother et al. 2007): completes a partial labelling (unlabelled variables first set
@@ -91,6 +91,10 @@ struct GroupMoveParams {
   std::span<const float> coordinate;
   std::uint32_t slabs = 1;
   std::uint32_t border_hops = 16;
+  /// Sweeps after the first re-solve each group only within this many terms of a seam (a
+  /// term that costs disagreement joining variables of different labels): the first sweep
+  /// has placed the pieces, later ones mostly move their edges. 0: everywhere, every sweep.
+  std::uint32_t later_sweep_hops = 0;
 };
 
 struct GroupMoveStats {
@@ -105,12 +109,13 @@ struct GroupMoveStats {
 /// (non-submodular only across groups, and none among the variables at 1) that restricted
 /// energy flips to submodular and one cut solves it exactly; otherwise QPBO's persistent
 /// labels of it are taken. A re-solve is kept only when it lowers the energy, so x never gets
-/// worse. Sweeps over the groups until a sweep changes nothing or `max_sweeps`.
+/// worse. Sweeps over the groups until a sweep changes nothing or `max_sweeps`; sweeps after
+/// the first near the seams only, with `later_sweep_hops`.
 GroupMoveStats improve_by_group_moves(const BinaryEnergy& e, std::span<const std::uint32_t> group,
                                       std::vector<std::int8_t>& x, const GroupMoveParams& params);
 
 struct MinimiseStats {
-  bool exact = false;               ///< solved by one cut after flipping
+  bool exact = false;  ///< solved by one cut after flipping
   std::size_t unlabelled_after_qpbo = 0;
   double energy_before_improvement = 0;  ///< QPBO's labels completed by ICM
   double energy = 0;
