@@ -24,6 +24,9 @@ Box3d box_from_bits(const nlohmann::json& j) {
   return b;
 }
 
+nlohmann::json float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
+float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.get<std::uint32_t>()); }
+
 nlohmann::json tile_key_json(const TileKey& k) { return {k.i, k.j}; }
 
 TileKey tile_key_from(const nlohmann::json& j) { return {j.at(0).get<std::int32_t>(), j.at(1).get<std::int32_t>()}; }

@@ -22,6 +22,8 @@ namespace citymesh::app {
 
 nlohmann::json double_bits(double v);
 double double_from_bits(const nlohmann::json& j);
+nlohmann::json float_bits(float v);
+float float_from_bits(const nlohmann::json& j);
 
 nlohmann::json box_bits(const Box3d& b);
 Box3d box_from_bits(const nlohmann::json& j);

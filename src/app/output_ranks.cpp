@@ -4,7 +4,6 @@
 #include <fmt/format.h>
 
 #include <atomic>
-#include <bit>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -58,9 +57,6 @@ StepPlan plan_of(std::string step, std::filesystem::path dir = {}) {
 std::string absolute_or_empty(const std::filesystem::path& p) {
   return p.empty() ? std::string() : std::filesystem::absolute(p).string();
 }
-
-nlohmann::json float_bits(float v) { return std::bit_cast<std::uint32_t>(v); }
-float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.get<std::uint32_t>()); }
 
 void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json leaves = nlohmann::json::array();

@@ -95,6 +95,18 @@ KeyedPiece in_input_order(const KeyedPiece& piece) {
   return subset(piece, order);
 }
 
+/// One more triangle of source acquisition `a` in `counts` (index: acquisition), grown as needed.
+void count_source(std::vector<std::uint64_t>& counts, std::size_t a) {
+  if (counts.size() <= a) counts.resize(a + 1, 0);
+  ++counts[a];
+}
+
+/// `from`'s counts per source acquisition added to `into`'s.
+void add_counts(std::vector<std::uint64_t>& into, const std::vector<std::uint64_t>& from) {
+  if (into.size() < from.size()) into.resize(from.size(), 0);
+  for (std::size_t a = 0; a < from.size(); ++a) into[a] += from[a];
+}
+
 }  // namespace
 
 std::filesystem::path seam_parts_folder(const std::filesystem::path& work) {
@@ -221,9 +233,7 @@ SeamPartFiles::FiledTile SeamPartFiles::file_tile(TileKey key, const std::vector
       const Triangle& tri = piece.triangles[t];
       const Vec3d centroid = (piece.positions[tri[0]] + piece.positions[tri[1]] + piece.positions[tri[2]]) / 3.0;
       triangles[block_part_of(centroid, blocks_)].push_back(t);
-      const auto a = static_cast<std::size_t>(piece.source_acq[t]);
-      if (out.source_sizes.size() <= a) out.source_sizes.resize(a + 1, 0);
-      ++out.source_sizes[a];
+      count_source(out.source_sizes, static_cast<std::size_t>(piece.source_acq[t]));
     }
     for (const auto& [part, ts] : triangles) by_part[part].push_back(subset(piece, ts));
   }
@@ -244,8 +254,7 @@ void SeamPartFiles::add_filed(const FiledTile& tile) {
     boxes_[tile.parts[k]].extend(tile.boxes[k]);
     fragments_[tile.parts[k]].push_back(tile.files[k]);
   }
-  if (source_sizes_.size() < tile.source_sizes.size()) source_sizes_.resize(tile.source_sizes.size(), 0);
-  for (std::size_t a = 0; a < tile.source_sizes.size(); ++a) source_sizes_[a] += tile.source_sizes[a];
+  add_counts(source_sizes_, tile.source_sizes);
 }
 
 std::vector<BlockPart> SeamPartFiles::finish() {
@@ -306,9 +315,7 @@ std::vector<OutputShare> file_part_shares(const std::filesystem::path& dir, cons
         ++out.stitched;
         continue;
       }
-      if (out.per_source.size() <= static_cast<std::size_t>(a))
-        out.per_source.resize(static_cast<std::size_t>(a) + 1, 0);
-      ++out.per_source[static_cast<std::size_t>(a)];
+      count_source(out.per_source, static_cast<std::size_t>(a));
     }
     write_scratch_file(out.file, encode_keyed_piece(share));
   }
@@ -345,8 +352,7 @@ OutputLeaves::OutputLeaves(std::filesystem::path dir, const TileGrid& grid, std:
       leaf.box.extend(s.box);
       leaf.triangles += s.triangles;
       fragments[index.at(s.key)].push_back(s.file);
-      if (per_source_.size() < s.per_source.size()) per_source_.resize(s.per_source.size(), 0);
-      for (std::size_t a = 0; a < s.per_source.size(); ++a) per_source_[a] += s.per_source[a];
+      add_counts(per_source_, s.per_source);
       stitched_ += s.stitched;
     }
   }

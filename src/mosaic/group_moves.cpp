@@ -94,10 +94,6 @@ struct Mover {
     to_local.assign(slabs, std::vector<std::uint32_t>(e.size(), UINT32_MAX));
   }
 
-  [[nodiscard]] std::span<const std::uint32_t> ends_of(std::uint32_t v) const {
-    return {index.ends.data() + index.offsets[v], index.ends.data() + index.offsets[v + 1]};
-  }
-
   /// Re-solves group k against the variables at 1 (x changes only where that lowers the
   /// energy), with `near_seams` only those within later_sweep_hops terms of a seam of x;
   /// nullopt when no variable is open.
