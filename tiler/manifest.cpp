@@ -149,8 +149,8 @@ std::optional<AcquisitionTiling> publish_acquisition_tiling(const std::filesyste
   return std::nullopt;
 }
 
-void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions, const std::string& fingerprint,
-                      bool staging) {
+void prune_tile_store(const std::filesystem::path& dir, std::span<const std::string> acquisition_fingerprints,
+                      const std::string& store_fingerprint, bool staging) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw OutputError(fmt::format("{}: cannot create the tile store: {}", dir.string(), ec.message()));
@@ -159,10 +159,11 @@ void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions
     const std::string name = entry.path().filename().string();
     if (name == kStagingFolder) {
       if (staging) stale.push_back(entry.path());
-    } else if (const std::optional<std::size_t> k = acquisition_folder_index(name); k && *k < acquisitions) {
-      if (!read_summary(entry.path(), fingerprint)) stale.push_back(entry.path());
+    } else if (const std::optional<std::size_t> k = acquisition_folder_index(name);
+               k && *k < acquisition_fingerprints.size()) {
+      if (!read_summary(entry.path(), acquisition_fingerprints[*k])) stale.push_back(entry.path());
     } else if (name == kManifestFile) {
-      if (!manifest_made_with(dir, fingerprint)) stale.push_back(entry.path());
+      if (!manifest_made_with(dir, store_fingerprint)) stale.push_back(entry.path());
     } else {
       stale.push_back(entry.path());  // a store of an older layout, or a dropped acquisition
     }

@@ -12,6 +12,7 @@
 #include "citymesh/config/config.h"
 #include "citymesh/tiler/tiler.h"
 #include "cluster.h"
+#include "run_state.h"
 #include "tile_plan.h"
 
 namespace citymesh::app {
@@ -19,16 +20,17 @@ namespace citymesh::app {
 /// <work>/results/<tile>.bin
 std::filesystem::path result_path(const Config& config, TileKey key);
 
-/// The finished tile store in <work>/tiles when it was made with `fingerprint`; nothing
-/// otherwise.
-std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t fingerprint);
+/// The finished tile store in <work>/tiles when it was made with `fingerprints.store`;
+/// nothing otherwise.
+std::optional<TileStore> finished_tile_store(const Config& config, const RunFingerprints& fingerprints);
 
 /// The tile store of `config`: the finished one in <work>/tiles when it was made with
-/// `fingerprint`, otherwise made now. Acquisitions already tiled with `fingerprint` are kept;
+/// `fingerprints.store`, otherwise made now. Acquisitions already tiled with their own
+/// fingerprint (`fingerprints.acquisitions`) are kept, so that appending one tiles only it;
 /// the others are handed out to the ranks of `cluster`, largest file first. A subset (which
 /// may run beside other subsets, unknown to it) takes them in turn starting at its own share,
 /// so that subsets started together tile different acquisitions. Collective.
-TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+TileStore prepare_tile_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                              const std::optional<Subset>& subset);
 
 struct TileStageReport {
@@ -37,13 +39,14 @@ struct TileStageReport {
 };
 
 /// Processes every tile of `tiles` (indices into store.tiles, closed under
-/// tile_dependencies) that has no finished result, each once its dependencies are done,
+/// tile_dependencies) that has no finished result under its digest (`digests`, per store
+/// tile: tile_digests), each once its dependencies are done,
 /// largest first, on the worker threads of every rank within each rank's memory budget.
 /// Results go to <work>/results. Collective; the report is complete on the root only.
 /// `theirs` (per store tile, or empty): tiles another process owns (a subset's dependencies
 /// in other subsets). They are taken only when nothing else is ready, and skipped when their
 /// result has appeared meanwhile, so subsets started together redo fewer of each other's.
-TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+TileStageReport process_tiles(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                               Cluster& cluster, const std::vector<std::size_t>& tiles,
                               std::span<const std::uint8_t> theirs = {});
 

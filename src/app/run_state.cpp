@@ -1,17 +1,21 @@
 // SPDX-License-Identifier: MIT
 // Which config a work folder was made with, so that a re-run resumes only compatible work.
+#include "run_state.h"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
-#include "run_state.h"
 #include "tiled_run.h"
 
 namespace citymesh::app {
@@ -35,6 +39,26 @@ std::string describe_rewrite(const std::map<std::string, std::string>& keys, con
                               ? fmt::format("same size, {} bytes, new modification time", size_of(after))
                               : fmt::format("{} -> {} bytes", size_of(before), size_of(after));
   return fmt::format("{} was rewritten since the last run ({})", where, how);
+}
+
+/// k of an "acquisition[k]..." key; nothing for other keys.
+std::optional<std::size_t> acquisition_of_key(std::string_view key) {
+  constexpr std::string_view prefix = "acquisition[";
+  if (!key.starts_with(prefix)) return std::nullopt;
+  std::size_t k = 0;
+  const char* end = key.data() + key.size();
+  const auto [at, ec] = std::from_chars(key.data() + prefix.size(), end, k);
+  if (ec != std::errc() || at == end || *at != ']') return std::nullopt;
+  return k;
+}
+
+/// How many acquisitions `keys` describe.
+std::size_t acquisition_count(const std::map<std::string, std::string>& keys) {
+  std::size_t count = 0;
+  for (const auto& entry : keys) {
+    if (const std::optional<std::size_t> a = acquisition_of_key(entry.first)) count = std::max(count, *a + 1);
+  }
+  return count;
 }
 
 std::string trim(std::string s) {
@@ -73,16 +97,30 @@ std::map<std::string, std::string> result_keys(const Config& config) {
   return keys;
 }
 
-std::uint64_t fingerprint(const std::map<std::string, std::string>& keys, bool tiling_only) {
-  // The formats' versions are part of it: work made by an older build is redone, not misread.
-  std::string text = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
+RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys, std::size_t acquisitions) {
+  // The formats' versions are part of each: work made by an older build is redone, not misread.
+  const std::string versions = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
+  std::string settings = versions, tiling = versions;
+  std::vector<std::string> own(acquisitions);
   for (const auto& [k, v] : keys) {
-    if (tiling_only && !(k.starts_with("input.") || k.starts_with("tiling.") || k.starts_with("acquisition["))) {
+    const std::string line = k + "=" + v + "\n";
+    if (const std::optional<std::size_t> a = acquisition_of_key(k)) {
+      if (*a < acquisitions) own[*a] += line;
       continue;
     }
-    text += k + "=" + v + "\n";
+    settings += line;
+    if (k.starts_with("input.") || k.starts_with("tiling.")) tiling += line;
   }
-  return fnv1a(text.data(), text.size());
+  const auto hash = [](const std::string& text) { return fnv1a(text.data(), text.size()); };
+  RunFingerprints f;
+  f.settings = hash(settings);
+  std::string store = tiling;
+  for (const std::string& lines : own) {
+    f.acquisitions.push_back(hash(tiling + lines));
+    store += lines;
+  }
+  f.store = hash(store);
+  return f;
 }
 
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
@@ -93,19 +131,30 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     try {
       before = nlohmann::json::parse(in).at("keys").get<std::map<std::string, std::string>>();
     } catch (const nlohmann::json::exception& e) {
-      if (!force) throw InputError(fmt::format("{}: malformed ({}); run with --force to start over", file.string(), e.what()));
+      if (!force)
+        throw InputError(fmt::format("{}: malformed ({}); run with --force to start over", file.string(), e.what()));
     }
     std::vector<std::string> changed;
+    const std::size_t recorded = acquisition_count(before);
     for (const auto& [k, v] : keys) {
       const auto it = before.find(k);
+      // An acquisition appended (a new pass over part of the city) is input, not a config
+      // change: the tiles it reaches are processed, the others reused.
+      if (const std::optional<std::size_t> a = acquisition_of_key(k); a && *a >= recorded) {
+        if (k.ends_with(".path"))
+          log::info("{} ({}) was added since the last run: the tiles it reaches are redone", k.substr(0, k.size() - 5),
+                    v);
+        continue;
+      }
       const std::string what = it == before.end() ? fmt::format("{} (new: {})", k, v)
                                : it->second != v  ? fmt::format("{} ({} -> {})", k, it->second, v)
                                                   : std::string();
       if (what.empty()) continue;
       // A rewritten input file is not a config change: its tiles are simply redone.
       if (k.ends_with(".file")) {
-        log::warn("{}: its work is redone", it == before.end() ? fmt::format("{} changed since the last run ({})", k, what)
-                                                                 : describe_rewrite(keys, k, it->second, v));
+        log::warn("{}: its work is redone", it == before.end()
+                                                ? fmt::format("{} changed since the last run ({})", k, what)
+                                                : describe_rewrite(keys, k, it->second, v));
       } else {
         changed.push_back(what);
       }
@@ -114,9 +163,10 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
       if (!keys.contains(k)) changed.push_back(fmt::format("{} (gone)", k));
     }
     if (!changed.empty() && !force) {
-      throw ConfigError(fmt::format("{}: the work there was done with another config; changed: {}. Run with --force to "
-                                    "discard it, or choose another [project] work folder",
-                                    work.string(), fmt::join(changed, "; ")));
+      throw ConfigError(
+          fmt::format("{}: the work there was done with another config; changed: {}. Run with --force to "
+                      "discard it, or choose another [project] work folder",
+                      work.string(), fmt::join(changed, "; ")));
     }
   }
   std::filesystem::create_directories(work);

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "citymesh/core/checksum.h"
 
@@ -13,15 +14,28 @@ namespace citymesh::app {
 
 inline constexpr const char* kRunConfigFile = "run-config.json";
 /// Bumped whenever what the tiler stores or what a tile result means changes.
-inline constexpr int kTileStoreVersion = 4;  // 2: one folder per acquisition; 3: XXH3 checksums;
-                                             // 4: zero-area triangles dropped as whole-mesh reading drops them
-inline constexpr int kTileResultVersion = 3;  // 3: XXH3 checksum
+inline constexpr int kTileStoreVersion = 4;   // 2: one folder per acquisition; 3: XXH3 checksums;
+                                              // 4: zero-area triangles dropped as whole-mesh reading drops them
+inline constexpr int kTileResultVersion = 4;  // 3: XXH3 checksum; 4: keyed on each tile's own inputs
 
-/// A hash of the result-affecting keys (tiling_only: those that change the tile store).
-std::uint64_t fingerprint(const std::map<std::string, std::string>& keys, bool tiling_only);
+/// Hashes of the result-affecting keys, split so that work depending on some acquisitions
+/// only is reused when another acquisition is added or rewritten.
+struct RunFingerprints {
+  /// The keys other than the acquisitions' (and the formats' versions): every tile result
+  /// depends on them.
+  std::uint64_t settings = 0;
+  /// Per acquisition: the keys that change the tile store (input, tiling) and its own keys
+  /// (path, file size and time, date...): its tiled folder, and the tile results it is in.
+  std::vector<std::uint64_t> acquisitions;
+  /// The tile store as a whole (its manifest): the tiling keys and every acquisition's.
+  std::uint64_t store = 0;
+};
+RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys, std::size_t acquisitions);
 
 /// Compares `keys` with <work>/run-config.json. When they differ: throws ConfigError naming
-/// every changed key, unless `force`. Then records `keys` there.
+/// every changed key, unless `force`. Acquisitions added after the last one recorded and
+/// rewritten input files are not changes: they are logged, and the work they touch is redone.
+/// Then records `keys` there.
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force);
 
 }  // namespace citymesh::app

@@ -91,8 +91,8 @@ inline constexpr int kTilePhases = 4;
 /// tile border agree.
 TileResult process_tile(const TileStore& store, TileKey key, const Config& config, const SettledSelection& settled);
 
-/// Writes the result atomically with the run's fingerprint.
-void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t fingerprint);
+/// Writes the result atomically with the tile's digest (tile_digests).
+void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t digest);
 /// Which sections of a tile result to decode (the checksum covers the whole file whatever
 /// is decoded).
 struct TileResultSections {
@@ -101,13 +101,14 @@ struct TileResultSections {
   bool pairs = true;
 };
 
-/// The result in `file` when it is complete and was made with `fingerprint`; nothing
-/// otherwise (then the tile is processed again). Sections not asked for are left empty.
-std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
+/// The result in `file` when it is complete and was made under `digest`; nothing otherwise
+/// (then the tile is processed again). Sections not asked for are left empty; a result made
+/// before acquisitions were appended gets empty pieces for them.
+std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t digest,
                                            const TileStore& store, TileResultSections sections = {});
 /// Only the labels of that result (same checks; the other sections are not decoded): what
 /// a later-phase neighbour needs.
-std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t fingerprint,
+std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t digest,
                                                         const TileStore& store);
 
 }  // namespace citymesh::app

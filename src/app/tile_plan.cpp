@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <utility>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "tile_job.h"
 
@@ -29,6 +30,32 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
   return after;
 }
 
+std::vector<std::uint64_t> tile_digests(const TileStore& store, std::uint64_t settings,
+                                        std::span<const std::uint64_t> acquisitions) {
+  std::vector<std::uint64_t> digests(store.tiles.size());
+  // A tile's dependencies are of earlier phases: phase by phase, their digests are known.
+  for (int phase = 0; phase < kTilePhases; ++phase) {
+    for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+      const TileContents& tile = store.tiles[k];
+      if (tile_phase(tile.key) != phase) continue;
+      if (tile.triangles.size() > acquisitions.size()) {
+        throw ProcessingError(fmt::format("tile {} holds {} acquisitions, {} are fingerprinted", tile.key.name(),
+                                          tile.triangles.size(), acquisitions.size()));
+      }
+      std::vector<std::uint64_t> words{settings, static_cast<std::uint32_t>(tile.key.i),
+                                       static_cast<std::uint32_t>(tile.key.j)};
+      for (std::size_t a = 0; a < tile.triangles.size(); ++a) {
+        const auto& counts = tile.triangles[a];
+        if (counts[0] + counts[1] + counts[2] == 0) continue;
+        words.insert(words.end(), {a, acquisitions[a], counts[0], counts[1], counts[2]});
+      }
+      for (const std::size_t d : tile_dependencies(store, k)) words.push_back(digests[d]);
+      digests[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
+    }
+  }
+  return digests;
+}
+
 std::vector<std::uint64_t> tile_priorities(const TileStore& store, const std::vector<std::size_t>& tiles,
                                            std::span<const std::uint8_t> theirs) {
   std::uint64_t own_first = 1;  // above every tile's cost
@@ -48,9 +75,8 @@ std::vector<std::size_t> tiles_over_budget(const TileStore& store, const std::ve
   for (const std::size_t k : tiles) {
     if (tile_memory_estimate(store.tiles[k]) > budget) over.push_back(k);
   }
-  std::stable_sort(over.begin(), over.end(), [&](std::size_t a, std::size_t b) {
-    return store.tiles[a].total() > store.tiles[b].total();
-  });
+  std::stable_sort(over.begin(), over.end(),
+                   [&](std::size_t a, std::size_t b) { return store.tiles[a].total() > store.tiles[b].total(); });
   return over;
 }
 

@@ -52,7 +52,7 @@ ChangeStats stats_of(const ChangeFigures& f) {
 
 struct ResultHeader {
   char magic[8];
-  std::uint64_t fingerprint;
+  std::uint64_t fingerprint;  ///< the tile's digest (tile_digests)
   std::int32_t i, j;
   std::uint64_t labels, pairs, acquisitions, triangles_in_tile;
   double seconds_read, seconds_detect, seconds_mosaic;
@@ -167,12 +167,12 @@ void append_raw(std::string& bytes, const T& value) {
 
 }  // namespace
 
-void write_tile_result(const std::filesystem::path& file, const TileResult& r, std::uint64_t fingerprint) {
+void write_tile_result(const std::filesystem::path& file, const TileResult& r, std::uint64_t digest) {
   const VarintWriter labels = encode_labels(r.labels), pairs = encode_deltas<LabelPair>(r.pairs, kPairFields),
                      refuted = encode_deltas<RefutedCopy>(r.refuted, kRefutedFields);
   ResultHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
-  h.fingerprint = fingerprint;
+  h.fingerprint = digest;
   h.i = r.key.i;
   h.j = r.key.j;
   h.labels = r.labels.size();
@@ -216,7 +216,7 @@ std::nullopt_t stale(const std::filesystem::path& file, std::string_view why) {
   return std::nullopt;
 }
 
-std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::uint64_t fingerprint,
+std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::uint64_t digest,
                                             const TileStore& store) {
   std::optional<std::string> read = read_file_bytes(file);
   if (!read) return std::nullopt;
@@ -228,11 +228,14 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale(file, "checksum mismatch");
   std::memcpy(&h, bytes.data(), sizeof h);
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return older_version(file);
-  if (h.fingerprint != fingerprint) return std::nullopt;  // made with another config: --force was given
+  // Made from other inputs: another config (--force was given), a rewritten or added
+  // acquisition in this tile, or a dependency redone.
+  if (h.fingerprint != digest) return std::nullopt;
   const std::size_t body = bytes.size() - sizeof sum - sizeof h;
   // Counts are checked against the section sizes (a varint takes a byte at least) before
-  // anything is allocated.
-  if (h.acquisitions != store.triangles.size() || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
+  // anything is allocated. A result made before acquisitions were appended holds fewer
+  // pieces: the digest says the tile has none of the new ones.
+  if (h.acquisitions > store.triangles.size() || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
       h.refuted_bytes > body - h.label_bytes - h.pair_bytes || h.labels > h.label_bytes / kVarintsPerLabel ||
       h.pairs > h.pair_bytes / kPairFields.size() || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
@@ -242,9 +245,9 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
 
 }  // namespace
 
-std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t fingerprint,
+std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t digest,
                                            const TileStore& store, TileResultSections sections) {
-  const std::optional<CheckedResult> checked = checked_result(file, fingerprint, store);
+  const std::optional<CheckedResult> checked = checked_result(file, digest, store);
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
   const std::string_view bytes = checked->bytes;
@@ -280,12 +283,16 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
     r.selected.push_back(std::move(piece));
     at += size;
   }
+  while (r.selected.size() < store.triangles.size()) {
+    r.selected.emplace_back();
+    r.selected.back().mesh.origin = origin;
+  }
   return r;
 }
 
-std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t fingerprint,
+std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t digest,
                                                         const TileStore& store) {
-  const std::optional<CheckedResult> checked = checked_result(file, fingerprint, store);
+  const std::optional<CheckedResult> checked = checked_result(file, digest, store);
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
   std::vector<OwnedLabel> labels;

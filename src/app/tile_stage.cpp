@@ -72,36 +72,37 @@ class Progress {
 /// A dependency's labels. On a shared filesystem a file another machine just renamed into
 /// place may take a moment to appear: look again for a few seconds before giving up.
 std::vector<OwnedLabel> dependency_labels(const Config& config, const TileStore& store, TileKey key, TileKey needed_by,
-                                          std::uint64_t fingerprint) {
+                                          std::uint64_t digest) {
   const std::filesystem::path file = result_path(config, key);
   for (int attempt = 0;; ++attempt) {
-    if (std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(file, fingerprint, store)) {
+    if (std::optional<std::vector<OwnedLabel>> labels = read_tile_labels(file, digest, store)) {
       return std::move(*labels);
     }
-    if (attempt == 20) throw ProcessingError(fmt::format("{}: missing, needed by tile {}", file.string(), needed_by.name()));
+    if (attempt == 20)
+      throw ProcessingError(fmt::format("{}: missing, needed by tile {}", file.string(), needed_by.name()));
     std::this_thread::sleep_for(std::chrono::milliseconds(250));
   }
 }
 
 /// The decisions of the tiles `k` waits for.
 SettledSelection settled_selection(const Config& config, const TileStore& store, std::size_t k,
-                                   std::uint64_t fingerprint) {
+                                   std::span<const std::uint64_t> digests) {
   SettledSelection settled;
   for (const std::size_t d : tile_dependencies(store, k)) {
-    settled.add(dependency_labels(config, store, store.tiles[d].key, store.tiles[k].key, fingerprint));
+    settled.add(dependency_labels(config, store, store.tiles[d].key, store.tiles[k].key, digests[d]));
   }
   return settled;
 }
 
-/// Whether tile `key` has a finished result made with `fingerprint`: complete (the checksum
+/// Whether tile `key` has a finished result made under `digest`: complete (the checksum
 /// covers the whole file) and decodable, its consistent pairs left undecoded (the largest
 /// section, which only the labelled PLYs read).
-bool has_finished_result(const Config& config, const TileStore& store, TileKey key, std::uint64_t fingerprint) {
-  return read_tile_result(result_path(config, key), fingerprint, store, {.pairs = false}).has_value();
+bool has_finished_result(const Config& config, const TileStore& store, TileKey key, std::uint64_t digest) {
+  return read_tile_result(result_path(config, key), digest, store, {.pairs = false}).has_value();
 }
 
 /// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
-WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                            const std::vector<std::size_t>& tiles, std::span<const std::uint8_t> theirs) {
   std::vector<std::vector<std::size_t>> after;
   std::vector<std::uint8_t> done;
@@ -116,7 +117,7 @@ WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::ui
       positions.push_back(static_cast<std::size_t>(it - tiles.begin()));
     }
     after.push_back(std::move(positions));
-    done.push_back(has_finished_result(config, store, store.tiles[k].key, fingerprint) ? 1 : 0);
+    done.push_back(has_finished_result(config, store, store.tiles[k].key, digests[k]) ? 1 : 0);
   }
   return WorkSchedule(tile_priorities(store, tiles, theirs), after, done);
 }
@@ -126,11 +127,12 @@ void warn_tiles_over_budget(const Config& config, const TileStore& store, const 
   const std::vector<std::size_t> over = tiles_over_budget(store, tiles, config.run.memory);
   if (over.empty()) return;
   const TileContents& largest = store.tiles[over.front()];
-  log::warn("{} of {} tiles are estimated above the memory budget of {} (largest: tile {}, {} triangles with its "
-            "halo, ~{} MiB); each runs alone and may pass the budget: use a smaller [tiling] tile_size or a larger "
-            "--memory",
-            over.size(), tiles.size(), format_byte_size(config.run.memory), largest.key.name(), largest.total(),
-            tile_memory_estimate(largest) >> 20);
+  log::warn(
+      "{} of {} tiles are estimated above the memory budget of {} (largest: tile {}, {} triangles with its "
+      "halo, ~{} MiB); each runs alone and may pass the budget: use a smaller [tiling] tile_size or a larger "
+      "--memory",
+      over.size(), tiles.size(), format_byte_size(config.run.memory), largest.key.name(), largest.total(),
+      tile_memory_estimate(largest) >> 20);
 }
 
 }  // namespace
@@ -139,9 +141,10 @@ std::filesystem::path result_path(const Config& config, TileKey key) {
   return config.project.work / "results" / (key.name() + ".bin");
 }
 
-TileStageReport process_tiles(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+TileStageReport process_tiles(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                               Cluster& cluster, const std::vector<std::size_t>& tiles,
                               std::span<const std::uint8_t> theirs) {
+  if (digests.size() != store.tiles.size()) throw ProcessingError("process_tiles: one digest per tile is needed");
   if (!theirs.empty() && theirs.size() != store.tiles.size()) {
     throw ProcessingError("process_tiles: the other processes' tiles are not given per tile");
   }
@@ -153,7 +156,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   for (const std::size_t k : tiles) input += store.tiles[k].owned();
   Progress progress(tiles.size(), input);
   if (cluster.root()) {
-    schedule.emplace(tile_schedule(config, store, fingerprint, tiles, theirs));
+    schedule.emplace(tile_schedule(config, store, digests, tiles, theirs));
     warn_tiles_over_budget(config, store, tiles);
   }
   MemoryGate gate(config.run.memory);
@@ -169,7 +172,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
     throw_if_interrupted("tile processing");
-    if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, fingerprint)) {
+    if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, digests[k])) {
       finished_elsewhere[item] = 1;  // its owner made it while this process did its own
       return;
     }
@@ -183,8 +186,8 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
       release_freed_memory();
     }
     try {
-      const TileResult r = process_tile(store, tile.key, config, settled_selection(config, store, k, fingerprint));
-      write_tile_result(result_path(config, tile.key), r, fingerprint);
+      const TileResult r = process_tile(store, tile.key, config, settled_selection(config, store, k, digests));
+      write_tile_result(result_path(config, tile.key), r, digests[k]);
     } catch (...) {
       gate.release(estimate);
       throw;

@@ -184,7 +184,7 @@ class FinalOutput {
 /// time in parallel (each filed under the seam pass's parts there too), then added in tile
 /// order: a read result is several times the piece the assembly keeps of it, so not all at
 /// once.
-void read_tile_results(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+void read_tile_results(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                        const TileStageReport& tiles, TileAssembly& assembly, FinalOutput& output,
                        std::vector<nlohmann::json>& per_tile) {
   constexpr std::size_t kBatch = 4;
@@ -195,7 +195,8 @@ void read_tile_results(const Config& config, const TileStore& store, std::uint64
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const TileKey key = store.tiles[first + i].key;
-        batch[i] = read_tile_result(result_path(config, key), fingerprint, store, {.pairs = config.output.labels});
+        batch[i] =
+            read_tile_result(result_path(config, key), digests[first + i], store, {.pairs = config.output.labels});
         filed[i] = batch[i] ? output.file_tile(key, *batch[i]) : std::nullopt;
       }
     });
@@ -209,7 +210,7 @@ void read_tile_results(const Config& config, const TileStore& store, std::uint64
 
 /// The outputs from every tile's result: assembly, labels, the seam pass, mosaic, 3D Tiles and
 /// run.json. `seconds` holds the stages timed so far.
-void write_run_outputs(const Config& config, const TileStore& store, std::uint64_t fingerprint,
+void write_run_outputs(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                        const TileStageReport& tiles, const PictureOptions& pictures, nlohmann::json seconds,
                        Cluster* cluster) {
   const int ranks = cluster != nullptr ? cluster->size() : 1;
@@ -228,7 +229,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::uint64
                         config.output.labels ? std::optional(pair_spill_folder(config.project.work)) : std::nullopt);
   FinalOutput output(config, cluster);
   std::vector<nlohmann::json> per_tile;
-  read_tile_results(config, store, fingerprint, tiles, assembly, output, per_tile);
+  read_tile_results(config, store, digests, tiles, assembly, output, per_tile);
   const std::uint64_t selected = output.assemble(assembly);
   stage_done("assembly");
   if (config.output.labels) write_labels(config, assembly, pictures);
@@ -300,14 +301,14 @@ std::vector<std::size_t> all_tiles(const TileStore& store) {
 
 /// A subset's share: its tiles and, where they wait for tiles of other subsets that are not
 /// finished yet, those too (the same bytes whoever makes them). No outputs: `merge` writes them.
-void run_subset(const Config& config, const TileStore& store, std::uint64_t fingerprint, const Subset& subset,
-                Cluster& cluster) {
+void run_subset(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
+                const Subset& subset, Cluster& cluster) {
   Stopwatch clock;
   const std::vector<std::size_t> own = subset_tiles(store, subset);
   const std::vector<std::size_t> needed = with_dependencies(store, own);
   std::vector<std::uint8_t> theirs(store.tiles.size(), 1);
   for (const std::size_t k : own) theirs[k] = 0;
-  const TileStageReport report = process_tiles(config, store, fingerprint, cluster, needed, theirs);
+  const TileStageReport report = process_tiles(config, store, digests, cluster, needed, theirs);
   std::size_t own_processed = 0;
   for (const std::size_t k : own) own_processed += report.processed[k];
   std::cout << fmt::format(
@@ -327,20 +328,21 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
     check_run_config(config.project.work, keys, options.force);
     remove_leftovers_of_ended_runs(config);
   }
-  const std::uint64_t result_fingerprint = fingerprint(keys, false);
-  const TileStore store = prepare_tile_store(config, fingerprint(keys, true), cluster, options.subset);
+  const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
+  const TileStore store = prepare_tile_store(config, fingerprints, cluster, options.subset);
+  const std::vector<std::uint64_t> digests = tile_digests(store, fingerprints.settings, fingerprints.acquisitions);
   // Each stage's arrays differ from the last one's: the memory one freed goes back to the
   // system instead of staying resident under the next one's peak.
   release_freed_memory();
   nlohmann::json seconds{{"tiling", clock.restart()}};
-  if (options.subset) return run_subset(config, store, result_fingerprint, *options.subset, cluster);
-  const TileStageReport tiles = process_tiles(config, store, result_fingerprint, cluster, all_tiles(store));
+  if (options.subset) return run_subset(config, store, digests, *options.subset, cluster);
+  const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
   // The seam pass and the outputs need every tile: the root writes them, the other ranks
   // help it stitch.
   if (cluster.root()) {
-    write_run_outputs(config, store, result_fingerprint, tiles, options.pictures, seconds, &cluster);
+    write_run_outputs(config, store, digests, tiles, options.pictures, seconds, &cluster);
   } else if (seam_pass_in_blocks(config)) {
     help_seam_pass(config, cluster);
     help_outputs(config, cluster);
@@ -353,18 +355,19 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const auto keys = result_keys(config);
   check_run_config(config.project.work, keys, false);
   remove_leftovers_of_ended_runs(config);
-  const std::uint64_t result_fingerprint = fingerprint(keys, false);
-  const std::optional<TileStore> store = finished_tile_store(config, fingerprint(keys, true));
+  const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
+  const std::optional<TileStore> store = finished_tile_store(config, fingerprints);
   if (!store) {
     throw InputError(
         fmt::format("{}: no finished tile store for this config; run the subsets first "
                     "(citymesh run CONFIG --subset i/N)",
                     (config.project.work / "tiles").string()));
   }
+  const std::vector<std::uint64_t> digests = tile_digests(*store, fingerprints.settings, fingerprints.acquisitions);
   std::vector<std::string> missing;
-  for (const TileContents& tile : store->tiles) {
-    if (!read_tile_result(result_path(config, tile.key), result_fingerprint, *store))
-      missing.push_back(tile.key.name());
+  for (std::size_t k = 0; k < store->tiles.size(); ++k) {
+    if (!read_tile_result(result_path(config, store->tiles[k].key), digests[k], *store))
+      missing.push_back(store->tiles[k].key.name());
   }
   if (!missing.empty()) {
     const std::size_t shown = std::min<std::size_t>(missing.size(), 8);
@@ -376,7 +379,7 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     shown < missing.size() ? ", ..." : ""));
   }
   const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0};
-  write_run_outputs(config, *store, result_fingerprint, none, pictures, nlohmann::json::object(), nullptr);
+  write_run_outputs(config, *store, digests, none, pictures, nlohmann::json::object(), nullptr);
 }
 
 }  // namespace citymesh::app

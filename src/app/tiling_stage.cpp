@@ -40,6 +40,12 @@ std::vector<std::uint64_t> tiling_priorities(std::span<const std::uint64_t> size
 
 std::string store_fingerprint(std::uint64_t fingerprint) { return fmt::format("{:016x}", fingerprint); }
 
+std::vector<std::string> acquisition_fingerprints(const RunFingerprints& fingerprints) {
+  std::vector<std::string> out;
+  for (const std::uint64_t f : fingerprints.acquisitions) out.push_back(store_fingerprint(f));
+  return out;
+}
+
 /// How many acquisitions a rank tiles at once: one per thread while each fits the budget
 /// with its buffers and its vertices, held whole (about the size of its file). The result
 /// does not depend on it: each acquisition is tiled alone, with the same buffers.
@@ -65,20 +71,21 @@ void warn_if_halo_too_narrow(const TileStore& store, const Config& config) {
 
 }  // namespace
 
-std::optional<TileStore> finished_tile_store(const Config& config, std::uint64_t fingerprint) {
+std::optional<TileStore> finished_tile_store(const Config& config, const RunFingerprints& fingerprints) {
   std::optional<TileStore> store = read_tile_manifest(config.project.work / "tiles");
-  if (!store || store->fingerprint != store_fingerprint(fingerprint)) return std::nullopt;
+  if (!store || store->fingerprint != store_fingerprint(fingerprints.store)) return std::nullopt;
   return store;
 }
 
 namespace {
 
 /// prepare_tile_store without the halo check: the store reused or made now.
-TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+TileStore reused_or_tiled_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                                 const std::optional<Subset>& subset) {
   const std::filesystem::path dir = config.project.work / "tiles";
-  const std::string wanted = store_fingerprint(fingerprint);
-  const std::optional<TileStore> existing = finished_tile_store(config, fingerprint);
+  const std::string wanted = store_fingerprint(fingerprints.store);
+  const std::vector<std::string> wanted_each = acquisition_fingerprints(fingerprints);
+  const std::optional<TileStore> existing = finished_tile_store(config, fingerprints);
   cluster.barrier();  // every rank has looked before any rank changes the store
   if (existing) {
     log::info("{}: reusing the tile store ({} tiles)", dir.string(), existing->tiles.size());
@@ -88,7 +95,7 @@ TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint,
   const std::vector<Acquisition> acquisitions = config.acquisition_list();
   const std::vector<std::uint64_t> sizes = file_sizes(acquisitions);
   // Only a run that owns the folder removes unfinished staging: subsets may be tiling there.
-  if (cluster.root()) prune_tile_store(dir, acquisitions.size(), wanted, !subset);
+  if (cluster.root()) prune_tile_store(dir, wanted_each, wanted, !subset);
 
   TilerParams params;
   params.grid = {config.tiling.tile_size, config.tiling.halo, config.tiling.origin};
@@ -99,7 +106,10 @@ TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint,
   if (cluster.root()) {
     std::vector<std::uint8_t> done(acquisitions.size());
     for (std::size_t k = 0; k < acquisitions.size(); ++k) {
-      done[k] = read_acquisition_tiling(dir, static_cast<std::uint32_t>(k), wanted).has_value() ? 1 : 0;
+      done[k] = read_acquisition_tiling(dir, static_cast<std::uint32_t>(k), wanted_each[k]).has_value() ? 1 : 0;
+    }
+    if (const auto kept = std::count(done.begin(), done.end(), 1); kept > 0) {
+      log::info("{}: reusing the tiling of {} of {} acquisitions", dir.string(), kept, acquisitions.size());
     }
     schedule.emplace(tiling_priorities(sizes, subset), std::vector<std::vector<std::size_t>>(acquisitions.size()),
                      done);
@@ -107,12 +117,12 @@ TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint,
   {
     const auto channel = cluster.share(schedule ? &*schedule : nullptr, nullptr);
     run_workers(*channel, tiling_workers(sizes, config.run.memory, params.buffer_bytes),
-                [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted); });
+                [&](std::size_t k) { (void)tile_acquisition(acquisitions[k], params, wanted_each[k]); });
   }
   if (cluster.root()) {
     std::vector<AcquisitionTiling> parts;
     for (std::uint32_t k = 0; k < acquisitions.size(); ++k) {
-      std::optional<AcquisitionTiling> part = read_acquisition_tiling(dir, k, wanted);
+      std::optional<AcquisitionTiling> part = read_acquisition_tiling(dir, k, wanted_each[k]);
       if (!part)
         throw ProcessingError(
             fmt::format("{}: the tiled acquisition vanished", acquisition_tiles_path(dir, k).string()));
@@ -124,7 +134,7 @@ TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint,
               clock.seconds());
   }
   cluster.barrier();
-  std::optional<TileStore> store = finished_tile_store(config, fingerprint);
+  std::optional<TileStore> store = finished_tile_store(config, fingerprints);
   if (!store) {
     throw ProcessingError(
         fmt::format("{}: no finished tile store after tiling (is the work folder shared by every "
@@ -136,9 +146,9 @@ TileStore reused_or_tiled_store(const Config& config, std::uint64_t fingerprint,
 
 }  // namespace
 
-TileStore prepare_tile_store(const Config& config, std::uint64_t fingerprint, Cluster& cluster,
+TileStore prepare_tile_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                              const std::optional<Subset>& subset) {
-  TileStore store = reused_or_tiled_store(config, fingerprint, cluster, subset);
+  TileStore store = reused_or_tiled_store(config, fingerprints, cluster, subset);
   if (cluster.root()) warn_if_halo_too_narrow(store, config);
   return store;
 }

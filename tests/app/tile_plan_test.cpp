@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // Which tiles wait for which, and subsets: against brute force on random tile sets.
+#include "tile_plan.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -8,7 +10,6 @@
 
 #include "citymesh/core/error.h"
 #include "tile_job.h"
-#include "tile_plan.h"
 #include "work_schedule.h"
 
 namespace citymesh::app {
@@ -188,6 +189,47 @@ TEST(TilePlan, WithDependenciesIsTheSmallestClosedSet) {
   }
   EXPECT_EQ(in, reach);
   EXPECT_GT(needed.size(), own.size());  // a strip in the middle waits for its neighbours
+}
+
+TEST(TilePlan, AChangedAcquisitionChangesTheDigestsOfTheTilesItReachesAndOfTheirLaterNeighboursOnly) {
+  std::mt19937 rng(11);
+  TileStore store = random_store(rng, 12, 10);
+  // Acquisition 1 covers the western tiles, as a new pass over part of the city would.
+  for (TileContents& t : store.tiles) {
+    const std::uint64_t owned = t.key.i < 3 ? 1 + rng() % 50 : 0;
+    t.triangles.push_back({owned, owned > 0 ? rng() % 9 : 0, t.key.i == 3 ? rng() % 2 : 0});
+  }
+  const std::vector<std::uint64_t> before = tile_digests(store, 7, std::vector<std::uint64_t>{100, 200});
+  EXPECT_EQ(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200}), before);
+  const std::vector<std::uint64_t> after = tile_digests(store, 7, std::vector<std::uint64_t>{100, 201});
+  // Brute force: the tiles holding acquisition 1, then whatever waits for a changed tile.
+  std::set<std::size_t> changed;
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    const auto& counts = store.tiles[k].triangles[1];
+    if (counts[0] + counts[1] + counts[2] > 0) changed.insert(k);
+  }
+  for (bool grew = true; grew;) {
+    grew = false;
+    for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+      for (const std::size_t d : tile_dependencies(store, k)) {
+        if (changed.contains(d)) grew = changed.insert(k).second || grew;
+      }
+    }
+  }
+  std::size_t differ = 0;
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    EXPECT_EQ(after[k] != before[k], changed.contains(k)) << store.tiles[k].key.name();
+    differ += after[k] != before[k] ? 1 : 0;
+  }
+  EXPECT_GT(differ, 0u);
+  EXPECT_LT(differ, store.tiles.size()) << "the eastern tiles are far from acquisition 1";
+  // The settings reach every tile; a tile's own counts reach it.
+  const std::vector<std::uint64_t> settings = tile_digests(store, 8, std::vector<std::uint64_t>{100, 200});
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) EXPECT_NE(settings[k], before[k]);
+  const std::size_t last = store.tiles.size() - 1;
+  ++store.tiles[last].triangles[0][1];
+  EXPECT_NE(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200})[last], before[last]);
+  EXPECT_THROW((void)tile_digests(store, 7, std::vector<std::uint64_t>{100}), ProcessingError);
 }
 
 TEST(TilePlan, SubsetParsing) {

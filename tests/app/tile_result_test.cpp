@@ -115,6 +115,25 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
   }
 }
 
+TEST(TileResult, AResultMadeBeforeAnAcquisitionWasAddedReadsWithAnEmptyPieceForIt) {
+  test::TempDir tmp;
+  const TileResult r = random_result(4, true);  // two acquisitions' pieces
+  write_tile_result(tmp / "t.bin", r, kFingerprint);
+  TileStore three = two_acquisitions();
+  three.triangles.push_back(500);
+  const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint, three);
+  ASSERT_TRUE(back.has_value());
+  ASSERT_EQ(back->selected.size(), 3u);
+  EXPECT_EQ(back->selected[2].triangle_count(), 0u);
+  EXPECT_EQ(back->selected[2].mesh.origin, back->selected[0].mesh.origin);
+  expect_same_labels(back->labels, r.labels);
+  // A result holding more acquisitions than the store is another store's.
+  TileStore one = two_acquisitions();
+  one.triangles.pop_back();
+  EXPECT_FALSE(read_tile_result(tmp / "t.bin", kFingerprint, one).has_value());
+  EXPECT_FALSE(read_tile_labels(tmp / "t.bin", kFingerprint, one).has_value());
+}
+
 TEST(TileResult, ScanOrderedLabelsTakeUnderAQuarterOfTheFixedLayout) {
   test::TempDir tmp;
   TileResult r = random_result(3, true);

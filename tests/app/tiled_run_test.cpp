@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cfloat>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 
@@ -308,6 +309,74 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
       test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10 --set change.distance_threshold=0.2 --force"));
   EXPECT_EQ(forced.exit_code, 0) << forced.err;
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
+}
+
+/// `mesh` with only the triangles whose centroid lies in the first `share` of its longer
+/// horizontal extent (a pass that drove part of the street).
+Mesh first_part(const Mesh& mesh, double share) {
+  double lo[2] = {DBL_MAX, DBL_MAX}, hi[2] = {-DBL_MAX, -DBL_MAX};
+  for (const Vec3f& p : mesh.positions) {
+    lo[0] = std::min(lo[0], double(p.x)), hi[0] = std::max(hi[0], double(p.x));
+    lo[1] = std::min(lo[1], double(p.y)), hi[1] = std::max(hi[1], double(p.y));
+  }
+  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
+  const double end = lo[axis] + share * (hi[axis] - lo[axis]);
+  Mesh part = mesh;
+  part.triangles.clear();
+  part.triangle_ids.clear();
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const auto [a, b, c] = mesh.corners(t);
+    const Vec3d centroid = (a + b + c) / 3.0;
+    if ((axis == 0 ? centroid.x : centroid.y) >= end) continue;
+    part.triangles.push_back(mesh.triangles[t]);
+    part.triangle_ids.push_back(mesh.triangle_ids[t]);
+  }
+  return part;
+}
+
+TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFreshRun) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
+  // Five passes first; then a sixth over the first quarter of the street is appended.
+  const std::string config = test::read_text(dir / "sim/config.toml");
+  const std::size_t last = config.rfind("[[acquisition]]");
+  ASSERT_NE(last, std::string::npos);
+  std::string sixth = config.substr(last);
+  const std::size_t path = sixth.find("acq_5.ply");
+  ASSERT_NE(path, std::string::npos);
+  sixth.replace(path, 9, "acq_5_part.ply");
+  test::write_text(dir / "sim/five.toml", config.substr(0, last));
+  test::write_text(dir / "sim/six.toml", config.substr(0, last) + sixth);
+  write_mesh_ply(dir / "sim/acq_5_part.ply", first_part(read_mesh(dir / "sim/acq_5.ply").mesh, 0.25));
+  const auto run = [&](const std::string& file, const std::string& name, const std::string& extra = "") {
+    return test::run_citymesh(
+        fmt::format("run {}/{} --no-pictures --set tiling.tile_size=10 --set project.output={} "
+                    "--set project.work=work-{} {}",
+                    sim, file, name, name, extra));
+  };
+  const auto five = run("five.toml", "u");
+  ASSERT_EQ(five.exit_code, 0) << five.err;
+  const auto appended = run("six.toml", "u");
+  ASSERT_EQ(appended.exit_code, 0) << appended.err;
+  EXPECT_NE(appended.err.find("acquisition[5] (" + (dir / "sim/acq_5_part.ply").string() + ") was added"),
+            std::string::npos)
+      << appended.err;
+  EXPECT_NE(appended.err.find("reusing the tiling of 5 of 6 acquisitions"), std::string::npos) << appended.err;
+  const nlohmann::json report = read_json(dir / "sim/u/run.json");
+  EXPECT_GT(report["reused_tiles"].get<int>(), 0) << "tiles far from the new pass";
+  EXPECT_LT(report["reused_tiles"].get<int>(), report["tiles"].get<int>()) << "tiles the new pass reaches";
+
+  const auto fresh = run("six.toml", "f");
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
+  const auto reference = test::result_bytes(dir / "sim/f");
+  ASSERT_GE(reference.size(), 8u);
+  EXPECT_TRUE(test::result_bytes(dir / "sim/u") == reference) << "appending differs from a fresh run";
+
+  // Dropping an acquisition is a change of config: refused without --force.
+  const auto dropped = run("five.toml", "u");
+  EXPECT_EQ(dropped.exit_code, 1);
+  EXPECT_NE(dropped.err.find("acquisition[5].path (gone)"), std::string::npos) << dropped.err;
 }
 
 /// The face count a PLY header declares.

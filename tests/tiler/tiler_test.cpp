@@ -437,23 +437,24 @@ TEST(Tiler, TwoAcquisitionsAtOnceGiveTheSameBlockBytes) {
   EXPECT_TRUE(one == two) << "block files differ between one and two acquisitions at once";
 }
 
-TEST(Tiler, PruneKeepsOnlyWhatTheFingerprintOwns) {
+TEST(Tiler, PruneKeepsEachAcquisitionTiledWithItsOwnFingerprint) {
   Fixture f;
   std::filesystem::remove_all(f.params.dir);
-  (void)tile_acquisition(f.acquisitions[0], f.params, "old");
-  (void)tile_acquisition(f.acquisitions[1], f.params, "new");
+  (void)tile_acquisition(f.acquisitions[0], f.params, "a0");
+  (void)tile_acquisition(f.acquisitions[1], f.params, "a1 before");
   std::filesystem::create_directories(f.params.dir / "3_4");             // an older layout
   std::filesystem::create_directories(f.params.dir / "a7");              // beyond the acquisitions
   std::filesystem::create_directories(f.params.dir / "staging/a0.x.1");  // another process's work
-  prune_tile_store(f.params.dir, 2, "new", false);
-  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a0"));
-  EXPECT_TRUE(read_acquisition_tiling(f.params.dir, 1, "new").has_value());
+  const std::vector<std::string> fingerprints{"a0", "a1 now"};
+  prune_tile_store(f.params.dir, fingerprints, "store", false);
+  EXPECT_TRUE(read_acquisition_tiling(f.params.dir, 0, "a0").has_value()) << "its own fingerprint: kept";
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a1"));
   EXPECT_FALSE(std::filesystem::exists(f.params.dir / "3_4"));
   EXPECT_FALSE(std::filesystem::exists(f.params.dir / "a7"));
   EXPECT_TRUE(std::filesystem::exists(f.params.dir / "staging/a0.x.1")) << "staging kept when others may tile";
-  prune_tile_store(f.params.dir, 2, "new", true);
+  prune_tile_store(f.params.dir, fingerprints, "store", true);
   EXPECT_FALSE(std::filesystem::exists(f.params.dir / "staging"));
-  EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 1, "other").has_value());
+  EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 0, "other").has_value());
 }
 
 }  // namespace

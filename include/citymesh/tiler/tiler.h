@@ -99,12 +99,13 @@ std::optional<AcquisitionTiling> read_acquisition_tiling(const std::filesystem::
 TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridParams& grid,
                               std::span<const AcquisitionTiling> parts, std::string fingerprint);
 
-/// Removes from `dir` what a store of `acquisitions` made with `fingerprint` does not use: the
-/// manifest, acquisition folders of another fingerprint or beyond the count, older layouts;
-/// with `staging` also unfinished staging folders (only when no other process can be tiling
-/// into `dir`).
-void prune_tile_store(const std::filesystem::path& dir, std::size_t acquisitions, const std::string& fingerprint,
-                      bool staging);
+/// Removes from `dir` what a store of the acquisitions tiled with `acquisition_fingerprints`
+/// (one each, in order) does not use: a manifest made with another `store_fingerprint`,
+/// acquisition folders of another fingerprint or beyond the count, older layouts; with
+/// `staging` also unfinished staging folders (only when no other process can be tiling into
+/// `dir`). Acquisitions are fingerprinted one by one so that adding one keeps the others' tiling.
+void prune_tile_store(const std::filesystem::path& dir, std::span<const std::string> acquisition_fingerprints,
+                      const std::string& store_fingerprint, bool staging);
 
 /// Empties `params.dir`, tiles every acquisition, largest file first and `at_once` at a time
 /// (each alone, with its own buffers: the store's bytes do not depend on it), and assembles

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Appending a pass over one district to a run (a monthly update): the run of every
+# acquisition but the last, then the last one's triangles within a box appended to the same
+# work folder, against a fresh run of the same config. Prints both wall times, the tiles
+# reused and whether the outputs are the same bytes.
+# Usage: tools/bench/append.sh FOLDER XMIN YMIN XMAX YMAX [threads (default 2)]
+#   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+dir="$1"
+threads="${6:-2}"
+bin="$PWD/build/release/citymesh"
+last=$(grep -n '^\[\[acquisition\]\]' "$dir/config.toml" | tail -1 | cut -d: -f1)
+last_path=$(tail -n +"$last" "$dir/config.toml" | sed -n 's/^path = "\(.*\)"/\1/p' | head -1)
+head -n $((last - 1)) "$dir/config.toml" >"$dir/append-before.toml"
+cp "$dir/append-before.toml" "$dir/append-after.toml"
+tail -n +"$last" "$dir/config.toml" | sed "s|^path = \".*\"|path = \"append-part.ply\"|" >>"$dir/append-after.toml"
+build/release/bench/partial_pass "$dir/$last_path" "$dir/append-part.ply" "$2" "$3" "$4" "$5"
+run() {  # config, work/output name
+  /usr/bin/time -f "%e s, peak RSS %M kB" "$bin" run "$dir/$1" --no-pictures --threads "$threads" --memory 2GiB \
+    --set output.labels=false --set project.work="work-$2" --set project.output="out-$2" 2>"$dir/append-$2.log" |
+    tail -1
+  tail -1 "$dir/append-$2.log"
+}
+rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh"
+echo "every acquisition but the last:"
+run append-before.toml append
+echo "the district appended to that work folder:"
+run append-after.toml append
+python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']}\")"
+echo "a fresh run of the same config:"
+run append-after.toml fresh
+if cmp -s "$dir/out-append/mosaic/mosaic.ply" "$dir/out-fresh/mosaic/mosaic.ply" &&
+  diff -rq "$dir/out-append/tiles" "$dir/out-fresh/tiles" >/dev/null; then
+  echo "appended and fresh: identical mosaic.ply and 3D Tiles"
+else
+  echo "appended and fresh: outputs DIFFER"
+fi
