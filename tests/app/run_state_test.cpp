@@ -1,0 +1,91 @@
+// SPDX-License-Identifier: MIT
+// The work folder's record of its config: what resumes, what is refused, and which
+// fingerprints an appended acquisition leaves alone.
+#include "run_state.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+
+#include "citymesh/core/error.h"
+#include "test_support.h"
+
+namespace citymesh::app {
+namespace {
+
+using Keys = std::map<std::string, std::string>;
+
+/// The keys of a run of `n` acquisitions (dates one month apart).
+Keys keys_of(std::size_t n) {
+  Keys keys{{"change.distance_threshold", "0.1"}, {"tiling.tile_size", "50"}, {"input.time_base", "\"gps-week\""}};
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::string a = "acquisition[" + std::to_string(k) + "]";
+    keys[a + ".path"] = "/data/pass" + std::to_string(k) + ".ply";
+    keys[a + ".file"] = std::to_string(1000 + k) + " bytes, modified 42";
+    keys[a + ".time"] = "2026-0" + std::to_string(k + 1) + "-01T10:00:00Z";
+  }
+  return keys;
+}
+
+TEST(RunState, AnAcquisitionAppendedResumesAndOneChangedRemovedOrInsertedIsRefused) {
+  test::TempDir work;
+  check_run_config(work.path(), keys_of(3), false);
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(3), false));
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(5), false)) << "two passes appended";
+  EXPECT_THROW(check_run_config(work.path(), keys_of(4), false), ConfigError) << "the last pass removed";
+  Keys changed = keys_of(6);
+  changed["acquisition[1].time"] = "2026-02-02T10:00:00Z";
+  try {
+    check_run_config(work.path(), changed, false);
+    ADD_FAILURE() << "an existing pass's date changed beside an appended one";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("acquisition[1].time"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("acquisition[5]"), std::string::npos) << e.what();
+  }
+  // A pass inserted before the last one renumbers it: its keys change.
+  Keys inserted = keys_of(5);
+  inserted["acquisition[4].path"] = "/data/inserted.ply";
+  inserted["acquisition[5].path"] = "/data/pass4.ply";
+  inserted["acquisition[5].file"] = keys_of(5)["acquisition[4].file"];
+  inserted["acquisition[5].time"] = "2026-07-01T10:00:00Z";
+  EXPECT_THROW(check_run_config(work.path(), inserted, false), ConfigError);
+  // A rewritten file is not refused; --force takes anything.
+  Keys rewritten = keys_of(5);
+  rewritten["acquisition[0].file"] = "1000 bytes, modified 43";
+  EXPECT_NO_THROW(check_run_config(work.path(), rewritten, false));
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(2), true));
+}
+
+TEST(RunState, AppendingAnAcquisitionKeepsTheOtherFingerprints) {
+  const RunFingerprints three = run_fingerprints(keys_of(3), 3), four = run_fingerprints(keys_of(4), 4);
+  EXPECT_EQ(three.settings, four.settings);
+  ASSERT_EQ(four.acquisitions.size(), 4u);
+  for (std::size_t k = 0; k < 3; ++k) EXPECT_EQ(three.acquisitions[k], four.acquisitions[k]) << k;
+  EXPECT_NE(four.acquisitions[3], four.acquisitions[2]);
+  EXPECT_NE(three.store, four.store);
+  // A rewritten file changes its own acquisition's fingerprint only.
+  Keys rewritten = keys_of(3);
+  rewritten["acquisition[1].file"] = "1001 bytes, modified 43";
+  const RunFingerprints r = run_fingerprints(rewritten, 3);
+  EXPECT_EQ(r.settings, three.settings);
+  EXPECT_EQ(r.acquisitions[0], three.acquisitions[0]);
+  EXPECT_NE(r.acquisitions[1], three.acquisitions[1]);
+  EXPECT_EQ(r.acquisitions[2], three.acquisitions[2]);
+  // A tiling key changes every acquisition's tiling; a change key only the settings.
+  Keys tiling = keys_of(3), change = keys_of(3);
+  tiling["tiling.tile_size"] = "40";
+  change["change.distance_threshold"] = "0.2";
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_NE(run_fingerprints(tiling, 3).acquisitions[k], three.acquisitions[k]);
+    EXPECT_EQ(run_fingerprints(change, 3).acquisitions[k], three.acquisitions[k]);
+  }
+  EXPECT_NE(run_fingerprints(change, 3).settings, three.settings);
+  // acquisition[10] is the eleventh acquisition, not the second.
+  const RunFingerprints eleven = run_fingerprints(keys_of(11), 11);
+  EXPECT_EQ(eleven.acquisitions[1], three.acquisitions[1]);
+  EXPECT_NE(eleven.acquisitions[10], eleven.acquisitions[1]);
+}
+
+}  // namespace
+}  // namespace citymesh::app
