@@ -137,7 +137,9 @@ CutGraph cut_graph(const BinaryEnergy& e, bool doubled, std::span<const std::uin
       [&g](std::uint32_t from, std::uint32_t to, double capacity, double reverse) {
         g.arcs.push_back({from, to, capacity, reverse});
       },
-      [&g](std::uint32_t node, double from_source, double to_sink) { g.terminal[node] = {from_source, to_sink}; });
+      [&g](std::uint32_t node, double from_source, double to_sink) {
+        g.terminal[node] = {from_source, to_sink};
+      });
   return g;
 }
 
@@ -148,7 +150,70 @@ bool flips_make_submodular(const BinaryEnergy& e, std::span<const std::uint8_t> 
   });
 }
 
+namespace {
+
+/// Variables joined by coupled pairs, each with its parity (flipped or not) against its set's
+/// root: union-find with path compression.
+class ParitySets {
+ public:
+  explicit ParitySets(std::size_t n) : parent_(n), parity_(n, 0) {
+    std::iota(parent_.begin(), parent_.end(), std::uint32_t{0});
+  }
+
+  /// Joins i and j with parity `differ` between them; false when they are joined already with
+  /// the other parity (an odd cycle of differing pairs).
+  bool join(std::uint32_t i, std::uint32_t j, bool differ) {
+    const auto [ri, pi] = find(i);
+    const auto [rj, pj] = find(j);
+    if (ri == rj) return (pi ^ pj) == std::uint8_t{differ};
+    parent_[ri] = rj;
+    parity_[ri] = static_cast<std::uint8_t>(pi ^ pj ^ std::uint8_t{differ});
+    return true;
+  }
+
+ private:
+  /// v's root and v's parity against it; points the path at the root.
+  std::pair<std::uint32_t, std::uint8_t> find(std::uint32_t v) {
+    std::uint32_t root = v;
+    std::uint8_t parity = 0;
+    while (parent_[root] != root) {
+      parity ^= parity_[root];
+      root = parent_[root];
+    }
+    for (std::uint32_t u = v, pu = parity; parent_[u] != u;) {
+      const std::uint32_t next = parent_[u];
+      const auto p_next = static_cast<std::uint8_t>(pu ^ parity_[u]);
+      parent_[u] = root;
+      parity_[u] = static_cast<std::uint8_t>(pu);
+      u = next;
+      pu = p_next;
+    }
+    return {root, parity};
+  }
+
+  std::vector<std::uint32_t> parent_;
+  std::vector<std::uint8_t> parity_;
+};
+
+/// Whether the coupled pairs close a cycle with an odd number of differing pairs. Pair by
+/// pair, stopping at the first such cycle: with three meshes or more one comes early, long
+/// before the colouring of submodular_flips has built its adjacency (a tenth of the mosaic's
+/// solve on the bench street). Last pair first: the mosaic lists its seam terms (which never
+/// differ) before its overlap terms, and these by triangle, so three meshes overlapping close
+/// a cycle within the last meshes' overlaps.
+bool has_odd_cycle(const BinaryEnergy& e) {
+  ParitySets sets(e.size());
+  for (auto p = e.pairs.rbegin(); p != e.pairs.rend(); ++p) {
+    const double c = coupling(*p);
+    if (c != 0 && !sets.join(p->i, p->j, c < 0)) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e) {
+  if (has_odd_cycle(e)) return std::nullopt;
   const std::size_t n = e.size();
   // Adjacency (compressed rows): for each pair with a real coupling, whether its ends must differ.
   std::vector<std::uint32_t> offsets(n + 1, 0);

@@ -301,6 +301,55 @@ TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
   }
 }
 
+TEST(Qpbo, FlipsAreFoundExactlyWhenSomeFlippingMakesEveryCouplingAttractive) {
+  // Against brute force over every flipping: sparse pairs that attract (seams), repel
+  // (overlaps) or do not couple, in any order; odd cycles anywhere in the list.
+  std::mt19937 rng(31);
+  int found = 0, refused = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const std::size_t n = 2 + rng() % 9;
+    BinaryEnergy e;
+    e.unary.assign(n, {0, -1});
+    const std::size_t pairs = rng() % (n + 3);
+    for (std::size_t k = 0; k < pairs; ++k) {
+      const auto i = static_cast<std::uint32_t>(rng() % n), j = static_cast<std::uint32_t>(rng() % n);
+      if (i == j) continue;
+      switch (rng() % 3) {
+        case 0:
+          e.pairs.push_back({i, j, 0, 1, 1, 0});
+          break;  // attracts: coupling > 0
+        case 1:
+          e.pairs.push_back({i, j, 0, 0, 0, 1});
+          break;  // repels: coupling < 0
+        default:
+          e.pairs.push_back({i, j, 1, 2, 3, 4});
+          break;  // e01 + e10 = e00 + e11: no coupling
+      }
+    }
+    const auto consistent = [&](std::uint32_t bits) {
+      for (const auto& p : e.pairs) {
+        const double c = p.e01 + p.e10 - p.e00 - p.e11;
+        if (c != 0 && (((bits >> p.i) ^ (bits >> p.j)) & 1u) != (c < 0 ? 1u : 0u)) return false;
+      }
+      return true;
+    };
+    bool exists = false;
+    for (std::uint32_t bits = 0; bits < (1u << n) && !exists; ++bits) exists = consistent(bits);
+    const auto flips = submodular_flips(e);
+    ASSERT_EQ(flips.has_value(), exists) << "trial " << trial;
+    if (!flips) {
+      ++refused;
+      continue;
+    }
+    ++found;
+    std::uint32_t bits = 0;
+    for (std::size_t v = 0; v < n; ++v) bits |= std::uint32_t{(*flips)[v] != 0} << v;
+    EXPECT_TRUE(consistent(bits)) << "trial " << trial;
+  }
+  EXPECT_GT(found, 200);
+  EXPECT_GT(refused, 200);
+}
+
 TEST(Qpbo, ThreeMutuallyOverlappingTrianglesCannotBeFlipped) {
   BinaryEnergy e;
   e.unary = {{0, -1}, {0, -1}, {0, -1}};
