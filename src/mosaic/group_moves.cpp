@@ -65,10 +65,17 @@ SolveOutcome solve_subset(const BinaryEnergy& e, const PairIndex& index, std::sp
 
 /// Slab of every variable: slabs of equal counts along the coordinate (ties stay together).
 std::vector<std::uint32_t> slab_of_variables(std::span<const float> coordinate, std::uint32_t slabs) {
-  std::vector<float> sorted(coordinate.begin(), coordinate.end());
-  std::sort(sorted.begin(), sorted.end());
+  // Each bound is the value a full sort would put at its rank: found by selection, in
+  // increasing rank, each within what the previous one left above it.
+  std::vector<float> ranked(coordinate.begin(), coordinate.end());
   std::vector<float> bounds;
-  for (std::uint32_t s = 1; s < slabs; ++s) bounds.push_back(sorted[sorted.size() * s / slabs]);
+  auto from = ranked.begin();
+  for (std::uint32_t s = 1; s < slabs; ++s) {
+    const auto at = ranked.begin() + static_cast<std::ptrdiff_t>(ranked.size() * s / slabs);
+    std::nth_element(from, at, ranked.end());
+    bounds.push_back(*at);
+    from = at;
+  }
   std::vector<std::uint32_t> slab(coordinate.size());
   for (std::size_t v = 0; v < slab.size(); ++v) {
     slab[v] =

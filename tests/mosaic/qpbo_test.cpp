@@ -301,6 +301,46 @@ TEST(GroupMoves, NoTermJoinsTheInteriorsOfTwoSlabs) {
   }
 }
 
+TEST(GroupMoves, ThePairIndexListsEachVariablesTermsInOrderOnAnyThreadCount) {
+  // Enough terms for the index to be built in blocks on two threads.
+  std::mt19937 rng(41);
+  const std::size_t n = 5000;
+  BinaryEnergy e;
+  e.unary.assign(n, {0, 0});
+  std::uniform_real_distribution<double> u(-2, 2);
+  for (std::size_t k = 0; k < 300000; ++k) {
+    const auto i = static_cast<std::uint32_t>(rng() % n), j = static_cast<std::uint32_t>(rng() % n);
+    if (i != j) e.pairs.push_back({i, j, u(rng), u(rng), u(rng), u(rng)});
+  }
+  const auto check = [&](const mosaic_detail::PairIndex& index) {
+    // Brute force: each variable's terms in increasing order, with the other end and the
+    // values seen from this end.
+    std::vector<std::vector<std::uint32_t>> rows(n);
+    for (std::uint32_t k = 0; k < e.pairs.size(); ++k) {
+      rows[e.pairs[k].i].push_back(k);
+      rows[e.pairs[k].j].push_back(k);
+    }
+    for (std::uint32_t v = 0; v < n; ++v) {
+      ASSERT_EQ(index.offsets[v + 1] - index.offsets[v], rows[v].size()) << v;
+      for (std::size_t r = 0; r < rows[v].size(); ++r) {
+        const std::uint32_t entry = index.offsets[v] + static_cast<std::uint32_t>(r);
+        const auto& p = e.pairs[rows[v][r]];
+        ASSERT_EQ(index.pairs[entry], rows[v][r]);
+        const bool at_j = p.i != v;
+        ASSERT_EQ(index.ends[entry], at_j ? (p.i | mosaic_detail::PairIndex::kAtJ) : p.j);
+        const std::array<double, 4> seen =
+            at_j ? std::array{p.e00, p.e10, p.e01, p.e11} : std::array{p.e00, p.e01, p.e10, p.e11};
+        ASSERT_EQ(index.values[entry], seen);
+      }
+    }
+  };
+  {
+    const ThreadLimit one(1);
+    check(mosaic_detail::PairIndex(e));
+  }
+  check(mosaic_detail::PairIndex(e));
+}
+
 TEST(Qpbo, FlipsAreFoundExactlyWhenSomeFlippingMakesEveryCouplingAttractive) {
   // Against brute force over every flipping: sparse pairs that attract (seams), repel
   // (overlaps) or do not couple, in any order; odd cycles anywhere in the list.
