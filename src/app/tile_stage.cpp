@@ -47,10 +47,13 @@ class MemoryGate {
   std::uint64_t budget_, in_use_ = 0;
 };
 
-/// Progress lines on stderr: tiles done, input triangles per second, ETA, memory.
+/// Progress lines on stderr: tiles done of those to process (and how many are reused),
+/// input triangles per second, ETA, memory. Reused tiles count neither in the total nor in
+/// the ETA: a resumed or appended run would otherwise show an ETA for work it does not do.
 class Progress {
  public:
-  Progress(std::size_t tiles, std::uint64_t triangles) : tiles_(tiles), triangles_(triangles) {}
+  Progress(std::size_t tiles, std::uint64_t triangles, std::size_t reused)
+      : tiles_(tiles), reused_(reused), triangles_(triangles) {}
   /// Called under the work channel's lock.
   void done(std::uint64_t owned) {
     ++done_;
@@ -58,13 +61,15 @@ class Progress {
     if (done_ < tiles_ && since_line_.seconds() < 1.0) return;
     since_line_.restart();
     const double rate = static_cast<double>(triangles_done_) / std::max(clock_.seconds(), 1e-9);
-    const double eta = rate > 0 ? static_cast<double>(triangles_ - triangles_done_) / rate : 0.0;
-    log::info("tiles {}/{}, {:.2f} M triangles/s, ETA {:.0f} s, memory {:.0f} MiB", done_, tiles_, rate / 1e6, eta,
+    const double eta =
+        rate > 0 && triangles_ > triangles_done_ ? static_cast<double>(triangles_ - triangles_done_) / rate : 0.0;
+    log::info("tiles {}/{}{}, {:.2f} M triangles/s, ETA {:.0f} s, memory {:.0f} MiB", done_, tiles_,
+              reused_ > 0 ? fmt::format(" ({} reused)", reused_) : std::string(), rate / 1e6, eta,
               static_cast<double>(resident_bytes()) / (1 << 20));
   }
 
  private:
-  std::size_t tiles_, done_ = 0;
+  std::size_t tiles_, reused_, done_ = 0;
   std::uint64_t triangles_, triangles_done_ = 0;
   Stopwatch clock_, since_line_;
 };
@@ -101,11 +106,20 @@ bool has_finished_result(const Config& config, const TileStore& store, TileKey k
   return read_tile_result(result_path(config, key), digest, store, {.pairs = false}).has_value();
 }
 
-/// The schedule of `tiles` (positions in `tiles`), with the tiles that have a result done.
-WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
-                           const std::vector<std::size_t>& tiles, std::span<const std::uint8_t> theirs) {
-  std::vector<std::vector<std::size_t>> after;
+/// Per item of `tiles` (positions in store.tiles): 1 when its tile has a finished result.
+std::vector<std::uint8_t> finished_items(const Config& config, const TileStore& store,
+                                         std::span<const std::uint64_t> digests,
+                                         const std::vector<std::size_t>& tiles) {
   std::vector<std::uint8_t> done;
+  for (const std::size_t k : tiles)
+    done.push_back(has_finished_result(config, store, store.tiles[k].key, digests[k]) ? 1 : 0);
+  return done;
+}
+
+/// The schedule of `tiles` (positions in `tiles`), with the items `done` finished already.
+WorkSchedule tile_schedule(const TileStore& store, const std::vector<std::size_t>& tiles,
+                           std::span<const std::uint8_t> theirs, std::vector<std::uint8_t> done) {
+  std::vector<std::vector<std::size_t>> after;
   for (const std::size_t k : tiles) {
     std::vector<std::size_t> positions;
     for (const std::size_t d : tile_dependencies(store, k)) {
@@ -117,7 +131,6 @@ WorkSchedule tile_schedule(const Config& config, const TileStore& store, std::sp
       positions.push_back(static_cast<std::size_t>(it - tiles.begin()));
     }
     after.push_back(std::move(positions));
-    done.push_back(has_finished_result(config, store, store.tiles[k].key, digests[k]) ? 1 : 0);
   }
   return WorkSchedule(tile_priorities(store, tiles, theirs), after, done);
 }
@@ -152,13 +165,18 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   TileStageReport report;
   report.processed.assign(store.tiles.size(), 0);
   std::optional<WorkSchedule> schedule;
+  std::size_t pending = tiles.size();
   std::uint64_t input = 0;
-  for (const std::size_t k : tiles) input += store.tiles[k].owned();
-  Progress progress(tiles.size(), input);
   if (cluster.root()) {
-    schedule.emplace(tile_schedule(config, store, digests, tiles, theirs));
+    std::vector<std::uint8_t> done = finished_items(config, store, digests, tiles);
+    for (std::size_t item = 0; item < tiles.size(); ++item) {
+      if (done[item] == 0) input += store.tiles[tiles[item]].owned();
+    }
+    pending = static_cast<std::size_t>(std::count(done.begin(), done.end(), 0));
+    schedule.emplace(tile_schedule(store, tiles, theirs, std::move(done)));
     warn_tiles_over_budget(config, store, tiles);
   }
+  Progress progress(pending, input, tiles.size() - pending);
   MemoryGate gate(config.run.memory);
   const auto on_finish = [&](std::size_t item) {
     report.processed[tiles[item]] = 1;

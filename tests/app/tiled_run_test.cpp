@@ -366,6 +366,12 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   const nlohmann::json report = read_json(dir / "sim/u/run.json");
   EXPECT_GT(report["reused_tiles"].get<int>(), 0) << "tiles far from the new pass";
   EXPECT_LT(report["reused_tiles"].get<int>(), report["tiles"].get<int>()) << "tiles the new pass reaches";
+  // Progress counts the tiles to process, not the reused ones (nor do they enter the ETA).
+  const int redone = report["tiles"].get<int>() - report["reused_tiles"].get<int>();
+  EXPECT_NE(
+      appended.err.find(fmt::format("tiles {}/{} ({} reused)", redone, redone, report["reused_tiles"].get<int>())),
+      std::string::npos)
+      << appended.err;
 
   const auto fresh = run("six.toml", "f");
   ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
