@@ -2,9 +2,11 @@
 // The paper's baseline mosaic (add acquisitions in date order, keep what is new) and the hole
 // fill after the energy mosaic (the same rule, newest first, from the mosaic's selection).
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 
 #include "citymesh/core/error.h"
+#include "citymesh/core/geometry.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -17,12 +19,49 @@ namespace citymesh {
 
 namespace {
 
+/// Per global triangle: 1 when it is a candidate (kept, not selected) with a selected
+/// consistent partner clearly within `reach` of its centroid. Most candidates the energy
+/// left out overlap a selected triangle: their pairs answer for them, and only the others
+/// need the search (which took most of the hole fill's time). "Clearly": 0.1 mm inside, far
+/// more than the merged mesh's coordinates differ from the meshes' own, so the search would
+/// have found that partner too.
+std::vector<std::uint8_t> covered_by_partners(const MosaicInput& input, const std::vector<std::uint8_t>& selected,
+                                              double reach) {
+  const ChangeResult& change = *input.change;
+  const GlobalTriangles& index = change.index;
+  std::vector<std::uint8_t> covered(index.size(), 0);
+  constexpr double kClear = 1e-4;
+  if (!(reach > kClear)) return covered;
+  const double clear_sq = (reach - kClear) * (reach - kClear);
+  const auto corners = [&](std::uint32_t g) {
+    const std::uint32_t a = index.acquisition_of(g);
+    return input.meshes[a].corners(g - index.offsets[a]);
+  };
+  const std::span<const TrianglePair> pairs(change.consistent_pairs);
+  parallel_for_blocks(pairs.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t k = begin; k < end; ++k) {
+      for (const auto& [candidate, partner] : {pairs[k], TrianglePair{pairs[k].second, pairs[k].first}}) {
+        if (change.kept[candidate] == 0 || selected[candidate] != 0 || selected[partner] == 0) continue;
+        // Flags are only raised: any order of raising gives the same result.
+        std::atomic_ref<std::uint8_t> flag(covered[candidate]);
+        if (flag.load(std::memory_order_relaxed) != 0) continue;
+        const auto [p, q, r] = corners(candidate);
+        if (point_triangle_distance_sq((p + q + r) / 3.0, corners(partner)) <= clear_sq) {
+          flag.store(1, std::memory_order_relaxed);
+        }
+      }
+    }
+  });
+  return covered;
+}
+
 /// Per global triangle: 1 when the change step kept it, it is not selected and no selected
 /// triangle lies within the distance threshold of its centroid.
 std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const std::vector<std::uint8_t>& selected) {
   const ChangeResult& change = *input.change;
   const GlobalTriangles& index = change.index;
   const double reach = input.distance_threshold;
+  const std::vector<std::uint8_t> by_partner = covered_by_partners(input, selected, reach);
   const MergedMesh initial = merge_selection(input.meshes, index, selected);
   const MeshProximity near_initial(initial.mesh, reach);
   std::vector<std::uint8_t> open(index.size(), 0);
@@ -34,7 +73,7 @@ std::vector<std::uint8_t> uncovered_by_selection(const MosaicInput& input, const
       std::vector<std::uint32_t> asked;
       std::vector<Vec3d> centroids;
       for (std::size_t t = begin; t < end; ++t) {
-        if (change.kept[base + t] == 0 || selected[base + t] != 0) continue;
+        if (change.kept[base + t] == 0 || selected[base + t] != 0 || by_partner[base + t] != 0) continue;
         const auto [p, q, r] = mesh.corners(t);
         asked.push_back(static_cast<std::uint32_t>(t));
         centroids.push_back((p + q + r) / 3.0);
@@ -78,9 +117,9 @@ std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::S
 /// the acquisition: its own triangles never hide each other), unless, with `visibility`,
 /// another pass saw through them. The triangles selected at the start are indexed once; the
 /// ones added on the way are indexed again per acquisition (few, for the hole fill).
-HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order, std::vector<std::uint8_t>& selected,
-                             const mosaic_detail::SeenThroughParams* visibility, std::span<const std::uint8_t> seen = {},
-                             std::vector<std::uint8_t>* notes = nullptr) {
+HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order,
+                             std::vector<std::uint8_t>& selected, const mosaic_detail::SeenThroughParams* visibility,
+                             std::span<const std::uint8_t> seen = {}, std::vector<std::uint8_t>* notes = nullptr) {
   const GlobalTriangles& index = input.change->index;
   const double reach = input.distance_threshold;
   std::vector<std::uint8_t> open = uncovered_by_selection(input, selected);
@@ -117,7 +156,8 @@ HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size
 std::vector<std::size_t> date_order(const MosaicInput& input) {
   std::vector<std::size_t> order(input.meshes.size());
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
   return order;
 }
 

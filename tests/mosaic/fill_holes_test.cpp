@@ -44,6 +44,34 @@ TEST(FillHoles, AddsNewestTrianglesWhereNothingSelectedIsNear) {
   for (std::size_t g = 264; g < 328; ++g) EXPECT_EQ(selected[g], 0) << "the oldest fills nothing left";
 }
 
+TEST(FillHoles, ConsistentPairsOnlySpareTheSearchAndNeverChangeWhatIsAdded) {
+  // The fill looks at a candidate's selected partners before searching around it: whatever
+  // pairs are listed (here every pair of triangles of different meshes, near or far, and
+  // partners found from either side), it adds exactly what it adds without any.
+  const std::vector<Mesh> meshes{grid(0, 10, 10, 0.1f, 0), grid(0.05f, 8, 4, 0.25f, 0.09f),
+                                 grid(0.3f, 8, 4, 0.25f, 0.02f)};
+  const std::vector<TimePoint> dates{TimePoint(std::chrono::days(10)), TimePoint(std::chrono::days(20)),
+                                     TimePoint(std::chrono::days(1))};
+  ChangeResult change;
+  change.index.offsets = {0, 200, 264, 328};
+  change.kept.assign(328, 1);
+  std::vector<std::uint8_t> start(328, 0);
+  for (std::size_t g = 0; g < 200; g += 3) start[g] = 1;  // a sparse selection: holes everywhere
+  start[210] = start[300] = 1;
+  std::vector<std::uint8_t> without = start;
+  const std::uint64_t added = fill_holes({meshes, dates, &change, 0.1, {}}, without).added;
+  for (std::uint32_t g = 0; g < 328; ++g) {
+    for (std::uint32_t u = g + 1; u < 328; ++u) {
+      if (change.index.acquisition_of(g) != change.index.acquisition_of(u)) change.consistent_pairs.emplace_back(g, u);
+    }
+  }
+  std::vector<std::uint8_t> with = start;
+  EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, with).added, added);
+  EXPECT_EQ(with, without);
+  EXPECT_GT(added, 10u);
+  EXPECT_LT(added, 328u - 70u) << "some candidates were covered";
+}
+
 TEST(FillHoles, NeverAddsWhatTheChangeStepDropped) {
   const std::vector<Mesh> meshes{grid(0, 2, 2, 0.1f, 0), grid(5, 2, 2, 0.1f, 0)};
   const std::vector<TimePoint> dates{TimePoint(std::chrono::days(1)), TimePoint(std::chrono::days(2))};
