@@ -149,19 +149,35 @@ struct BoxedTriangles {
 BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& partners,
                                    std::span<const OccupancyGrid> grids, std::size_t j, const ChangeParams& params,
                                    ChangeStats& stats) {
-  BoxedTriangles out;
-  for (std::size_t a = 0; a < f.acquisitions(); ++a) {
-    if (!(f.dates[a] < f.dates[j])) continue;
-    for (std::size_t g = f.index.offsets[a]; g < f.index.offsets[a + 1]; ++g) {
-      if (!f.asks(g) || partners.has(g, j)) continue;
-      ++stats.conflict_candidates;
+  // In blocks on the pool, each with its own reader of the grid (consecutive triangles of a
+  // scan fall in the same tree nodes), then put together in triangle order.
+  struct Block {
+    std::vector<std::uint32_t> ids;
+    std::uint64_t candidates = 0, skipped = 0;
+  };
+  constexpr std::size_t kGrain = 16384;
+  const std::size_t n = f.size();
+  std::vector<Block> blocks((n + kGrain - 1) / kGrain);
+  parallel_for_blocks(n, kGrain, [&](std::size_t begin, std::size_t end) {
+    Block& block = blocks[begin / kGrain];
+    std::optional<OccupancyGrid::Reader> reader;
+    if (params.prefilter) reader.emplace(grids[j]);
+    for (std::size_t g = begin; g < end; ++g) {
+      if (!(f.date_of(g) < f.dates[j]) || !f.asks(g) || partners.has(g, j)) continue;
+      ++block.candidates;
       const Box3f& box = f.bounds(g);
-      if (params.prefilter && !grids[j].any_in_box(box.min, box.max)) {
-        ++stats.prefilter_skipped;
+      if (reader && !reader->any_in_box(box.min, box.max)) {
+        ++block.skipped;
         continue;
       }
-      out.add(static_cast<std::uint32_t>(g), box);
+      block.ids.push_back(static_cast<std::uint32_t>(g));
     }
+  });
+  BoxedTriangles out;
+  for (const Block& block : blocks) {
+    stats.conflict_candidates += block.candidates;
+    stats.prefilter_skipped += block.skipped;
+    for (const std::uint32_t g : block.ids) out.add(g, f.bounds(g));
   }
   return out;
 }

@@ -3,11 +3,11 @@
 #include "citymesh/spatial/occupancy_grid.h"
 
 #include <fmt/format.h>
+#include <openvdb/openvdb.h>
 
 #include <array>
 #include <cmath>
 #include <mutex>
-#include <openvdb/openvdb.h>
 
 #include "citymesh/core/error.h"
 
@@ -100,22 +100,42 @@ bool OccupancyGrid::occupied(const Vec3f& p) const {
   return impl_->grid->tree().isValueOn(voxel_of(p, impl_->inverse_size));
 }
 
-bool OccupancyGrid::any_in_box(const Vec3f& lo, const Vec3f& hi) const {
-  const openvdb::CoordBBox box = coord_box(voxel_box(lo, hi, impl_->inverse_size));
-  const auto& tree = impl_->grid->tree();
+namespace {
+
+/// Whether any voxel of `box` is on, through `access` (its cache kept for the next query).
+bool any_on(const openvdb::BoolGrid& grid, openvdb::BoolGrid::ConstAccessor& access, const openvdb::CoordBBox& box) {
   if (static_cast<std::int64_t>(box.volume()) <= kDenseQueryLimit) {
-    openvdb::BoolGrid::ConstAccessor access = impl_->grid->getConstAccessor();
     for (auto it = box.begin(); it; ++it) {
       if (access.isValueOn(*it)) return true;
     }
     return false;
   }
-  for (auto it = tree.cbeginValueOn(); it; ++it) {
+  for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
     openvdb::CoordBBox active;
     it.getBoundingBox(active);  // a voxel or a whole active tile
     if (box.hasOverlap(active)) return true;
   }
   return false;
+}
+
+}  // namespace
+
+bool OccupancyGrid::any_in_box(const Vec3f& lo, const Vec3f& hi) const {
+  openvdb::BoolGrid::ConstAccessor access = impl_->grid->getConstAccessor();
+  return any_on(*impl_->grid, access, coord_box(voxel_box(lo, hi, impl_->inverse_size)));
+}
+
+struct OccupancyGrid::Reader::Impl {
+  const OccupancyGrid::Impl& grid;
+  openvdb::BoolGrid::ConstAccessor access;
+  explicit Impl(const OccupancyGrid::Impl& g) : grid(g), access(g.grid->getConstAccessor()) {}
+};
+
+OccupancyGrid::Reader::Reader(const OccupancyGrid& grid) : impl_(std::make_unique<Impl>(*grid.impl_)) {}
+OccupancyGrid::Reader::~Reader() = default;
+
+bool OccupancyGrid::Reader::any_in_box(const Vec3f& lo, const Vec3f& hi) {
+  return any_on(*impl_->grid.grid, impl_->access, coord_box(voxel_box(lo, hi, impl_->grid.inverse_size)));
 }
 
 void OccupancyGrid::merge(OccupancyGrid&& other) {

@@ -43,6 +43,8 @@ TEST(OccupancyGrid, MarksAndQueriesLikeAVoxelSet) {
     const Vec3f p{u(rng), u(rng), u(rng)};
     ASSERT_EQ(grid.occupied(p), reference.count(voxel(p, s)) == 1);
   }
+  // A reader keeps its node cache from one query to the next: the same answers.
+  OccupancyGrid::Reader reader(grid);
   for (int i = 0; i < 500; ++i) {
     const Vec3f lo{u(rng), u(rng), u(rng)};
     const float e = i % 10 == 0 ? 8.f : 0.7f;  // some boxes take the sparse query path
@@ -54,6 +56,7 @@ TEST(OccupancyGrid, MarksAndQueriesLikeAVoxelSet) {
       expected |= a >= i0 && a <= i1 && b >= j0 && b <= j1 && c >= k0 && c <= k1;
     }
     ASSERT_EQ(grid.any_in_box(lo, hi), expected) << i;
+    ASSERT_EQ(reader.any_in_box(lo, hi), expected) << i;
   }
 }
 

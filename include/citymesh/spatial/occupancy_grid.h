@@ -34,6 +34,23 @@ class OccupancyGrid {
   /// True when any voxel overlapping the closed box [lo, hi] is marked.
   [[nodiscard]] bool any_in_box(const Vec3f& lo, const Vec3f& hi) const;
   [[nodiscard]] std::size_t marked_voxels() const;
+
+  /// Box queries for one thread, through a cache of the tree nodes last visited: consecutive
+  /// boxes of a scan fall in the same nodes (answers as any_in_box; a grid's reader must not
+  /// outlive it nor see it change).
+  class Reader {
+   public:
+    explicit Reader(const OccupancyGrid& grid);
+    ~Reader();
+    Reader(const Reader&) = delete;
+    Reader& operator=(const Reader&) = delete;
+    /// True when any voxel overlapping the closed box [lo, hi] is marked.
+    [[nodiscard]] bool any_in_box(const Vec3f& lo, const Vec3f& hi);
+
+   private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+  };
   /// Marks every voxel marked in `other` (same voxel size), which is left empty.
   void merge(OccupancyGrid&& other);
 
