@@ -8,6 +8,10 @@
 #   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
+if [ $# -lt 5 ] || [ ! -f "$1/config.toml" ]; then
+  echo "usage: tools/bench/append.sh FOLDER XMIN YMIN XMAX YMAX [threads] (FOLDER/config.toml must exist)" >&2
+  exit 1
+fi
 dir="$1"
 threads="${6:-2}"
 bin="$PWD/build/release/citymesh"
