@@ -162,15 +162,20 @@ BoxedTriangles conflict_candidates(const TriangleFrames& f, const PartnerBits& p
     Block& block = blocks[begin / kGrain];
     std::optional<OccupancyGrid::Reader> reader;
     if (params.prefilter) reader.emplace(grids[j]);
-    for (std::size_t g = begin; g < end; ++g) {
-      if (!(f.date_of(g) < f.dates[j]) || !f.asks(g) || partners.has(g, j)) continue;
-      ++block.candidates;
-      const Box3f& box = f.bounds(g);
-      if (reader && !reader->any_in_box(box.min, box.max)) {
-        ++block.skipped;
-        continue;
+    // The block's part of each older acquisition (newer ones have nothing to ask).
+    for (std::size_t a = 0; a < f.acquisitions(); ++a) {
+      if (!(f.dates[a] < f.dates[j])) continue;
+      const std::size_t from = std::max(begin, f.index.offsets[a]), to = std::min(end, f.index.offsets[a + 1]);
+      for (std::size_t g = from; g < to; ++g) {
+        if (!f.asks(g) || partners.has(g, j)) continue;
+        ++block.candidates;
+        const Box3f& box = f.bounds(g);
+        if (reader && !reader->any_in_box(box.min, box.max)) {
+          ++block.skipped;
+          continue;
+        }
+        block.ids.push_back(static_cast<std::uint32_t>(g));
       }
-      block.ids.push_back(static_cast<std::uint32_t>(g));
     }
   });
   BoxedTriangles out;

@@ -171,7 +171,6 @@ class ParitySets {
     return true;
   }
 
- private:
   /// v's root and v's parity against it; points the path at the root.
   std::pair<std::uint32_t, std::uint8_t> find(std::uint32_t v) {
     std::uint32_t root = v;
@@ -191,67 +190,35 @@ class ParitySets {
     return {root, parity};
   }
 
+ private:
   std::vector<std::uint32_t> parent_;
   std::vector<std::uint8_t> parity_;
 };
 
-/// Whether the coupled pairs close a cycle with an odd number of differing pairs. Pair by
-/// pair, stopping at the first such cycle: with three meshes or more one comes early, long
-/// before the colouring of submodular_flips has built its adjacency (a tenth of the mosaic's
-/// solve on the bench street). Last pair first: the mosaic lists its seam terms (which never
-/// differ) before its overlap terms, and these by triangle, so three meshes overlapping close
-/// a cycle within the last meshes' overlaps.
-bool has_odd_cycle(const BinaryEnergy& e) {
-  ParitySets sets(e.size());
-  for (auto p = e.pairs.rbegin(); p != e.pairs.rend(); ++p) {
-    const double c = coupling(*p);
-    if (c != 0 && !sets.join(p->i, p->j, c < 0)) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e) {
-  if (has_odd_cycle(e)) return std::nullopt;
+  // Pair by pair, stopping at the first cycle with an odd number of differing pairs: with
+  // three meshes or more one comes early (a breadth-first colouring first built the adjacency
+  // of every term, a tenth of the mosaic's solve on the bench street). Last pair first: the
+  // mosaic lists its seam terms (which never differ) before its overlap terms, and these by
+  // triangle, so three meshes overlapping close a cycle within the last meshes' overlaps.
   const std::size_t n = e.size();
-  // Adjacency (compressed rows): for each pair with a real coupling, whether its ends must differ.
-  std::vector<std::uint32_t> offsets(n + 1, 0);
-  for (const BinaryEnergy::Pair& p : e.pairs) {
-    if (coupling(p) == 0) continue;
-    ++offsets[p.i + 1];
-    ++offsets[p.j + 1];
+  ParitySets sets(n);
+  for (auto p = e.pairs.rbegin(); p != e.pairs.rend(); ++p) {
+    const double c = coupling(*p);
+    if (c != 0 && !sets.join(p->i, p->j, c < 0)) return std::nullopt;
   }
-  std::partial_sum(offsets.begin(), offsets.end(), offsets.begin());
-  std::vector<std::pair<std::uint32_t, bool>> adjacent(offsets.back());
-  std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-  for (const BinaryEnergy::Pair& p : e.pairs) {
-    const double c = coupling(p);
-    if (c == 0) continue;
-    adjacent[fill[p.i]++] = {p.j, c < 0};
-    adjacent[fill[p.j]++] = {p.i, c < 0};
+  // The colouring that leaves the lowest variable of each connected set unflipped: every
+  // variable's parity against the root, less that lowest variable's.
+  std::vector<std::uint8_t> flips(n);
+  std::vector<std::int8_t> base(n, -1);  // per root: its lowest variable's parity
+  for (std::uint32_t v = 0; v < n; ++v) {
+    const auto [root, parity] = sets.find(v);
+    if (base[root] < 0) base[root] = static_cast<std::int8_t>(parity);
+    flips[v] = static_cast<std::uint8_t>(parity ^ base[root]);
   }
-  std::vector<std::int8_t> colour(n, -1);
-  std::vector<std::uint32_t> queue;
-  for (std::uint32_t s = 0; s < n; ++s) {
-    if (colour[s] >= 0) continue;
-    colour[s] = 0;
-    queue.assign(1, s);
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::uint32_t i = queue[head];
-      for (std::uint32_t k = offsets[i]; k < offsets[i + 1]; ++k) {
-        const auto [j, differ] = adjacent[k];
-        const auto want = static_cast<std::int8_t>(differ ? 1 - colour[i] : colour[i]);
-        if (colour[j] < 0) {
-          colour[j] = want;
-          queue.push_back(j);
-        } else if (colour[j] != want) {
-          return std::nullopt;
-        }
-      }
-    }
-  }
-  return std::vector<std::uint8_t>(colour.begin(), colour.end());
+  return flips;
 }
 
 std::vector<std::int8_t> minimise_by_flipped_cut(const BinaryEnergy& e, std::span<const std::uint8_t> flips) {

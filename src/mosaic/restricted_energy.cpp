@@ -88,6 +88,21 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
   return r;
 }
 
+namespace {
+
+/// Per variable of `all`, 1 when `test` holds for it: a read-only question per variable, so
+/// asked in parallel.
+template <class Test>
+std::vector<std::uint8_t> flags_of(std::span<const std::uint32_t> all, const Test& test) {
+  std::vector<std::uint8_t> flags(all.size());
+  parallel_for_blocks(all.size(), 8192, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t l = begin; l < end; ++l) flags[l] = test(all[l]) ? 1 : 0;
+  });
+  return flags;
+}
+
+}  // namespace
+
 std::vector<std::uint32_t> grow_region(const PairIndex& index, std::vector<std::uint32_t> seeds,
                                        std::span<const std::uint8_t> open, std::uint32_t hops,
                                        std::vector<std::uint8_t>& mark) {
@@ -135,11 +150,7 @@ std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const s
     }
     return false;
   };
-  // Read-only per variable: in parallel, as split_by_slab's.
-  std::vector<std::uint8_t> seam_flag(all.size());
-  parallel_for_blocks(all.size(), 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t l = begin; l < end; ++l) seam_flag[l] = on_seam(all[l]) ? 1 : 0;
-  });
+  const std::vector<std::uint8_t> seam_flag = flags_of(all, on_seam);
   std::vector<std::uint32_t> seeds;
   for (std::size_t l = 0; l < all.size(); ++l) {
     if (seam_flag[l] != 0) seeds.push_back(all[l]);
@@ -156,11 +167,7 @@ SlabSplit split_by_slab(const PairIndex& index, std::span<const std::uint32_t> a
     }
     return false;
   };
-  // Read-only per variable: in parallel.
-  std::vector<std::uint8_t> border_flag(all.size());
-  parallel_for_blocks(all.size(), 8192, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t l = begin; l < end; ++l) border_flag[l] = on_border(all[l]) ? 1 : 0;
-  });
+  const std::vector<std::uint8_t> border_flag = flags_of(all, on_border);
   SlabSplit out;
   out.interior.resize(slabs);
   for (std::size_t l = 0; l < all.size(); ++l) {

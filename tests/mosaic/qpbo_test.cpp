@@ -385,6 +385,24 @@ TEST(Qpbo, FlipsAreFoundExactlyWhenSomeFlippingMakesEveryCouplingAttractive) {
     std::uint32_t bits = 0;
     for (std::size_t v = 0; v < n; ++v) bits |= std::uint32_t{(*flips)[v] != 0} << v;
     EXPECT_TRUE(consistent(bits)) << "trial " << trial;
+    // Of the consistent flippings, the one that leaves the lowest variable of every connected
+    // set of coupled variables unflipped (what a breadth-first colouring from each gives).
+    std::vector<std::size_t> lowest(n);
+    for (std::size_t v = 0; v < n; ++v) lowest[v] = v;
+    for (bool moved = true; moved;) {
+      moved = false;
+      for (const auto& p : e.pairs) {
+        if (p.e01 + p.e10 - p.e00 - p.e11 == 0) continue;
+        const std::size_t m = std::min(lowest[p.i], lowest[p.j]);
+        moved = moved || lowest[p.i] != m || lowest[p.j] != m;
+        lowest[p.i] = lowest[p.j] = m;
+      }
+    }
+    for (std::size_t v = 0; v < n; ++v) {
+      if (lowest[v] == v) {
+        EXPECT_EQ((*flips)[v], 0) << "trial " << trial << ", variable " << v;
+      }
+    }
   }
   EXPECT_GT(found, 200);
   EXPECT_GT(refused, 200);
