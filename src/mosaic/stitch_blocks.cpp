@@ -18,6 +18,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
+#include "citymesh/core/radix_sort.h"
 #include "citymesh/core/stopwatch.h"
 #include "gap_fill.h"
 #include "part_cut.h"
@@ -84,7 +85,8 @@ class PartFinder {
     }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
-    std::erase_if(out, [&](std::uint32_t q) { return q == self || !box_for_level(parts_[q], level_).intersects(reach); });
+    std::erase_if(out,
+                  [&](std::uint32_t q) { return q == self || !box_for_level(parts_[q], level_).intersects(reach); });
     return out;
   }
 
@@ -120,9 +122,9 @@ double part_context(const PartStitchRun& run) {
 /// Stitches a part cut out with its surroundings; throws ProcessingError if stitching
 /// changed them (they must come out first, unchanged, for the part to be taken back).
 StitchStats stitch_cut(PartCut& cut, const StitchParams& params, std::span<const std::uint64_t> sizes) {
-  const StitchStats stats = stitch(
-      cut.merged, params,
-      {.vertex_roles = cut.roles, .source_sizes = sizes, .first_own_triangle = cut.surroundings.size()});
+  const StitchStats stats =
+      stitch(cut.merged, params,
+             {.vertex_roles = cut.roles, .source_sizes = sizes, .first_own_triangle = cut.surroundings.size()});
   const std::vector<Triangle>& out = cut.merged.mesh.triangles;
   if (out.size() < cut.surroundings.size() ||
       !std::equal(cut.surroundings.begin(), cut.surroundings.end(), out.begin())) {
@@ -175,7 +177,8 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
                   BlockStitchStats& stats) {
   const LevelStitcher stitcher(parts, level, store, run);
   const std::vector<PartOutcome> outcomes = run.run_level ? run.run_level(stitcher) : stitch_level_here(stitcher);
-  if (outcomes.size() != stitcher.size()) throw ProcessingError("stitching block by block: a level's outcomes are missing");
+  if (outcomes.size() != stitcher.size())
+    throw ProcessingError("stitching block by block: a level's outcomes are missing");
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
     parts[stitcher.parts_of_level()[i]].stitched_box = outcomes[i].box;
     stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);
@@ -185,40 +188,47 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
 }
 
 /// The length of the edges of `own`'s triangles used by exactly one triangle of `own` and
-/// `around` (every triangle sharing an edge with `own` is in one of them): every edge that
-/// can be one of own's, sorted once, and the runs of one own edge counted.
+/// `around` (every triangle sharing an edge with `own` is in one of them). Own's edges are
+/// sorted (by their corners' indices, which ascend with their keys) and those it uses once
+/// kept; the triangles around then only strike off the ones they use too. Sorting the edges
+/// around with own's, by key, made up most of the measure. The lengths are summed in the
+/// order of the edges' keys.
 double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<const KeyedPiece>> around) {
-  struct Use {
-    std::uint64_t a, b;      ///< the edge's keys, smaller first
-    std::uint32_t own_edge;  ///< 3 t + k for own's triangle t, edge k; kNotOwn for the others'
-    bool operator<(const Use& o) const { return std::tie(a, b) < std::tie(o.a, o.b); }
+  using Edge = std::pair<std::uint32_t, std::uint32_t>;  // own's vertices, smaller first
+  std::vector<Edge> edges;
+  edges.reserve(3 * own.triangle_count());
+  for (const Triangle& tri : own.triangles) {
+    for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(tri[k], tri[(k + 1) % 3]));
+  }
+  radix_sort_pairs(edges);
+  std::vector<Edge> once;  // used once by own
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t end = i + 1;
+    while (end < edges.size() && edges[end] == edges[i]) ++end;
+    if (end == i + 1) once.push_back(edges[i]);
+    i = end;
+  }
+  const auto by_keys = [&](const Edge& e, const std::pair<std::uint64_t, std::uint64_t>& key) {
+    return std::pair(own.keys[e.first], own.keys[e.second]) < key;
   };
-  constexpr std::uint32_t kNotOwn = UINT32_MAX;
-  std::vector<Use> uses;
-  const auto add = [&](const KeyedPiece& p, const Triangle& tri, std::uint32_t first_edge) {
-    for (std::uint32_t k = 0; k < 3; ++k) {
-      const std::uint64_t x = p.keys[tri[k]], y = p.keys[tri[(k + 1) % 3]];
-      uses.push_back({std::min(x, y), std::max(x, y), first_edge == kNotOwn ? kNotOwn : first_edge + k});
-    }
-  };
-  for (std::uint32_t t = 0; t < own.triangle_count(); ++t) add(own, own.triangles[t], 3 * t);
+  std::vector<std::uint8_t> shared(once.size(), 0);
   const Box3d own_box = own.box();
   for (const auto& piece : around) {
     for (std::size_t t = 0; t < piece->triangle_count(); ++t) {
-      if (piece->box(t).intersects(own_box)) add(*piece, piece->triangles[t], kNotOwn);  // else it shares no edge
+      if (!piece->box(t).intersects(own_box)) continue;  // it shares no edge
+      const Triangle& tri = piece->triangles[t];
+      for (int k = 0; k < 3; ++k) {
+        const auto key = std::minmax(piece->keys[tri[k]], piece->keys[tri[(k + 1) % 3]]);
+        const auto it = std::lower_bound(once.begin(), once.end(), key, by_keys);
+        if (it != once.end() && own.keys[it->first] == key.first && own.keys[it->second] == key.second) {
+          shared[static_cast<std::size_t>(it - once.begin())] = 1;
+        }
+      }
     }
   }
-  std::sort(uses.begin(), uses.end());
   double length = 0;
-  for (std::size_t i = 0; i < uses.size();) {
-    std::size_t end = i + 1;
-    while (end < uses.size() && uses[end].a == uses[i].a && uses[end].b == uses[i].b) ++end;
-    if (end == i + 1 && uses[i].own_edge != kNotOwn) {
-      const Triangle& tri = own.triangles[uses[i].own_edge / 3];
-      const std::uint32_t k = uses[i].own_edge % 3;
-      length += norm(own.positions[tri[k]] - own.positions[tri[(k + 1) % 3]]);
-    }
-    i = end;
+  for (std::size_t i = 0; i < once.size(); ++i) {
+    if (shared[i] == 0) length += norm(own.positions[once[i].first] - own.positions[once[i].second]);
   }
   return length;
 }
@@ -316,14 +326,15 @@ void check_block_layout(const BlockStitchParams& p, double context) {
 }
 
 double block_context(const StitchParams& params) {
-  const double farthest = std::max({params.snap, params.reach, params.clip,
-                                    0.5 * mosaic_detail::kGapPerimeterInWidths * params.gap});
+  const double farthest =
+      std::max({params.snap, params.reach, params.clip, 0.5 * mosaic_detail::kGapPerimeterInWidths * params.gap});
   return 1.25 * farthest;  // a margin: what is looked for near a vertex may lie a little farther
 }
 
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run) {
   check_block_layout(run.blocks, part_context(run));
-  if (!std::is_sorted(parts.begin(), parts.end(), [](const BlockPart& a, const BlockPart& b) { return a.key < b.key; })) {
+  if (!std::is_sorted(parts.begin(), parts.end(),
+                      [](const BlockPart& a, const BlockPart& b) { return a.key < b.key; })) {
     throw ProcessingError("stitching block by block: the parts are not in key order");
   }
   BlockStitchStats stats;

@@ -53,69 +53,96 @@ std::uint16_t feature_of(std::int32_t source) {
   return source < 0 ? kNullFeatureId : static_cast<std::uint16_t>(source);
 }
 
-SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source_acq, std::span<const Vec3f> local) {
-  // The split vertices in (vertex, feature) order. Nearly every vertex has one feature, its
-  // smallest; only the pairs beyond it (vertices that stitch triangles share with a source)
-  // are listed and sorted. Sorting a key per corner took three times the output's triangle
-  // array, twice over: the peak of a city's export.
+/// One vertex per (vertex, feature) pair the triangles draw, in (vertex, feature) order
+/// (vertices no triangle uses are left out), and the triangles re-indexed onto them.
+struct FeatureSplit {
+  std::vector<std::uint32_t> vertex;   ///< per split vertex: the vertex it copies
+  std::vector<std::uint16_t> feature;  ///< per split vertex
+  std::vector<Triangle> triangles;
+};
+
+/// `features`: one per triangle. Nearly every vertex has one feature, its smallest; only the
+/// pairs beyond it (vertices that stitch triangles share with a source) are listed and
+/// sorted. Sorting a key per corner took three times the output's triangle array, twice over
+/// (the peak of a city's export), and a sixth of the time a leaf of the export took to load.
+FeatureSplit split_by_feature(std::size_t vertex_count, std::span<const Triangle> triangles,
+                              std::span<const std::uint16_t> features) {
   constexpr std::uint32_t kUnused = UINT32_MAX;
   auto key = [](std::uint32_t v, std::uint16_t f) { return (std::uint64_t{v} << 16) | f; };
-  const std::size_t n = mesh.triangle_count();
-  std::vector<std::uint32_t> first(mesh.vertex_count(), kUnused);  ///< per vertex: its smallest feature
+  const std::size_t n = triangles.size();
+  std::vector<std::uint32_t> first(vertex_count, kUnused);  ///< per vertex: its smallest feature
   for (std::size_t t = 0; t < n; ++t) {
-    const std::uint32_t f = feature_of(source_acq[t]);
-    for (const std::uint32_t v : mesh.triangles[t]) first[v] = std::min(first[v], f);
+    for (const std::uint32_t v : triangles[t]) first[v] = std::min<std::uint32_t>(first[v], features[t]);
   }
   std::vector<std::uint64_t> extra;  ///< (vertex, feature) pairs beyond the vertex's first, sorted
   for (std::size_t t = 0; t < n; ++t) {
-    const std::uint16_t f = feature_of(source_acq[t]);
-    for (const std::uint32_t v : mesh.triangles[t]) {
-      if (f != first[v]) extra.push_back(key(v, f));
+    for (const std::uint32_t v : triangles[t]) {
+      if (features[t] != first[v]) extra.push_back(key(v, features[t]));
     }
   }
   std::sort(extra.begin(), extra.end());
   extra.erase(std::unique(extra.begin(), extra.end()), extra.end());
-  std::vector<std::uint32_t> start(mesh.vertex_count() + 1, 0);  ///< per vertex: its first split vertex
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) start[v + 1] = first[v] != kUnused ? 1 : 0;
+  std::vector<std::uint32_t> start(vertex_count + 1, 0);  ///< per vertex: its first split vertex
+  for (std::size_t v = 0; v < vertex_count; ++v) start[v + 1] = first[v] != kUnused ? 1 : 0;
   for (const std::uint64_t k : extra) ++start[(k >> 16) + 1];
-  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) start[v + 1] += start[v];
+  for (std::size_t v = 0; v < vertex_count; ++v) start[v + 1] += start[v];
   const auto index = [&](std::uint32_t v, std::uint16_t f) -> std::uint32_t {
     if (f == first[v]) return start[v];
     const auto it = std::lower_bound(extra.begin(), extra.end(), key(v, f));
     const auto v_first = std::lower_bound(extra.begin(), it, key(v, 0));
     return start[v] + 1 + static_cast<std::uint32_t>(it - v_first);
   };
-  SplitMesh out;
-  TilesetVertices& vx = out.vertices;
+  FeatureSplit out;
   const std::size_t count = start.back();
-  vx.positions.resize(count);
-  vx.feature_ids.resize(count);
-  if (!mesh.intensities.empty()) vx.intensities.resize(count);
-  if (!mesh.colors.empty()) vx.colors.resize(count);
-  const auto put = [&](std::uint32_t v, std::uint16_t f, std::uint32_t i) {
-    vx.positions[i] = local[v];
-    vx.feature_ids[i] = f;
-    if (!vx.intensities.empty()) vx.intensities[i] = mesh.intensities[v];
-    if (!vx.colors.empty()) vx.colors[i] = mesh.colors[v];
-  };
-  parallel_for_blocks(mesh.vertex_count(), 16384, [&](std::size_t begin, std::size_t end) {
+  out.vertex.resize(count);
+  out.feature.resize(count);
+  parallel_for_blocks(vertex_count, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t v = begin; v < end; ++v) {
-      if (first[v] != kUnused) put(static_cast<std::uint32_t>(v), static_cast<std::uint16_t>(first[v]), start[v]);
+      if (first[v] == kUnused) continue;
+      out.vertex[start[v]] = static_cast<std::uint32_t>(v);
+      out.feature[start[v]] = static_cast<std::uint16_t>(first[v]);
     }
   });
   for (const std::uint64_t k : extra) {
     const auto v = static_cast<std::uint32_t>(k >> 16);
     const auto f = static_cast<std::uint16_t>(k & 0xFFFF);
-    put(v, f, index(v, f));
+    out.vertex[index(v, f)] = v;
+    out.feature[index(v, f)] = f;
   }
   out.triangles.resize(n);
   parallel_for_blocks(n, 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t t = begin; t < end; ++t) {
-      const Triangle& tri = mesh.triangles[t];
-      const std::uint16_t f = feature_of(source_acq[t]);
-      out.triangles[t] = {index(tri[0], f), index(tri[1], f), index(tri[2], f)};
+      const Triangle& tri = triangles[t];
+      out.triangles[t] = {index(tri[0], features[t]), index(tri[1], features[t]), index(tri[2], features[t])};
     }
   });
+  return out;
+}
+
+std::vector<std::uint16_t> triangle_features(std::span<const std::int32_t> source_acq) {
+  std::vector<std::uint16_t> out(source_acq.size());
+  for (std::size_t t = 0; t < out.size(); ++t) out[t] = feature_of(source_acq[t]);
+  return out;
+}
+
+SplitMesh split_by_source(const Mesh& mesh, std::span<const std::int32_t> source_acq, std::span<const Vec3f> local) {
+  FeatureSplit split = split_by_feature(mesh.vertex_count(), mesh.triangles, triangle_features(source_acq));
+  SplitMesh out;
+  TilesetVertices& vx = out.vertices;
+  const std::size_t count = split.vertex.size();
+  vx.positions.resize(count);
+  vx.feature_ids = std::move(split.feature);
+  if (!mesh.intensities.empty()) vx.intensities.resize(count);
+  if (!mesh.colors.empty()) vx.colors.resize(count);
+  parallel_for_blocks(count, 16384, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const std::uint32_t v = split.vertex[i];
+      vx.positions[i] = local[v];
+      if (!vx.intensities.empty()) vx.intensities[i] = mesh.intensities[v];
+      if (!vx.colors.empty()) vx.colors[i] = mesh.colors[v];
+    }
+  });
+  out.triangles = std::move(split.triangles);
   return out;
 }
 
@@ -363,34 +390,24 @@ TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
     throw ProcessingError(
         fmt::format("3D Tiles: {} mapped positions for a piece of {} vertices", local.size(), piece.vertex_count()));
   // One tile vertex per (vertex, feature) the triangles draw: a vertex shared by two sources
-  // is drawn twice, each with its own feature id.
-  std::vector<TileVertexKey> keys;
-  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
-    const std::uint16_t f = feature_of(piece.source_acq[t]);
-    for (const std::uint32_t v : piece.triangles[t]) keys.push_back({piece.keys[v], f});
-  }
-  std::sort(keys.begin(), keys.end());
-  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  // is drawn twice, each with its own feature id. The piece's keys ascend, so (key, feature)
+  // order is (vertex, feature) order.
+  const FeatureSplit split =
+      split_by_feature(piece.vertex_count(), piece.triangles, triangle_features(piece.source_acq));
   TileMesh m;
-  const auto vertex = [&](std::uint64_t key) {  // piece.keys ascend
-    return static_cast<std::uint32_t>(std::lower_bound(piece.keys.begin(), piece.keys.end(), key) - piece.keys.begin());
-  };
-  for (const TileVertexKey& k : keys) {
-    const std::uint32_t v = vertex(k.vertex);
-    m.keys.push_back(k);
-    m.positions.push_back(local[v]);
-    if (!piece.intensities.empty()) m.intensities.push_back(piece.intensities[v]);
-    if (!piece.colors.empty()) m.colors.push_back(piece.colors[v]);
+  const std::size_t count = split.vertex.size();
+  m.keys.resize(count);
+  m.positions.resize(count);
+  if (!piece.intensities.empty()) m.intensities.resize(count);
+  if (!piece.colors.empty()) m.colors.resize(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const std::uint32_t v = split.vertex[i];
+    m.keys[i] = {piece.keys[v], split.feature[i]};
+    m.positions[i] = local[v];
+    if (!piece.intensities.empty()) m.intensities[i] = piece.intensities[v];
+    if (!piece.colors.empty()) m.colors[i] = piece.colors[v];
   }
-  const auto index = [&](const TileVertexKey& k) {
-    return static_cast<std::uint32_t>(std::lower_bound(keys.begin(), keys.end(), k) - keys.begin());
-  };
-  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
-    const std::uint16_t f = feature_of(piece.source_acq[t]);
-    const Triangle& tri = piece.triangles[t];
-    m.triangles.push_back(
-        {index({piece.keys[tri[0]], f}), index({piece.keys[tri[1]], f}), index({piece.keys[tri[2]], f})});
-  }
+  m.triangles = split.triangles;
   return m;
 }
 
