@@ -119,21 +119,23 @@ std::string encode_keyed_piece(const KeyedPiece& p) {
   h.flags = flags_of(p);
   h.vertices = p.vertex_count();
   h.triangles = p.triangle_count();
-  std::string payload;
-  payload.reserve(payload_size(h.flags, h.vertices, h.triangles));
-  put_array(payload, p.keys);
-  put_array(payload, p.positions);
-  put_array(payload, p.sensors);
-  put_array(payload, p.times);
-  put_array(payload, p.intensities);
-  put_array(payload, p.colors);
-  put_array(payload, p.triangles);
-  put_array(payload, p.ids);
-  put_array(payload, p.source_acq);
-  put_array(payload, p.source_triangle);
-  h.checksum = bulk_checksum(payload.data(), payload.size());
-  std::string out(reinterpret_cast<const char*>(&h), sizeof(h));
-  return out + payload;
+  // The header's room first and the arrays after it, in one string: concatenating a header
+  // and a payload copied every part of a city's seam pass once more.
+  std::string out(sizeof(h), '\0');
+  out.reserve(sizeof(h) + payload_size(h.flags, h.vertices, h.triangles));
+  put_array(out, p.keys);
+  put_array(out, p.positions);
+  put_array(out, p.sensors);
+  put_array(out, p.times);
+  put_array(out, p.intensities);
+  put_array(out, p.colors);
+  put_array(out, p.triangles);
+  put_array(out, p.ids);
+  put_array(out, p.source_acq);
+  put_array(out, p.source_triangle);
+  h.checksum = bulk_checksum(out.data() + sizeof(h), out.size() - sizeof(h));
+  std::memcpy(out.data(), &h, sizeof(h));
+  return out;
 }
 
 KeyedPiece decode_keyed_piece(std::string_view bytes, std::string_view source) {
