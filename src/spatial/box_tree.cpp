@@ -83,7 +83,8 @@ struct Node {
   }
   [[nodiscard]] Box3f bounds() const {
     Box3f b{{lo[0][0], lo[1][0], lo[2][0]}, {hi[0][0], hi[1][0], hi[2][0]}};
-    for (std::size_t s = 1; s < kFanout; ++s) b = united(b, {{lo[0][s], lo[1][s], lo[2][s]}, {hi[0][s], hi[1][s], hi[2][s]}});
+    for (std::size_t s = 1; s < kFanout; ++s)
+      b = united(b, {{lo[0][s], lo[1][s], lo[2][s]}, {hi[0][s], hi[1][s], hi[2][s]}});
     return b;
   }
   /// Bit s set when slot s meets the query box.
@@ -137,7 +138,8 @@ BoxTree::BoxTree(std::vector<Box3f> boxes) : impl_(std::make_unique<Impl>()) {
   parallel_for_blocks(boxes.size(), 16384, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) order[i] = {frame.code(boxes[i]), static_cast<std::uint32_t>(i)};
   });
-  radix_sort_pairs(order);  // ties broken by index: the same tree on any thread count
+  // Ties broken by index (the pairs come in index order): the same tree on any thread count.
+  stable_radix_sort_by_first(order);
   impl_->original.resize(boxes.size());
   for (std::size_t i = 0; i < order.size(); ++i) impl_->original[i] = order[i].second;
   std::vector<std::pair<std::uint32_t, std::uint32_t>>().swap(order);

@@ -1,11 +1,11 @@
 // SPDX-License-Identifier: MIT
+#include "citymesh/core/radix_sort.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <random>
 #include <vector>
-
-#include "citymesh/core/radix_sort.h"
 
 namespace citymesh {
 namespace {
@@ -28,11 +28,11 @@ void expect_sorted_like_std(Pairs values) {
 }
 
 TEST(RadixSortPairs, MatchesStdSortOnSmallAndLargeKeys) {
-  expect_sorted_like_std(random_pairs(10'000, 300'000, 300'000, 1));        // triangle ids
+  expect_sorted_like_std(random_pairs(10'000, 300'000, 300'000, 1));          // triangle ids
   expect_sorted_like_std(random_pairs(10'000, 0xffffffffu, 0xffffffffu, 2));  // every digit used
-  expect_sorted_like_std(random_pairs(5'000, 7, 3, 3));                        // many ties
-  expect_sorted_like_std(random_pairs(3'000, 0, 0xffffffffu, 4));              // first all zero
-  expect_sorted_like_std(random_pairs(3'001, (1u << 30) - 1, 0, 5));            // odd pass count
+  expect_sorted_like_std(random_pairs(5'000, 7, 3, 3));                       // many ties
+  expect_sorted_like_std(random_pairs(3'000, 0, 0xffffffffu, 4));             // first all zero
+  expect_sorted_like_std(random_pairs(3'001, (1u << 30) - 1, 0, 5));          // odd pass count
 }
 
 TEST(RadixSortPairs, EdgeCases) {
@@ -40,6 +40,29 @@ TEST(RadixSortPairs, EdgeCases) {
   expect_sorted_like_std({{5, 1}});
   expect_sorted_like_std({{0, 0}, {0, 0}});
   expect_sorted_like_std({{2, 1}, {1, 2}, {1, 1}, {0xffffffffu, 0}, {0, 0xffffffffu}});
+}
+
+void expect_stable_by_first_like_std(Pairs values) {
+  Pairs expected = values;
+  std::stable_sort(expected.begin(), expected.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  stable_radix_sort_by_first(values);
+  EXPECT_EQ(values, expected);
+}
+
+TEST(RadixSortPairs, ByFirstKeepsTheOrderOfTiesAsStdStableSortDoes) {
+  // Seconds in no order: the ties must keep it, not sort it.
+  expect_stable_by_first_like_std(random_pairs(10'000, 0xffffffffu, 0xffffffffu, 6));
+  expect_stable_by_first_like_std(random_pairs(5'000, 7, 1000, 7));         // many ties
+  expect_stable_by_first_like_std(random_pairs(3'000, 0, 0xffffffffu, 8));  // first all zero
+  expect_stable_by_first_like_std({});
+  expect_stable_by_first_like_std({{3, 9}, {1, 8}, {3, 2}, {1, 1}, {0xffffffffu, 0}, {3, 5}});
+  // Pairs made in index order come out as radix_sort_pairs() sorts them.
+  Pairs indexed = random_pairs(4'000, 50, 0, 9);
+  for (std::uint32_t i = 0; i < indexed.size(); ++i) indexed[i].second = i;
+  Pairs full = indexed;
+  radix_sort_pairs(full);
+  stable_radix_sort_by_first(indexed);
+  EXPECT_EQ(indexed, full);
 }
 
 }  // namespace

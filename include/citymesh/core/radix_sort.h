@@ -13,4 +13,9 @@ namespace citymesh {
 /// pairs of a detect step it beats a parallel comparison sort on two cores several times over.
 void radix_sort_pairs(std::span<std::pair<std::uint32_t, std::uint32_t>> values);
 
+/// Sorts pairs by `first` only, keeping the order of pairs with equal firsts (stable): the
+/// same as radix_sort_pairs() when the pairs come ordered by `second`, such as (key, index)
+/// pairs made in index order, in half the passes.
+void stable_radix_sort_by_first(std::span<std::pair<std::uint32_t, std::uint32_t>> values);
+
 }  // namespace citymesh
