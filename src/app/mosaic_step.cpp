@@ -1,8 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "mosaic_step.h"
 
-#include "tileset_output.h"
-
 #include <fmt/format.h>
 
 #include <cmath>
@@ -20,6 +18,8 @@
 #include "face_table.h"
 #include "mosaic_eval.h"
 #include "mosaic_output.h"
+#include "seam_cache.h"
+#include "tileset_output.h"
 
 namespace citymesh::app {
 
@@ -30,7 +30,8 @@ constexpr double kWeldInThresholds = 0.05;
 
 MosaicSelection select(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change) {
   const MosaicInput in{input.meshes, input.dates, &change, config.change.distance_threshold, {}};
-  return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in) : select_mosaic(in, config.mosaic);
+  return config.mosaic.method == MosaicMethod::update_model ? select_update_model(in)
+                                                            : select_mosaic(in, config.mosaic);
 }
 
 }  // namespace
@@ -48,16 +49,21 @@ StitchParams stitch_params(const Config& config) {
 namespace {
 
 /// Whether the tiles are wide enough for the bands of the seam pass by blocks.
-bool tiles_fit_blocks(const Config& config) { return 4 * block_context(stitch_params(config)) < config.tiling.tile_size; }
+bool tiles_fit_blocks(const Config& config) {
+  return 4 * block_context(stitch_params(config)) < config.tiling.tile_size;
+}
 
 }  // namespace
 
 bool seam_pass_in_blocks(const Config& config) {
   if (config.mosaic.method != MosaicMethod::energy) return false;  // the baseline is not stitched
   switch (config.run.seam_pass) {
-    case SeamPass::blocks: return true;
-    case SeamPass::whole: return false;
-    default: return tiles_fit_blocks(config);
+    case SeamPass::blocks:
+      return true;
+    case SeamPass::whole:
+      return false;
+    default:
+      return tiles_fit_blocks(config);
   }
 }
 
@@ -65,32 +71,36 @@ void check_seam_pass(const Config& config) {
   if (config.run.seam_pass != SeamPass::blocks || config.mosaic.method != MosaicMethod::energy) return;
   if (tiles_fit_blocks(config)) return;
   const double band = block_context(stitch_params(config));
-  throw ConfigError(fmt::format("{}: [run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m (the "
-                                "stitching's reach): tiling.tile_size must be over {:.2f} m, or use seam_pass = \"whole\"",
-                                config.file.string(), config.tiling.tile_size, band, 4 * band));
+  throw ConfigError(
+      fmt::format("{}: [run] seam_pass = \"blocks\": tiles of {} m are too small for bands of {:.2f} m (the "
+                  "stitching's reach): tiling.tile_size must be over {:.2f} m, or use seam_pass = \"whole\"",
+                  config.file.string(), config.tiling.tile_size, band, 4 * band));
 }
 
 /// Prints the stitching's line and returns its figures for the summary.
 nlohmann::json report_stitching(const StitchStats& s, const BlockStitchStats* blocks) {
   std::cout << fmt::format(
-      "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} triangles, open boundary "
+      "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} "
+      "triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
       s.triangles_clipped, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added, s.open_boundary_before,
       s.open_boundary_after);
   nlohmann::json report{{"open_boundary_before_m", s.open_boundary_before},
-          {"open_boundary_after_m", s.open_boundary_after},
-          {"triangles_clipped", s.triangles_clipped},
-          {"triangles_uncovered", s.triangles_uncovered},
-          {"strips", s.strips},
-          {"gaps_filled", s.gaps_filled},
-          {"triangles_added", s.triangles_added},
-          {"vertices_snapped", s.vertices_snapped},
-          {"edges_split", s.edges_split},
-          {"vertices_welded", s.vertices_welded},
-          {"rejected", s.rejected},
-          {"seconds", s.seconds}};
+                        {"open_boundary_after_m", s.open_boundary_after},
+                        {"triangles_clipped", s.triangles_clipped},
+                        {"triangles_uncovered", s.triangles_uncovered},
+                        {"strips", s.strips},
+                        {"gaps_filled", s.gaps_filled},
+                        {"triangles_added", s.triangles_added},
+                        {"vertices_snapped", s.vertices_snapped},
+                        {"edges_split", s.edges_split},
+                        {"vertices_welded", s.vertices_welded},
+                        {"rejected", s.rejected},
+                        {"seconds", s.seconds}};
   if (blocks != nullptr) {
-    report["by_blocks"] = {{"parts", blocks->parts}, {"largest_part_triangles", blocks->largest_part}};
+    report["by_blocks"] = {{"parts", blocks->parts},
+                           {"largest_part_triangles", blocks->largest_part},
+                           {"reused_parts", blocks->reused_parts}};
   }
   return report;
 }
@@ -109,25 +119,30 @@ BlockStitchParams tile_grid_blocks(const Config& config) {
 }
 
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work) {
+                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work,
+                                       SeamPartCache* cache) {
   check_seam_pass(config);
   Stopwatch clock;
   const PartStitchRun run{.params = stitch_params(config),
                           .blocks = tile_grid_blocks(config),
                           .source_sizes = {source_sizes.begin(), source_sizes.end()},
                           .frame = std::nullopt,
-                          .run_level = work.run_level};
+                          .run_level = work.run_level,
+                          .cache = cache};
   const double before = parts_open_boundary(parts, store, false, run.blocks, work.measure_parts);
   log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   BlockStitchStats s = stitch_parts(parts, store, run);
+  if (cache != nullptr) cache->prune(parts, s.digests);
   log::debug("stitch by blocks: stitched at {:.2f} s", clock.seconds());
   s.stitch.open_boundary_before = before;
   s.stitch.open_boundary_after = parts_open_boundary(parts, store, true, run.blocks, work.measure_parts);
   log::debug("stitch by blocks: open boundary after measured at {:.2f} s", clock.seconds());
   s.stitch.seconds = clock.seconds();
-  std::cout << fmt::format("stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
-                           "triangles with its surroundings\n",
-                           s.parts[0], s.parts[1], s.parts[2], s.parts[3], s.largest_part);
+  std::cout << fmt::format(
+      "stitching by blocks: {} tile interiors, {} + {} bands and {} corners; largest part {} "
+      "triangles with its surroundings{}\n",
+      s.parts[0], s.parts[1], s.parts[2], s.parts[3], s.largest_part,
+      cache != nullptr ? fmt::format("; {} parts as stitched by the last run", s.reused_parts) : std::string());
   return report_stitching(s.stitch, &s);
 }
 

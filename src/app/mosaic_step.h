@@ -13,6 +13,8 @@
 
 namespace citymesh::app {
 
+class SeamPartCache;
+
 /// Selects (energy or update model), merges, stitches (energy only) and writes
 /// <output>/mosaic; `seconds` (earlier steps) goes into its summary. Prints a short report.
 void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, const ChangeResult& change,
@@ -48,9 +50,11 @@ struct SeamPassWork {
 
 /// Stitches the parts in `store` block by block on the tile grid (`[run] seam_pass =
 /// "blocks"`), `source_sizes` the output's triangles per source; prints and returns the
-/// figures as stitch_and_report does.
+/// figures as stitch_and_report does. With `cache`, parts whose inputs are those of a part
+/// the cache kept are taken from it, the others kept in it, and the rest of it pruned.
 nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPart>& parts, PartStore& store,
-                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work = {});
+                                       std::span<const std::uint64_t> source_sizes, const SeamPassWork& work = {},
+                                       SeamPartCache* cache = nullptr);
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the

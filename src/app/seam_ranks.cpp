@@ -16,6 +16,7 @@
 #include "citymesh/core/parallel.h"
 #include "json_bits.h"
 #include "mosaic_step.h"
+#include "seam_cache.h"
 #include "work_schedule.h"
 
 namespace citymesh::app {
@@ -24,29 +25,6 @@ namespace {
 
 /// The plan of the step being shared, written by the root before it shares the step.
 std::filesystem::path plan_path(const Config& config) { return config.project.work / "seam-level.json"; }
-
-/// The counts stitch_parts() adds up, the part's stitched box and its size with surroundings.
-nlohmann::json outcome_json(const PartOutcome& o) {
-  const StitchStats& s = o.stats;
-  return {{"counts",
-           {s.vertices_snapped, s.edges_split, s.triangles_uncovered, s.triangles_clipped, s.strips, s.triangles_added,
-            s.vertices_welded, s.gaps_filled, s.rejected}},
-          {"box", box_bits(o.box)},
-          {"cut_triangles", o.cut_triangles}};
-}
-
-PartOutcome outcome_from(const nlohmann::json& j) {
-  PartOutcome o;
-  const auto counts = j.at("counts").get<std::vector<std::uint64_t>>();
-  if (counts.size() != 9) throw ProcessingError("a seam part's outcome: counts missing");
-  StitchStats& s = o.stats;
-  s.vertices_snapped = counts[0], s.edges_split = counts[1], s.triangles_uncovered = counts[2];
-  s.triangles_clipped = counts[3], s.strips = counts[4], s.triangles_added = counts[5];
-  s.vertices_welded = counts[6], s.gaps_filled = counts[7], s.rejected = counts[8];
-  o.box = box_from_bits(j.at("box"));
-  o.cut_triangles = j.at("cut_triangles").get<std::size_t>();
-  return o;
-}
 
 constexpr std::string_view kOutcomeSuffix = "outcome.json";
 
@@ -198,11 +176,13 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
       });
       continue;
     }
+    SeamPartCache cache = seam_part_cache(config);
     const PartStitchRun run{.params = stitch_params(config),
                             .blocks = tile_grid_blocks(config),
                             .source_sizes = plan.source_sizes,
                             .frame = std::nullopt,
-                            .run_level = {}};
+                            .run_level = {},
+                            .cache = &cache};
     const LevelStitcher stitcher(plan.parts, plan.level, files, run);
     run_part_workers(*channel, [&](std::size_t i) {
       const PartOutcome outcome = stitcher.stitch(i);

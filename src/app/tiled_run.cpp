@@ -23,6 +23,7 @@
 #include "output_ranks.h"
 #include "run_stages.h"
 #include "run_state.h"
+#include "seam_cache.h"
 #include "seam_parts.h"
 #include "seam_ranks.h"
 #include "tile_assembly.h"
@@ -123,9 +124,12 @@ class FinalOutput {
   nlohmann::json stitch() {
     if (seams_) {
       const bool shared = cluster_ != nullptr && cluster_->size() > 1;
+      // The stitched parts stay in the work folder: the next run (an acquisition appended)
+      // restitches only those whose inputs changed.
+      SeamPartCache cache = seam_part_cache(config_);
       nlohmann::json figures =
           stitch_parts_and_report(config_, parts_, *seams_, seams_->source_sizes(),
-                                  shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{});
+                                  shared ? share_seam_pass(config_, *cluster_, *seams_) : SeamPassWork{}, &cache);
       if (shared) remove_seam_plan(config_);
       // The outputs read the stitched output one grid tile at a time.
       std::vector<BlockPartKey> keys;

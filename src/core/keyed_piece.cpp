@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <functional>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/key_union.h"
 
@@ -117,6 +118,32 @@ KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces) {
     }
   }
   return out;
+}
+
+namespace {
+
+template <class T>
+void add_array(BulkChecksum& sum, const std::vector<T>& values) {
+  const std::uint64_t count = values.size();
+  sum.add(&count, sizeof(count));  // so that moving an element to the next array changes it
+  sum.add(values.data(), values.size() * sizeof(T));
+}
+
+}  // namespace
+
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece) {
+  BulkChecksum sum;
+  add_array(sum, piece.keys);
+  add_array(sum, piece.positions);
+  add_array(sum, piece.sensors);
+  add_array(sum, piece.times);
+  add_array(sum, piece.intensities);
+  add_array(sum, piece.colors);
+  add_array(sum, piece.triangles);
+  add_array(sum, piece.ids);
+  add_array(sum, piece.source_acq);
+  add_array(sum, piece.source_triangle);
+  return sum.value();
 }
 
 }  // namespace citymesh

@@ -13,6 +13,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
@@ -145,12 +146,51 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.rejected += s.rejected;
 }
 
-/// Loads part p and the parts around it as level `level` sees them, stitches it and saves it.
+/// The digest a PartCache finds part p by: everything its stitching reads besides the
+/// settings. Clipping compares the sources' sizes only, so of those the order of the sources
+/// present counts, not the sizes: a pass appended elsewhere changes every size, not this.
+std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double context, const KeyedPiece& own,
+                          std::span<const BlockPartKey> around_keys, std::span<const Neighbour> around,
+                          std::span<const std::uint64_t> source_sizes) {
+  constexpr std::uint64_t kFormat = 1;  // bumped when stitching a part reads something more
+  BulkChecksum sum;
+  const auto add = [&sum](const auto& value) { sum.add(&value, sizeof(value)); };
+  add(kFormat);
+  add(std::uint64_t{p});
+  add(std::int64_t{level});
+  add(origin);
+  add(context);
+  add(keyed_piece_digest(own));
+  std::vector<std::int32_t> sources(own.source_acq.begin(), own.source_acq.end());
+  for (std::size_t i = 0; i < around.size(); ++i) {
+    // The part around by key, not index: an index is only the part's place in this run's list.
+    add(std::int64_t{around_keys[i].level});  // field by field: the struct has padding
+    add(around_keys[i].x);
+    add(around_keys[i].y);
+    add(around[i].role);
+    add(keyed_piece_digest(*around[i].piece));
+    sources.insert(sources.end(), around[i].piece->source_acq.begin(), around[i].piece->source_acq.end());
+  }
+  std::sort(sources.begin(), sources.end());
+  sources.erase(std::unique(sources.begin(), sources.end()), sources.end());
+  std::erase_if(sources, [&](std::int32_t a) { return a < 0 || static_cast<std::size_t>(a) >= source_sizes.size(); });
+  // In the order clipping compares them: (size, index).
+  std::sort(sources.begin(), sources.end(), [&](std::int32_t a, std::int32_t b) {
+    return std::pair(source_sizes[static_cast<std::size_t>(a)], a) <
+           std::pair(source_sizes[static_cast<std::size_t>(b)], b);
+  });
+  for (const std::int32_t a : sources) add(a);
+  return sum.value();
+}
+
+/// Loads part p and the parts around it as level `level` sees them, stitches it (or takes it
+/// from the run's cache) and saves it.
 PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int level, const PartFinder& finder,
                        PartStore& store, const PartStitchRun& run, double context) {
   const Box3d reach = parts[p].box.grown(context);
   std::vector<Neighbour> around;
-  for (const std::uint32_t q : finder.meeting(reach, p)) {
+  const std::vector<std::uint32_t> around_parts = finder.meeting(reach, p);
+  for (const std::uint32_t q : around_parts) {
     const int other = parts[q].key.level;
     // A part of this level is stitched at the same time: where they touch, neither joins.
     const VertexRole role = other < level ? VertexRole::done : other == level ? VertexRole::held : VertexRole::later;
@@ -158,13 +198,25 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   }
   const std::shared_ptr<const KeyedPiece> own = store.load(p, false);
   const Vec3d origin = run.frame ? *run.frame : whole_metre_origin(parts[p].box.min);
+  PartOutcome out;
+  if (run.cache != nullptr) {
+    std::vector<BlockPartKey> around_keys;
+    for (const std::uint32_t q : around_parts) around_keys.push_back(parts[q].key);
+    out.digest = part_digest(p, level, origin, context, *own, around_keys, around, run.source_sizes);
+    if (auto kept = run.cache->find(parts[p].key, out.digest)) {
+      kept->second.digest = out.digest;
+      kept->second.reused = true;
+      store.save_stitched(p, std::move(kept->first));
+      return kept->second;
+    }
+  }
   PartCut cut = mosaic_detail::cut_part(*own, around, reach, origin);
   around.clear();
-  PartOutcome out;
   out.cut_triangles = cut.merged.mesh.triangle_count();
   out.stats = stitch_cut(cut, run.params, run.source_sizes);
   KeyedPiece stitched = mosaic_detail::stitched_piece(cut, p);
   out.box = stitched.box();
+  if (run.cache != nullptr) run.cache->keep(parts[p].key, stitched, out);
   store.save_stitched(p, std::move(stitched));
   return out;
 }
@@ -182,6 +234,8 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
     parts[stitcher.parts_of_level()[i]].stitched_box = outcomes[i].box;
     stats.largest_part = std::max(stats.largest_part, outcomes[i].cut_triangles);
+    stats.reused_parts += outcomes[i].reused ? 1 : 0;
+    stats.digests[stitcher.parts_of_level()[i]] = outcomes[i].digest;
     add_counts(stats.stitch, outcomes[i].stats);
   }
   stats.parts[static_cast<std::size_t>(level)] = stitcher.size();
@@ -338,6 +392,7 @@ BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, c
     throw ProcessingError("stitching block by block: the parts are not in key order");
   }
   BlockStitchStats stats;
+  stats.digests.assign(parts.size(), 0);
   const Stopwatch clock;
   for (int level = 0; level < kLevels; ++level) {
     stitch_level(parts, level, store, run, stats);

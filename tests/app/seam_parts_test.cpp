@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -14,6 +15,7 @@
 #include "citymesh/core/error.h"
 #include "face_table.h"
 #include "leaf_outputs.h"
+#include "seam_cache.h"
 #include "test_support.h"
 
 namespace citymesh::app {
@@ -289,6 +291,96 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   std::uint64_t counted = leaves.stitched();
   for (const std::uint64_t n : leaves.per_source()) counted += n;
   EXPECT_EQ(counted, gathered.mesh.triangle_count());
+}
+
+/// The four-source scene without the triangles `drop` names, stitched from files (cache:
+/// optional), the cache pruned to what this run used; the output gathered.
+struct CachedStitch {
+  MergedMesh out;
+  BlockStitchStats stats;
+  std::size_t parts = 0;
+};
+template <class Drop>
+CachedStitch stitch_scene(const test::TempDir& dir, const std::string& name, Drop drop, SeamPartCache* cache) {
+  const MergedMesh scene = test::four_source_scene();
+  SeamPartFiles files(dir / name, blocks());
+  files.add_tile({0, 0}, tile_pieces(scene, [&](std::uint32_t t) { return !drop(scene, t); }));
+  std::vector<BlockPart> parts = files.finish();
+  const PartStitchRun run{.params = kParams,
+                          .blocks = blocks(),
+                          .source_sizes = files.source_sizes(),
+                          .frame = std::nullopt,
+                          .run_level = {},
+                          .cache = cache};
+  CachedStitch r;
+  r.stats = stitch_parts(parts, files, run);
+  if (cache != nullptr) cache->prune(parts, r.stats.digests);
+  r.out = gather_stitched_parts(parts, files);
+  r.parts = parts.size();
+  return r;
+}
+
+void expect_same_output(const MergedMesh& a, const MergedMesh& b) {
+  ASSERT_EQ(a.mesh.triangle_count(), b.mesh.triangle_count());
+  EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
+  EXPECT_EQ(a.mesh.positions, b.mesh.positions);
+  EXPECT_EQ(a.source_acq, b.source_acq);
+  EXPECT_EQ(a.source_triangle, b.source_triangle);
+}
+
+std::size_t files_in(const std::filesystem::path& dir) {
+  std::size_t n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(SeamCache, PartsWhoseInputsChangedAreStitchedAgainTheOthersTakenToTheSameOutput) {
+  test::TempDir dir;
+  const auto none = [](const MergedMesh&, std::uint32_t) { return false; };
+  // A hole in source 0 inside one block's interior: that block's stitched output changes,
+  // so the parts of later levels around it, which see it as done, are stitched again too; no
+  // part appears or goes, so every other part keeps its place in the list.
+  const auto hole = [](const MergedMesh& m, std::uint32_t t) {
+    Vec3f c{};
+    for (const std::uint32_t v : m.mesh.triangles[t]) c = c + m.mesh.positions[v] * (1.f / 3.f);
+    return m.source_acq[t] == 0 && c.x > 1.2f && c.x < 1.8f && c.y > 1.1f && c.y < 1.25f;
+  };
+  SeamPartCache cache(dir / "cache", 7);
+  const CachedStitch plain = stitch_scene(dir, "plain", none, nullptr);
+  const CachedStitch first = stitch_scene(dir, "first", none, &cache);
+  EXPECT_EQ(first.stats.reused_parts, 0u);
+  expect_same_output(first.out, plain.out);
+  EXPECT_EQ(files_in(dir / "cache"), first.parts);
+
+  const CachedStitch again = stitch_scene(dir, "again", none, &cache);
+  EXPECT_EQ(again.stats.reused_parts, again.parts);
+  expect_same_output(again.out, plain.out);
+  EXPECT_EQ(again.stats.stitch.strips, plain.stats.stitch.strips);
+  EXPECT_EQ(again.stats.stitch.vertices_snapped, plain.stats.stitch.vertices_snapped);
+  EXPECT_EQ(again.stats.largest_part, plain.stats.largest_part);
+
+  const CachedStitch changed_plain = stitch_scene(dir, "changed-plain", hole, nullptr);
+  const CachedStitch changed = stitch_scene(dir, "changed", hole, &cache);
+  ASSERT_EQ(changed.parts, first.parts);
+  EXPECT_GT(changed.stats.reused_parts, 0u);
+  EXPECT_LT(changed.stats.reused_parts + 1, changed.parts) << "the block and the parts that see it done";
+  expect_same_output(changed.out, changed_plain.out);
+  EXPECT_EQ(files_in(dir / "cache"), changed.parts) << "pruned to what the last run used";
+
+  // A damaged entry is stitched again, not read.
+  const auto victim = std::filesystem::directory_iterator(dir / "cache")->path();
+  {
+    std::fstream f(victim, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(static_cast<std::streamoff>(std::filesystem::file_size(victim) / 2));
+    f.put('\x5a');
+  }
+  const CachedStitch mended = stitch_scene(dir, "mended", hole, &cache);
+  EXPECT_EQ(mended.stats.reused_parts, mended.parts - 1);
+  expect_same_output(mended.out, changed_plain.out);
+
+  // Other settings: nothing of the earlier runs is theirs.
+  SeamPartCache other(dir / "cache", 8);
+  EXPECT_EQ(stitch_scene(dir, "other", hole, &other).stats.reused_parts, 0u);
 }
 
 }  // namespace

@@ -43,6 +43,9 @@ struct KeyedPiece {
   void check(std::string_view what) const;
 };
 
+/// A digest of every array of `piece` (XXH3): equal pieces, equal digests.
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece);
+
 /// The triangles `triangles` of `piece` (in that order) on the vertices they use.
 KeyedPiece subset(const KeyedPiece& piece, std::span<const std::uint32_t> triangles);
 

@@ -7,8 +7,8 @@
 
 #include <array>
 #include <compare>
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <span>
@@ -39,6 +39,8 @@ struct BlockStitchStats {
   /// per level: block interiors, bands along x = const, bands along y = const, corner squares
   std::array<std::size_t, 4> parts{};
   std::size_t largest_part = 0;        ///< triangles of the largest part with its surroundings
+  std::size_t reused_parts = 0;        ///< taken from the run's PartCache instead of stitched
+  std::vector<std::uint64_t> digests;  ///< per part, with a PartCache: PartOutcome::digest
 };
 
 /// The farthest any step of `params` looks from a vertex (snapping, joining, clipping, the
@@ -118,6 +120,27 @@ struct PartOutcome {
   StitchStats stats;
   Box3d box;                      ///< of the stitched part's triangles
   std::size_t cut_triangles = 0;  ///< the part with its surroundings, as stitched
+  /// With a PartCache: the digest of everything the part's stitching read (part_digest), and
+  /// whether the stitched part came from the cache.
+  std::uint64_t digest = 0;
+  bool reused = false;
+};
+
+/// Stitched parts kept from earlier runs, found by a digest of everything a part's stitching
+/// reads (the part, the parts around it as its level sees them, the order of precedence of
+/// the sources among them, its index, level and frame): a run that changed only some parts
+/// (an acquisition appended over one district) stitches again only the parts whose inputs
+/// changed, and gets the bytes of stitching them all. The implementation adds the settings.
+class PartCache {
+ public:
+  virtual ~PartCache() = default;
+  /// The part `key` stitched from inputs of digest `digest`, with its outcome, if kept (a
+  /// damaged entry is not found). Called from several threads at once.
+  [[nodiscard]] virtual std::optional<std::pair<KeyedPiece, PartOutcome>> find(const BlockPartKey& key,
+                                                                               std::uint64_t digest) const = 0;
+  /// Keeps part `key` stitched from inputs of digest `outcome.digest`. Called from several
+  /// threads at once, never for the same part.
+  virtual void keep(const BlockPartKey& key, const KeyedPiece& stitched, const PartOutcome& outcome) = 0;
 };
 
 struct PartStitchRun {
@@ -133,6 +156,8 @@ struct PartStitchRun {
   /// Unset: on this process's threads (stitch_level_here). A tiled MPI run hands the parts out
   /// to every rank.
   std::function<std::vector<PartOutcome>(const LevelStitcher&)> run_level;
+  /// Where stitched parts are looked up before stitching and kept after; null: none.
+  PartCache* cache = nullptr;
 };
 
 /// The parts of one level of stitch_parts(), each stitched on its own: loaded with the parts
