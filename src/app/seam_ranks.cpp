@@ -152,7 +152,7 @@ void remove_seam_plan(const Config& config) {
 }
 
 void help_seam_pass(const Config& config, Cluster& cluster) {
-  std::atomic<std::size_t> stitched = 0, measured = 0;
+  std::atomic<std::size_t> stitched = 0, reused = 0, measured = 0;
   // The root's steps: the boundary measured, the levels stitched, the boundary measured again.
   for (int step = 0; step < kBlockStitchLevels + 2; ++step) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.
@@ -187,11 +187,11 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     run_part_workers(*channel, [&](std::size_t i) {
       const PartOutcome outcome = stitcher.stitch(i);
       write_file_atomically(files.beside(stitcher.parts_of_level()[i], kOutcomeSuffix), outcome_json(outcome).dump());
-      ++stitched;
+      ++(outcome.reused ? reused : stitched);
     });
   }
-  log::info("rank {}: stitched {} parts of the seam pass and measured {}", cluster.rank(), stitched.load(),
-            measured.load());
+  log::info("rank {}: stitched {} parts of the seam pass, took {} as the last run stitched them, and measured {}",
+            cluster.rank(), stitched.load(), reused.load(), measured.load());
 }
 
 }  // namespace citymesh::app
