@@ -152,7 +152,8 @@ void add_counts(StitchStats& total, const StitchStats& s) {
 std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double context, const KeyedPiece& own,
                           std::span<const BlockPartKey> around_keys, std::span<const Neighbour> around,
                           std::span<const std::uint64_t> source_sizes) {
-  constexpr std::uint64_t kFormat = 1;  // bumped when stitching a part reads something more
+  constexpr std::uint64_t kFormat =
+      1;  // bumped when stitching a part reads something more (the cache also mixes in the build)
   BulkChecksum sum;
   const auto add = [&sum](const auto& value) { sum.add(&value, sizeof(value)); };
   add(kFormat);

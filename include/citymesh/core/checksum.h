@@ -22,6 +22,11 @@ inline std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t has
 /// XXH3 (64 bit) of `data`: tens of GB/s, so checksumming costs nothing next to writing.
 std::uint64_t bulk_checksum(const void* data, std::size_t size);
 
+/// A digest of this program's executable (its size and modification time; 0 when unknown):
+/// work kept for later runs (stitched parts, encoded tiles) mixes it in, so that a rebuilt
+/// or upgraded citymesh, whose code may give other results, never takes an older build's.
+std::uint64_t executable_identity();
+
 /// bulk_checksum of bytes given in parts: the parts' concatenation gives the same value.
 class BulkChecksum {
  public:
