@@ -19,6 +19,7 @@
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/read_file.h"
 #include "json_bits.h"
+#include "kept_files.h"
 #include "tileset_output.h"
 #include "work_schedule.h"
 
@@ -412,7 +413,9 @@ void end_shared_outputs(const Config& config, Cluster& cluster) {
 void help_outputs(const Config& config, Cluster& cluster) {
   std::atomic<std::size_t> filed = 0, merged = 0, mapped = 0, built = 0;
   const Crs crs = config.crs();
-  const TilesetExportParams params = tileset_export_params(config);
+  ExportPrimitiveCache primitives(export_cache_folder(config.project.work));
+  TilesetExportParams params = tileset_export_params(config);
+  params.primitives = &primitives;
   const TileGrid grid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin});
   for (;;) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.

@@ -3,15 +3,11 @@
 
 #include <fmt/format.h>
 
-#include <cstring>
-#include <fstream>
-
-#include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
-#include "citymesh/core/read_file.h"
 #include "json_bits.h"
+#include "kept_files.h"
 #include "run_state.h"
 #include "seam_parts.h"
 #include "tiled_run.h"
@@ -22,37 +18,6 @@ namespace {
 
 constexpr std::string_view kCacheMagic = "CMSTCH01";
 constexpr std::string_view kCacheSuffix = ".part";
-
-/// What precedes a kept part: the outcome's JSON and the piece follow, in that order.
-struct CacheHeader {
-  char magic[8];
-  std::uint64_t json_bytes;
-  std::uint64_t checksum;  ///< XXH3 of everything after the header
-};
-static_assert(sizeof(CacheHeader) == 24);
-
-/// The outcome and the piece of a kept part's bytes; nullopt (with the reason) when they are
-/// not one SeamPartCache::keep() wrote whole.
-std::optional<std::pair<KeyedPiece, PartOutcome>> decode_kept(std::string_view bytes, const std::string& source) {
-  CacheHeader h{};
-  const auto refuse = [&](std::string_view why) -> std::optional<std::pair<KeyedPiece, PartOutcome>> {
-    log::warn("{}: a stitched part of an earlier run, but {}: it is stitched again", source, why);
-    return std::nullopt;
-  };
-  if (bytes.size() < sizeof(h)) return refuse("too short");
-  std::memcpy(&h, bytes.data(), sizeof(h));
-  if (std::string_view(h.magic, sizeof(h.magic)) != kCacheMagic) return refuse("another magic");
-  const std::string_view rest = bytes.substr(sizeof(h));
-  if (bulk_checksum(rest.data(), rest.size()) != h.checksum) return refuse("its checksum does not match");
-  if (h.json_bytes > rest.size()) return refuse("its counts disagree with its size");
-  try {
-    PartOutcome outcome = outcome_from(nlohmann::json::parse(rest.substr(0, h.json_bytes)));
-    KeyedPiece piece = decode_keyed_piece(rest.substr(h.json_bytes), source);
-    return std::pair(std::move(piece), outcome);
-  } catch (const std::exception& e) {
-    return refuse(e.what());
-  }
-}
 
 }  // namespace
 
@@ -96,42 +61,18 @@ std::filesystem::path SeamPartCache::file(const BlockPartKey& key, std::uint64_t
 std::optional<std::pair<KeyedPiece, PartOutcome>> SeamPartCache::find(const BlockPartKey& key,
                                                                       std::uint64_t digest) const {
   const std::filesystem::path path = file(key, digest);
-  const std::optional<std::string> bytes = read_file_bytes(path);
-  if (!bytes) return std::nullopt;
-  return decode_kept(*bytes, path.string());
+  const auto kept = read_kept_file(path, kCacheMagic, "a stitched part");
+  if (!kept) return std::nullopt;
+  try {
+    return std::pair(decode_keyed_piece(kept->second, path.string()), outcome_from(kept->first));
+  } catch (const std::exception& e) {
+    log::warn("{}: a stitched part of an earlier run, but {}: it is stitched again", path.string(), e.what());
+    return std::nullopt;
+  }
 }
 
 void SeamPartCache::keep(const BlockPartKey& key, const KeyedPiece& stitched, const PartOutcome& outcome) {
-  const std::string json = outcome_json(outcome).dump();
-  const std::string piece = encode_keyed_piece(stitched);
-  CacheHeader h{};
-  std::memcpy(h.magic, kCacheMagic.data(), sizeof(h.magic));
-  h.json_bytes = json.size();
-  BulkChecksum sum;
-  sum.add(json.data(), json.size());
-  sum.add(piece.data(), piece.size());
-  h.checksum = sum.value();
-  std::error_code ec;
-  std::filesystem::create_directories(dir_, ec);
-  const std::filesystem::path path = file(key, outcome.digest);
-  // Under a temporary name first, so that nothing reads a file being written; a run killed
-  // here leaves it for the next run's leftover sweep.
-  std::filesystem::path temp = path;
-  temp += std::string(kTemporaryInfix) + process_tag();
-  {
-    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(&h), sizeof(h));
-    out.write(json.data(), static_cast<std::streamsize>(json.size()));
-    out.write(piece.data(), static_cast<std::streamsize>(piece.size()));
-    if (!out.flush()) {
-      log::warn("{}: cannot keep a stitched part for the next run", temp.string());
-      out.close();
-      std::filesystem::remove(temp, ec);
-      return;
-    }
-  }
-  std::filesystem::rename(temp, path, ec);
-  if (ec) log::warn("{}: cannot keep a stitched part for the next run: {}", path.string(), ec.message());
+  write_kept_file(file(key, outcome.digest), kCacheMagic, outcome_json(outcome).dump(), encode_keyed_piece(stitched));
 }
 
 void SeamPartCache::prune(std::span<const BlockPart> parts, std::span<const std::uint64_t> digests) const {

@@ -14,6 +14,7 @@
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/tiles3d/export.h"
+#include "kept_files.h"
 #include "leaf_outputs.h"
 #include "mosaic_output.h"
 
@@ -171,8 +172,14 @@ nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& l
     return report;
   }
   if (config.output.tiles_3d) {
-    const TilesetExportParams params = tileset_export_params(config);
+    // The encoded tiles stay in the work folder: the next run (an acquisition appended)
+    // encodes again only the tiles whose meshes changed.
+    ExportPrimitiveCache cache(export_cache_folder(config.project.work));
+    const auto started = std::filesystem::file_time_type::clock::now();
+    TilesetExportParams params = tileset_export_params(config);
+    params.primitives = &cache;
     report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, work), params);
+    cache.prune(started);
   }
   if (config.output.ply) report["ply"] = write_tile_plys(config, leaves);
   return report;

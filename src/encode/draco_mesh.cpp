@@ -4,12 +4,15 @@
 
 #include <draco/compression/decode.h>
 #include <draco/compression/encode.h>
+#include <draco/core/draco_version.h>
 #include <draco/mesh/mesh.h>
 #include <fmt/format.h>
 
 #include "citymesh/core/error.h"
 
 namespace citymesh {
+
+std::string_view draco_version() { return draco::kDracoVersion; }
 
 namespace {
 
@@ -58,12 +61,12 @@ DracoEncoded draco_encode(const DracoMeshView& view, const DracoEncodeParams& pa
   draco::Mesh mesh;
   mesh.set_num_points(static_cast<std::uint32_t>(view.positions.size()));
   DracoEncoded out;
-  out.ids.position = add_attribute(mesh, draco::GeometryAttribute::POSITION, draco::DT_FLOAT32, 3, false,
-                                   view.positions);
-  out.ids.feature_id = add_attribute(mesh, draco::GeometryAttribute::GENERIC, draco::DT_UINT16, 1, false,
-                                     view.feature_ids);
-  out.ids.intensity = add_attribute(mesh, draco::GeometryAttribute::GENERIC, draco::DT_FLOAT32, 1, false,
-                                    view.intensities);
+  out.ids.position =
+      add_attribute(mesh, draco::GeometryAttribute::POSITION, draco::DT_FLOAT32, 3, false, view.positions);
+  out.ids.feature_id =
+      add_attribute(mesh, draco::GeometryAttribute::GENERIC, draco::DT_UINT16, 1, false, view.feature_ids);
+  out.ids.intensity =
+      add_attribute(mesh, draco::GeometryAttribute::GENERIC, draco::DT_FLOAT32, 1, false, view.intensities);
   out.ids.color = add_attribute(mesh, draco::GeometryAttribute::COLOR, draco::DT_UINT8, 3, true, view.colors);
   for (const Triangle& t : view.triangles) {
     if (t[0] >= view.positions.size() || t[1] >= view.positions.size() || t[2] >= view.positions.size()) {
@@ -105,12 +108,12 @@ DecodedMesh draco_decode(std::span<const std::uint8_t> data, const DracoAttribut
     a.GetMappedValue(p, xyz);
     return Vec3f{xyz[0], xyz[1], xyz[2]};
   });
-  out.feature_ids = read_attribute<std::uint16_t, 1>(*mesh, ids.feature_id, "feature id",
-                                                     [](const auto& a, draco::PointIndex p) {
-                                                       std::uint16_t v = 0;
-                                                       a.ConvertValue(a.mapped_index(p), &v);
-                                                       return v;
-                                                     });
+  out.feature_ids =
+      read_attribute<std::uint16_t, 1>(*mesh, ids.feature_id, "feature id", [](const auto& a, draco::PointIndex p) {
+        std::uint16_t v = 0;
+        a.ConvertValue(a.mapped_index(p), &v);
+        return v;
+      });
   out.intensities = read_attribute<float, 1>(*mesh, ids.intensity, "intensity", [](const auto& a, draco::PointIndex p) {
     float v = 0;
     a.ConvertValue(a.mapped_index(p), &v);

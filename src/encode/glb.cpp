@@ -8,13 +8,14 @@
 #include <limits>
 #include <set>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 
 namespace citymesh {
 
 namespace {
 
-constexpr std::uint32_t kGlbMagic = 0x46546C67;  // "glTF"
+constexpr std::uint32_t kGlbMagic = 0x46546C67;   // "glTF"
 constexpr std::uint32_t kJsonChunk = 0x4E4F534A;  // "JSON"
 constexpr std::uint32_t kBinChunk = 0x004E4942;   // "BIN\0"
 constexpr int kFloat = 5126, kUnsignedInt = 5125, kUnsignedShort = 5123, kUnsignedByte = 5121;
@@ -214,6 +215,32 @@ std::vector<std::uint8_t> assemble_glb(const nlohmann::json& json, std::span<con
 
 }  // namespace
 
+std::uint64_t glb_primitive_digest(const DracoMeshView& mesh, const DracoEncodeParams& params) {
+  constexpr std::uint64_t kFormat = 1;  // bumped when mesh_primitive writes something else
+  BulkChecksum sum;
+  const auto add = [&sum](const auto& value) { sum.add(&value, sizeof(value)); };
+  const auto add_array = [&](auto values) {
+    add(std::uint64_t{values.size()});
+    sum.add(values.data(), values.size_bytes());
+  };
+  add(kFormat);
+  const std::string_view draco = draco_version();  // another Draco may encode otherwise
+  sum.add(draco.data(), draco.size());
+  add_array(mesh.positions);
+  add_array(mesh.triangles);
+  add_array(mesh.feature_ids);
+  add_array(mesh.intensities);
+  add_array(mesh.colors);
+  add(std::int64_t{params.position_bits});
+  add(std::int64_t{params.speed});
+  add(params.lattice.has_value());
+  if (params.lattice) {
+    add(params.lattice->origin);
+    add(params.lattice->range);
+  }
+  return sum.value();
+}
+
 std::vector<std::uint8_t> write_glb(const DracoMeshView& given, const GlbParams& params) {
   check_mesh(given);
   // A tile of stitch triangles only has no feature: no feature ids then (ids without the
@@ -223,7 +250,22 @@ std::vector<std::uint8_t> write_glb(const DracoMeshView& given, const GlbParams&
   if (distinct_features(mesh.feature_ids) == 0) mesh.feature_ids = {};
   BinBuilder bin;
   nlohmann::json accessors = nlohmann::json::array();
-  nlohmann::json primitive = mesh_primitive(mesh, params, bin, accessors);
+  nlohmann::json primitive;
+  if (params.draco && params.primitives != nullptr) {
+    // The Draco bytes are the primitive's only buffer view, added first: a kept primitive
+    // gives the same views, and the glb the same bytes.
+    const std::uint64_t digest = glb_primitive_digest(mesh, params.draco_params);
+    if (std::optional<GlbPrimitive> kept = params.primitives->find(digest)) {
+      bin.add(kept->draco);
+      accessors = std::move(kept->accessors);
+      primitive = std::move(kept->primitive);
+    } else {
+      primitive = mesh_primitive(mesh, params, bin, accessors);
+      params.primitives->keep(digest, {primitive, accessors, bin.bytes()});
+    }
+  } else {
+    primitive = mesh_primitive(mesh, params, bin, accessors);
+  }
   nlohmann::json json{{"asset", {{"version", "2.0"}, {"generator", "citymesh"}}},
                       {"scene", 0},
                       {"scenes", {{{"nodes", {0}}}}},
@@ -289,7 +331,8 @@ std::span<const std::uint8_t> view_bytes(const GlbFile& glb, const nlohmann::jso
     throw InputError(fmt::format("{}: bufferView {} does not exist", name, index.dump()));
   }
   const nlohmann::json& view = views[index.get<std::size_t>()];
-  const std::size_t offset = view.value("byteOffset", std::size_t{0}), length = view.value("byteLength", std::size_t{0});
+  const std::size_t offset = view.value("byteOffset", std::size_t{0}),
+                    length = view.value("byteLength", std::size_t{0});
   if (offset > glb.bin.size() || length > glb.bin.size() - offset) {
     throw InputError(fmt::format("{}: bufferView {} lies outside the binary chunk", name, index.dump()));
   }
@@ -319,7 +362,8 @@ DecodedMesh read_plain_mesh(const GlbFile& glb, const nlohmann::json& primitive,
   const auto xyz = read_plain_accessor<float>(glb, attributes.at("POSITION").get<int>(), 3, name);
   for (std::size_t i = 0; i + 2 < xyz.size(); i += 3) m.positions.push_back({xyz[i], xyz[i + 1], xyz[i + 2]});
   const auto corners = read_plain_accessor<std::uint32_t>(glb, primitive.at("indices").get<int>(), 1, name);
-  for (std::size_t i = 0; i + 2 < corners.size(); i += 3) m.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
+  for (std::size_t i = 0; i + 2 < corners.size(); i += 3)
+    m.triangles.push_back({corners[i], corners[i + 1], corners[i + 2]});
   if (attributes.contains(kFeatureIdAttribute)) {
     m.feature_ids = read_plain_accessor<std::uint16_t>(glb, attributes[kFeatureIdAttribute].get<int>(), 1, name);
   }

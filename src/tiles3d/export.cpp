@@ -211,7 +211,10 @@ namespace {
 class TileWriter {
  public:
   TileWriter(const TilesetFrame& frame, const TilesetExportParams& params)
-      : glb_{.draco = params.draco, .draco_params = frame.lattice, .acquisitions = params.acquisitions},
+      : glb_{.draco = params.draco,
+             .draco_params = frame.lattice,
+             .acquisitions = params.acquisitions,
+             .primitives = params.primitives},
         staged_(staging_directory(params.dir)) {}
 
   /// Writes `node`'s tile (none when it has no triangles); returns its bytes.

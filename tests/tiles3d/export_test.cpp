@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <mutex>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -317,6 +318,64 @@ TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
   EXPECT_EQ(leaves.tiles, whole.tiles);
   EXPECT_EQ(leaves.all_triangles, whole.all_triangles);
   expect_same_files(tmp / "whole", tmp / "leaves");
+}
+
+/// Encoded primitives in memory, counting what was found and kept.
+class CountingPrimitives final : public GlbPrimitiveCache {
+ public:
+  [[nodiscard]] std::optional<GlbPrimitive> find(std::uint64_t digest) const override {
+    const std::lock_guard lock(mutex_);
+    const auto it = kept_.find(digest);
+    if (it == kept_.end()) return std::nullopt;
+    ++found;
+    return it->second;
+  }
+  void keep(std::uint64_t digest, const GlbPrimitive& primitive) override {
+    const std::lock_guard lock(mutex_);
+    kept_[digest] = primitive;
+    ++made;
+  }
+  mutable std::size_t found = 0;
+  std::size_t made = 0;
+
+ private:
+  mutable std::mutex mutex_;
+  std::map<std::uint64_t, GlbPrimitive> kept_;
+};
+
+TEST(TilesetExport, KeptPrimitivesGiveTheBytesOfEncodingAndOnlyChangedTilesAreEncodedAgain) {
+  test::TempDir tmp;
+  Scene s = scene();
+  CountingPrimitives cache;
+  TilesetExportParams with = params(tmp / "first");
+  with.primitives = &cache;
+  const TilesetExportStats first = export_tileset({s.mesh, s.source, lambert93()}, with);
+  (void)export_tileset({s.mesh, s.source, lambert93()}, params(tmp / "plain"));
+  expect_same_files(tmp / "first", tmp / "plain");
+  EXPECT_EQ(cache.made, first.tiles);
+  EXPECT_EQ(cache.found, 0u);
+
+  with.dir = tmp / "again";
+  (void)export_tileset({s.mesh, s.source, lambert93()}, with);
+  expect_same_files(tmp / "again", tmp / "plain");
+  EXPECT_EQ(cache.found, first.tiles) << "every tile found";
+
+  // One corner cell of the grid moves: its leaf and the parents above it change, the other
+  // leaves are found. The acquisition list grows too, as when one is appended: the
+  // primitives do not hold it.
+  s.mesh.positions[0].z += 0.5f;
+  const std::size_t found_before = cache.found, made_before = cache.made;
+  with.dir = tmp / "changed";
+  with.acquisitions.push_back({"d", "2026-04-01T00:00:00Z"});
+  TilesetExportParams plain = params(tmp / "changed-plain");
+  plain.acquisitions = with.acquisitions;
+  const TilesetExportStats changed = export_tileset({s.mesh, s.source, lambert93()}, with);
+  (void)export_tileset({s.mesh, s.source, lambert93()}, plain);
+  expect_same_files(tmp / "changed", tmp / "changed-plain");
+  const std::size_t made = cache.made - made_before, found = cache.found - found_before;
+  EXPECT_EQ(made + found, changed.tiles);
+  EXPECT_GE(made, 2u) << "the leaf and its parents";
+  EXPECT_GE(found, changed.leaves - 1) << "the other leaves";
 }
 
 TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {

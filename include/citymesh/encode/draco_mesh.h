@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include "citymesh/core/mesh.h"
@@ -20,6 +21,9 @@ struct DracoLattice {
   std::array<float, 3> origin{0, 0, 0};
   float range = 1.0f;  ///< metres, > 0: the edge of the cube the lattice covers
 };
+
+/// The version of the Draco library citymesh was built with.
+std::string_view draco_version();
 
 struct DracoEncodeParams {
   int position_bits = 14;  ///< 1..30

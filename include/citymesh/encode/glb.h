@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -27,11 +28,34 @@ struct GlbAcquisition {
   std::string date;  ///< ISO 8601, UTC
 };
 
+/// A glb's Draco-compressed primitive once encoded: its JSON, its accessors (counts and
+/// bounds of the decoded mesh) and the Draco bytes, its only buffer view. What a tile whose
+/// mesh did not change needs to be written again without encoding (or decoding) it.
+struct GlbPrimitive {
+  nlohmann::json primitive, accessors;
+  std::vector<std::uint8_t> draco;
+};
+
+/// Encoded primitives kept by a digest of the mesh and the Draco parameters
+/// (glb_primitive_digest). Called from several threads at once.
+class GlbPrimitiveCache {
+ public:
+  virtual ~GlbPrimitiveCache() = default;
+  [[nodiscard]] virtual std::optional<GlbPrimitive> find(std::uint64_t digest) const = 0;
+  virtual void keep(std::uint64_t digest, const GlbPrimitive& primitive) = 0;
+};
+
 struct GlbParams {
   bool draco = true;  ///< false: plain accessors (larger; for comparison and debugging)
   DracoEncodeParams draco_params;
   std::vector<GlbAcquisition> acquisitions;
+  /// With Draco: where encoded primitives are looked up first and kept after (null: none).
+  GlbPrimitiveCache* primitives = nullptr;
 };
+
+/// The digest GlbPrimitiveCache finds a mesh's primitive by: every array of `mesh` and every
+/// Draco parameter.
+std::uint64_t glb_primitive_digest(const DracoMeshView& mesh, const DracoEncodeParams& params);
 
 /// The glb bytes of one mesh. The mesh's positions are already in the tile's local frame.
 /// Throws ProcessingError when the mesh is inconsistent (attribute sizes, indices).

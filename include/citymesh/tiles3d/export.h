@@ -28,6 +28,9 @@ struct TilesetExportParams {
   std::size_t max_tiles_per_file = 341;  ///< per tileset JSON file; deeper tiles go to external tilesets
   bool draco = true;
   int draco_speed = 5;
+  /// Where encoded tiles are looked up before encoding and kept after (null: none): a tile
+  /// whose mesh did not change since the run that kept it is not encoded again.
+  GlbPrimitiveCache* primitives = nullptr;
 };
 
 struct TilesetExportStats {
