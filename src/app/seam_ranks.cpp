@@ -153,6 +153,7 @@ void remove_seam_plan(const Config& config) {
 
 void help_seam_pass(const Config& config, Cluster& cluster) {
   std::atomic<std::size_t> stitched = 0, reused = 0, measured = 0;
+  SeamPartCache cache = seam_part_cache(config);
   // The root's steps: the boundary measured, the levels stitched, the boundary measured again.
   for (int step = 0; step < kBlockStitchLevels + 2; ++step) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.
@@ -176,7 +177,6 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
       });
       continue;
     }
-    SeamPartCache cache = seam_part_cache(config);
     const PartStitchRun run{.params = stitch_params(config),
                             .blocks = tile_grid_blocks(config),
                             .source_sizes = plan.source_sizes,

@@ -370,7 +370,9 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const std::vector<std::uint64_t> digests = tile_digests(*store, fingerprints.settings, fingerprints.acquisitions);
   std::vector<std::string> missing;
   for (std::size_t k = 0; k < store->tiles.size(); ++k) {
-    if (!read_tile_result(result_path(config, store->tiles[k].key), digests[k], *store))
+    // Whole and decodable (the checksum covers every section): the pairs, the largest, are
+    // decoded once, when the outputs read the results.
+    if (!read_tile_result(result_path(config, store->tiles[k].key), digests[k], *store, {.pairs = false}))
       missing.push_back(store->tiles[k].key.name());
   }
   if (!missing.empty()) {

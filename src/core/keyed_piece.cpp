@@ -120,29 +120,18 @@ KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces) {
   return out;
 }
 
-namespace {
-
-template <class T>
-void add_array(BulkChecksum& sum, const std::vector<T>& values) {
-  const std::uint64_t count = values.size();
-  sum.add(&count, sizeof(count));  // so that moving an element to the next array changes it
-  sum.add(values.data(), values.size() * sizeof(T));
-}
-
-}  // namespace
-
 std::uint64_t keyed_piece_digest(const KeyedPiece& piece) {
   BulkChecksum sum;
-  add_array(sum, piece.keys);
-  add_array(sum, piece.positions);
-  add_array(sum, piece.sensors);
-  add_array(sum, piece.times);
-  add_array(sum, piece.intensities);
-  add_array(sum, piece.colors);
-  add_array(sum, piece.triangles);
-  add_array(sum, piece.ids);
-  add_array(sum, piece.source_acq);
-  add_array(sum, piece.source_triangle);
+  sum.add_array(std::span(piece.keys));
+  sum.add_array(std::span(piece.positions));
+  sum.add_array(std::span(piece.sensors));
+  sum.add_array(std::span(piece.times));
+  sum.add_array(std::span(piece.intensities));
+  sum.add_array(std::span(piece.colors));
+  sum.add_array(std::span(piece.triangles));
+  sum.add_array(std::span(piece.ids));
+  sum.add_array(std::span(piece.source_acq));
+  sum.add_array(std::span(piece.source_triangle));
   return sum.value();
 }
 

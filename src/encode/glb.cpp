@@ -218,25 +218,20 @@ std::vector<std::uint8_t> assemble_glb(const nlohmann::json& json, std::span<con
 std::uint64_t glb_primitive_digest(const DracoMeshView& mesh, const DracoEncodeParams& params) {
   constexpr std::uint64_t kFormat = 1;  // bumped when mesh_primitive writes something else
   BulkChecksum sum;
-  const auto add = [&sum](const auto& value) { sum.add(&value, sizeof(value)); };
-  const auto add_array = [&](auto values) {
-    add(std::uint64_t{values.size()});
-    sum.add(values.data(), values.size_bytes());
-  };
-  add(kFormat);
+  sum.add_value(kFormat);
   const std::string_view draco = draco_version();  // another Draco may encode otherwise
   sum.add(draco.data(), draco.size());
-  add_array(mesh.positions);
-  add_array(mesh.triangles);
-  add_array(mesh.feature_ids);
-  add_array(mesh.intensities);
-  add_array(mesh.colors);
-  add(std::int64_t{params.position_bits});
-  add(std::int64_t{params.speed});
-  add(params.lattice.has_value());
+  sum.add_array(mesh.positions);
+  sum.add_array(mesh.triangles);
+  sum.add_array(mesh.feature_ids);
+  sum.add_array(mesh.intensities);
+  sum.add_array(mesh.colors);
+  sum.add_value(std::int64_t{params.position_bits});
+  sum.add_value(std::int64_t{params.speed});
+  sum.add_value(params.lattice.has_value());
   if (params.lattice) {
-    add(params.lattice->origin);
-    add(params.lattice->range);
+    sum.add_value(params.lattice->origin);
+    sum.add_value(params.lattice->range);
   }
   return sum.value();
 }

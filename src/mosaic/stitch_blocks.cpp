@@ -152,24 +152,23 @@ void add_counts(StitchStats& total, const StitchStats& s) {
 std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double context, const KeyedPiece& own,
                           std::span<const BlockPartKey> around_keys, std::span<const Neighbour> around,
                           std::span<const std::uint64_t> source_sizes) {
-  constexpr std::uint64_t kFormat =
-      1;  // bumped when stitching a part reads something more (the cache also mixes in the build)
+  // Bumped when stitching a part reads something more (the cache also mixes in the build).
+  constexpr std::uint64_t kFormat = 1;
   BulkChecksum sum;
-  const auto add = [&sum](const auto& value) { sum.add(&value, sizeof(value)); };
-  add(kFormat);
-  add(std::uint64_t{p});
-  add(std::int64_t{level});
-  add(origin);
-  add(context);
-  add(keyed_piece_digest(own));
+  sum.add_value(kFormat);
+  sum.add_value(std::uint64_t{p});
+  sum.add_value(std::int64_t{level});
+  sum.add_value(origin);
+  sum.add_value(context);
+  sum.add_value(keyed_piece_digest(own));
   std::vector<std::int32_t> sources(own.source_acq.begin(), own.source_acq.end());
   for (std::size_t i = 0; i < around.size(); ++i) {
     // The part around by key, not index: an index is only the part's place in this run's list.
-    add(std::int64_t{around_keys[i].level});  // field by field: the struct has padding
-    add(around_keys[i].x);
-    add(around_keys[i].y);
-    add(around[i].role);
-    add(keyed_piece_digest(*around[i].piece));
+    sum.add_value(std::int64_t{around_keys[i].level});  // field by field: the struct has padding
+    sum.add_value(around_keys[i].x);
+    sum.add_value(around_keys[i].y);
+    sum.add_value(around[i].role);
+    sum.add_value(keyed_piece_digest(*around[i].piece));
     sources.insert(sources.end(), around[i].piece->source_acq.begin(), around[i].piece->source_acq.end());
   }
   std::sort(sources.begin(), sources.end());
@@ -180,7 +179,7 @@ std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double 
     return std::pair(source_sizes[static_cast<std::size_t>(a)], a) <
            std::pair(source_sizes[static_cast<std::size_t>(b)], b);
   });
-  for (const std::int32_t a : sources) add(a);
+  sum.add_array(std::span<const std::int32_t>(sources));
   return sum.value();
 }
 

@@ -395,8 +395,7 @@ TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
   // One tile vertex per (vertex, feature) the triangles draw: a vertex shared by two sources
   // is drawn twice, each with its own feature id. The piece's keys ascend, so (key, feature)
   // order is (vertex, feature) order.
-  const FeatureSplit split =
-      split_by_feature(piece.vertex_count(), piece.triangles, triangle_features(piece.source_acq));
+  FeatureSplit split = split_by_feature(piece.vertex_count(), piece.triangles, triangle_features(piece.source_acq));
   TileMesh m;
   const std::size_t count = split.vertex.size();
   m.keys.resize(count);
@@ -410,7 +409,7 @@ TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {
     if (!piece.intensities.empty()) m.intensities[i] = piece.intensities[v];
     if (!piece.colors.empty()) m.colors[i] = piece.colors[v];
   }
-  m.triangles = split.triangles;
+  m.triangles = std::move(split.triangles);
   return m;
 }
 

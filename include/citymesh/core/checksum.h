@@ -7,6 +7,8 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <type_traits>
 
 struct XXH3_state_s;
 
@@ -36,6 +38,20 @@ class BulkChecksum {
   BulkChecksum& operator=(const BulkChecksum&) = delete;
 
   void add(const void* data, std::size_t size);
+  /// The bytes of one value, of a type without padding (padding bytes are not the value's and
+  /// would make equal values digest differently: give such a struct field by field).
+  template <class T>
+  void add_value(const T& value) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    add(&value, sizeof(value));
+  }
+  /// An array's length, then its bytes: moving an element from one array to the next of a
+  /// digest changes it.
+  template <class T>
+  void add_array(std::span<const T> values) {
+    add_value(std::uint64_t{values.size()});
+    add(values.data(), values.size_bytes());
+  }
   [[nodiscard]] std::uint64_t value() const;
 
  private:
