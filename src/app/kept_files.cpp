@@ -24,9 +24,6 @@ struct KeptHeader {
 };
 static_assert(sizeof(KeptHeader) == 24);
 
-constexpr std::string_view kPrimitiveMagic = "CMGLBP01";
-constexpr std::string_view kPrimitiveSuffix = ".glbp";
-
 }  // namespace
 
 void write_kept_file(const std::filesystem::path& path, std::string_view magic, std::string_view json,
@@ -84,48 +81,88 @@ std::optional<std::pair<nlohmann::json, std::string>> read_kept_file(const std::
 
 std::filesystem::path export_cache_folder(const std::filesystem::path& work) { return work / "export-cache"; }
 
-ExportPrimitiveCache::ExportPrimitiveCache(std::filesystem::path dir) : dir_(std::move(dir)) {}
+KeptFolder::KeptFolder(std::filesystem::path dir, Kind kind) : dir_(std::move(dir)), kind_(kind) {}
 
-std::filesystem::path ExportPrimitiveCache::file(std::uint64_t digest) const {
-  // The build too: another build may write a primitive otherwise.
+std::filesystem::path KeptFolder::file(std::uint64_t digest) const {
   const std::uint64_t mixed[2] = {executable_identity(), digest};
-  return dir_ / fmt::format("{:016x}{}", bulk_checksum(mixed, sizeof(mixed)), kPrimitiveSuffix);
+  return dir_ / fmt::format("{:016x}{}", bulk_checksum(mixed, sizeof(mixed)), kind_.suffix);
 }
 
-std::optional<GlbPrimitive> ExportPrimitiveCache::find(std::uint64_t digest) const {
+std::optional<std::pair<nlohmann::json, std::string>> KeptFolder::find(std::uint64_t digest) const {
   const std::filesystem::path path = file(digest);
-  auto kept = read_kept_file(path, kPrimitiveMagic, "an encoded tile");
+  auto kept = read_kept_file(path, kind_.magic, kind_.what);
+  if (!kept) return std::nullopt;
+  std::error_code ec;
+  std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ec);  // used: kept
+  return kept;
+}
+
+void KeptFolder::keep(std::uint64_t digest, std::string_view json, std::string_view bytes) const {
+  write_kept_file(file(digest), kind_.magic, json, bytes);
+}
+
+void KeptFolder::refuse(std::uint64_t digest, std::string_view why) const {
+  log::warn("{}: {} of an earlier run, but {}: it is made again", file(digest).string(), kind_.what, why);
+}
+
+void KeptFolder::prune(std::filesystem::file_time_type since) const {
+  // Another node of a cluster may stamp by a clock a little behind this one's.
+  const std::filesystem::file_time_type before = since - std::chrono::minutes(10);
+  std::error_code ec;
+  std::vector<std::filesystem::path> stale;
+  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
+    if (!entry.path().string().ends_with(kind_.suffix)) continue;
+    std::error_code time_ec;
+    const auto time = std::filesystem::last_write_time(entry.path(), time_ec);
+    if (!time_ec && time < before) stale.push_back(entry.path());
+  }
+  for (const std::filesystem::path& f : stale) std::filesystem::remove(f, ec);
+}
+
+ExportPrimitiveCache::ExportPrimitiveCache(const std::filesystem::path& dir)
+    : files_(dir, {".glbp", "CMGLBP01", "an encoded tile"}) {}
+
+std::optional<GlbPrimitive> ExportPrimitiveCache::find(std::uint64_t digest) const {
+  auto kept = files_.find(digest);
   if (!kept) return std::nullopt;
   try {
-    GlbPrimitive p{kept->first.at("primitive"), kept->first.at("accessors"),
-                   std::vector<std::uint8_t>(kept->second.begin(), kept->second.end())};
-    std::error_code ec;
-    std::filesystem::last_write_time(path, std::filesystem::file_time_type::clock::now(), ec);  // used: kept
-    return p;
+    return GlbPrimitive{kept->first.at("primitive"), kept->first.at("accessors"),
+                        std::vector<std::uint8_t>(kept->second.begin(), kept->second.end())};
   } catch (const std::exception& e) {
-    log::warn("{}: an encoded tile of an earlier run, but {}: it is made again", path.string(), e.what());
+    files_.refuse(digest, e.what());
     return std::nullopt;
   }
 }
 
 void ExportPrimitiveCache::keep(std::uint64_t digest, const GlbPrimitive& primitive) {
   const nlohmann::json json{{"primitive", primitive.primitive}, {"accessors", primitive.accessors}};
-  write_kept_file(file(digest), kPrimitiveMagic, json.dump(),
-                  {reinterpret_cast<const char*>(primitive.draco.data()), primitive.draco.size()});
+  files_.keep(digest, json.dump(), {reinterpret_cast<const char*>(primitive.draco.data()), primitive.draco.size()});
 }
 
-void ExportPrimitiveCache::prune(std::filesystem::file_time_type since) const {
-  // Another node of a cluster may stamp by a clock a little behind this one's.
-  const std::filesystem::file_time_type before = since - std::chrono::minutes(10);
-  std::error_code ec;
-  std::vector<std::filesystem::path> stale;
-  for (const auto& entry : std::filesystem::directory_iterator(dir_, ec)) {
-    if (!entry.path().string().ends_with(kPrimitiveSuffix)) continue;
-    std::error_code time_ec;
-    const auto time = std::filesystem::last_write_time(entry.path(), time_ec);
-    if (!time_ec && time < before) stale.push_back(entry.path());
+ExportSimplifyCache::ExportSimplifyCache(const std::filesystem::path& dir)
+    : files_(dir, {".simp", "CMSIMP01", "a simplified tile"}) {}
+
+std::optional<SimplifiedMesh> ExportSimplifyCache::find(std::uint64_t digest) const {
+  auto kept = files_.find(digest);
+  if (!kept) return std::nullopt;
+  try {
+    SimplifiedMesh mesh;
+    mesh.error = kept->first.at("error").get<double>();
+    const auto triangles = kept->first.at("triangles").get<std::uint64_t>();
+    if (kept->second.size() != triangles * sizeof(Triangle)) throw std::runtime_error("its triangles are cut short");
+    mesh.triangles.resize(triangles);
+    std::memcpy(mesh.triangles.data(), kept->second.data(), kept->second.size());
+    return mesh;
+  } catch (const std::exception& e) {
+    files_.refuse(digest, e.what());
+    return std::nullopt;
   }
-  for (const std::filesystem::path& f : stale) std::filesystem::remove(f, ec);
+}
+
+void ExportSimplifyCache::keep(std::uint64_t digest, const SimplifiedMesh& mesh) {
+  const nlohmann::json json{{"triangles", mesh.triangles.size()}, {"error", mesh.error}};
+  files_.keep(digest, json.dump(),
+              {reinterpret_cast<const char*>(mesh.triangles.data()), mesh.triangles.size() * sizeof(Triangle)});
 }
 
 }  // namespace citymesh::app

@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "citymesh/encode/glb.h"
+#include "citymesh/tiles3d/simplify.h"
 
 namespace citymesh::app {
 
@@ -25,24 +26,71 @@ void write_kept_file(const std::filesystem::path& path, std::string_view magic, 
 std::optional<std::pair<nlohmann::json, std::string>> read_kept_file(const std::filesystem::path& path,
                                                                      std::string_view magic, std::string_view what);
 
-/// <work>/export-cache: where ExportPrimitiveCache keeps the encoded tiles.
+/// <work>/export-cache: where the export's caches keep encoded tiles and simplified parents.
 std::filesystem::path export_cache_folder(const std::filesystem::path& work);
 
-/// A GlbPrimitiveCache in one folder, one file per primitive: "<digest>.glbp" (magic
-/// `CMGLBP01`). The digest mixes in the build. A primitive found has its file's time set to
-/// now, so that prune() keeps what this run used, whichever process of the run used it.
-class ExportPrimitiveCache final : public GlbPrimitiveCache {
+/// Kept files of one kind in one folder, one per item: "<digest>.<suffix>", the digest mixed
+/// with the build's identity (another build may make an item otherwise). An item found has
+/// its file's time set to now, so that prune() keeps what this run used, whichever process of
+/// the run used it.
+class KeptFolder {
  public:
-  explicit ExportPrimitiveCache(std::filesystem::path dir);
-  [[nodiscard]] std::optional<GlbPrimitive> find(std::uint64_t digest) const override;
-  void keep(std::uint64_t digest, const GlbPrimitive& primitive) override;
-  /// Removes the primitives neither kept nor found since `since` (less a margin for the
-  /// clocks of a cluster's nodes). Best effort.
+  struct Kind {
+    std::string_view suffix;  ///< with its dot
+    std::string_view magic;   ///< 8 bytes
+    std::string_view what;    ///< for warnings: "an encoded tile"
+  };
+  KeptFolder(std::filesystem::path dir, Kind kind);
+  /// The JSON and bytes kept for `digest`; nullopt when none is (or it is damaged).
+  [[nodiscard]] std::optional<std::pair<nlohmann::json, std::string>> find(std::uint64_t digest) const;
+  void keep(std::uint64_t digest, std::string_view json, std::string_view bytes) const;
+  /// Warns that the item kept for `digest` cannot be read (`why`); it is made again.
+  void refuse(std::uint64_t digest, std::string_view why) const;
+  /// Removes the items neither kept nor found since `since` (less a margin for the clocks of
+  /// a cluster's nodes). Best effort.
   void prune(std::filesystem::file_time_type since) const;
 
  private:
   [[nodiscard]] std::filesystem::path file(std::uint64_t digest) const;
   std::filesystem::path dir_;
+  Kind kind_;
+};
+
+/// The export's encoded tiles: "<digest>.glbp" (magic `CMGLBP01`).
+class ExportPrimitiveCache final : public GlbPrimitiveCache {
+ public:
+  explicit ExportPrimitiveCache(const std::filesystem::path& dir);
+  [[nodiscard]] std::optional<GlbPrimitive> find(std::uint64_t digest) const override;
+  void keep(std::uint64_t digest, const GlbPrimitive& primitive) override;
+  void prune(std::filesystem::file_time_type since) const { files_.prune(since); }
+
+ private:
+  KeptFolder files_;
+};
+
+/// The export's parents as simplified: "<digest>.simp" (magic `CMSIMP01`), the triangles kept
+/// and the error.
+class ExportSimplifyCache final : public SimplifyCache {
+ public:
+  explicit ExportSimplifyCache(const std::filesystem::path& dir);
+  [[nodiscard]] std::optional<SimplifiedMesh> find(std::uint64_t digest) const override;
+  void keep(std::uint64_t digest, const SimplifiedMesh& mesh) override;
+  void prune(std::filesystem::file_time_type since) const { files_.prune(since); }
+
+ private:
+  KeptFolder files_;
+};
+
+/// Both of the export's caches in one work folder.
+struct ExportCaches {
+  explicit ExportCaches(const std::filesystem::path& work)
+      : primitives(export_cache_folder(work)), simplified(export_cache_folder(work)) {}
+  ExportPrimitiveCache primitives;
+  ExportSimplifyCache simplified;
+  void prune(std::filesystem::file_time_type since) const {
+    primitives.prune(since);
+    simplified.prune(since);
+  }
 };
 
 }  // namespace citymesh::app

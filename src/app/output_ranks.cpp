@@ -413,9 +413,10 @@ void end_shared_outputs(const Config& config, Cluster& cluster) {
 void help_outputs(const Config& config, Cluster& cluster) {
   std::atomic<std::size_t> filed = 0, merged = 0, mapped = 0, built = 0;
   const Crs crs = config.crs();
-  ExportPrimitiveCache primitives(export_cache_folder(config.project.work));
+  ExportCaches cache(config.project.work);
   TilesetExportParams params = tileset_export_params(config);
-  params.primitives = &primitives;
+  params.primitives = &cache.primitives;
+  params.tree.simplified = &cache.simplified;
   const TileGrid grid({config.tiling.tile_size, config.tiling.halo, config.tiling.origin});
   for (;;) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.

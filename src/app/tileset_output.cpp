@@ -172,12 +172,14 @@ nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& l
     return report;
   }
   if (config.output.tiles_3d) {
-    // The encoded tiles stay in the work folder: the next run (an acquisition appended)
-    // encodes again only the tiles whose meshes changed.
-    ExportPrimitiveCache cache(export_cache_folder(config.project.work));
+    // The encoded tiles and simplified parents stay in the work folder: the next run (an
+    // acquisition appended) encodes again only the tiles whose meshes changed, and simplifies
+    // again only the parents whose children changed.
+    ExportCaches cache(config.project.work);
     const auto started = std::filesystem::file_time_type::clock::now();
     TilesetExportParams params = tileset_export_params(config);
-    params.primitives = &cache;
+    params.primitives = &cache.primitives;
+    params.tree.simplified = &cache.simplified;
     report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, work), params);
     cache.prune(started);
   }

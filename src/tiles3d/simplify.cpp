@@ -11,6 +11,7 @@
 #include <numeric>
 #include <vector>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 
 namespace citymesh {
@@ -69,7 +70,8 @@ SimplifiedMesh simplify_unwelded(std::span<const Vec3f> positions, std::span<con
   SimplifiedMesh out;
   if (triangles.empty()) return out;
   const std::size_t corners = triangles.size() * 3;
-  const auto target = static_cast<std::size_t>(std::llround(static_cast<double>(corners) * params.target_ratio)) / 3 * 3;
+  const auto target =
+      static_cast<std::size_t>(std::llround(static_cast<double>(corners) * params.target_ratio)) / 3 * 3;
   std::vector<unsigned int> kept(corners);
   float relative_error = 0.0f;
   const std::vector<Vec3f> copies =
@@ -81,13 +83,12 @@ SimplifiedMesh simplify_unwelded(std::span<const Vec3f> positions, std::span<con
   const std::size_t count =
       params.sloppy ? meshopt_simplifySloppy(kept.data(), indices, corners, xyz, positions.size(), sizeof(Vec3f),
                                              target, error, &relative_error)
-                    : meshopt_simplify(kept.data(), indices, corners, xyz, all.size(), sizeof(Vec3f), target,
-                                       error, params.lock_border ? unsigned{meshopt_SimplifyLockBorder} : 0u,
-                                       &relative_error);
+                    : meshopt_simplify(kept.data(), indices, corners, xyz, all.size(), sizeof(Vec3f), target, error,
+                                       params.lock_border ? unsigned{meshopt_SimplifyLockBorder} : 0u, &relative_error);
   out.triangles.resize(count / 3);
   std::memcpy(out.triangles.data(), kept.data(), count * sizeof(unsigned int));
-  const float scale = meshopt_simplifyScale(reinterpret_cast<const float*>(positions.data()), positions.size(),
-                                            sizeof(Vec3f));
+  const float scale =
+      meshopt_simplifyScale(reinterpret_cast<const float*>(positions.data()), positions.size(), sizeof(Vec3f));
   out.error = static_cast<double>(relative_error) * static_cast<double>(scale);
   return out;
 }
@@ -104,6 +105,40 @@ SimplifiedMesh simplify_mesh(std::span<const Vec3f> positions, std::span<const T
   const Welded w = weld(positions, triangles, locked);
   SimplifiedMesh out = simplify_unwelded(w.positions, w.triangles, params, w.locked);
   for (Triangle& t : out.triangles) t = {w.first[t[0]], w.first[t[1]], w.first[t[2]]};
+  return out;
+}
+
+std::uint64_t simplify_digest(std::span<const Vec3f> positions, std::span<const Triangle> triangles,
+                              const SimplifyParams& params, std::span<const std::uint8_t> locked) {
+  constexpr std::uint64_t kFormat = 1;  // bumped when simplify_mesh changes what it makes
+  BulkChecksum sum;
+  sum.add_value(kFormat);
+  sum.add_value(std::int64_t{MESHOPTIMIZER_VERSION});
+  sum.add_array(positions);
+  sum.add_array(triangles);
+  // Field by field: the struct's padding would make equal parameters digest differently.
+  sum.add_value(params.target_ratio);
+  sum.add_value(params.max_error_fraction);
+  sum.add_value(params.lock_border);
+  sum.add_value(params.sloppy);
+  sum.add_value(params.weld);
+  sum.add_array(locked);
+  return sum.value();
+}
+
+SimplifiedMesh simplify_mesh_kept(SimplifyCache* cache, std::span<const Vec3f> positions,
+                                  std::span<const Triangle> triangles, const SimplifyParams& params,
+                                  std::span<const std::uint8_t> locked) {
+  if (cache == nullptr) return simplify_mesh(positions, triangles, params, locked);
+  const std::uint64_t digest = simplify_digest(positions, triangles, params, locked);
+  if (std::optional<SimplifiedMesh> found = cache->find(digest)) {
+    const auto fits = [&](const Triangle& t) {
+      return t[0] < positions.size() && t[1] < positions.size() && t[2] < positions.size();
+    };
+    if (std::all_of(found->triangles.begin(), found->triangles.end(), fits)) return std::move(*found);
+  }
+  SimplifiedMesh out = simplify_mesh(positions, triangles, params, locked);
+  cache->keep(digest, out);
   return out;
 }
 

@@ -148,7 +148,7 @@ void build_parent(const TreeBuild& b, std::span<const TileNode> nodes, TileNode&
     parent.box.extend(nodes[c].box);
   }
   const TileMesh whole = merge(children);
-  SimplifiedMesh simplified = simplify_mesh(whole.positions, whole.triangles, params.simplify);
+  SimplifiedMesh simplified = simplify_mesh_kept(params.simplified, whole.positions, whole.triangles, params.simplify);
   // Past the cap: only the seams with the neighbouring tiles locked (hole rims and the
   // borders of fragments free), then vertices clustered whatever the error (non-manifold
   // pieces and errors beyond the bound stop edge collapses; the cap is what bounds a tile's
@@ -164,7 +164,7 @@ void build_parent(const TreeBuild& b, std::span<const TileNode> nodes, TileNode&
     const std::vector<std::uint8_t> seams =
         sloppy ? std::vector<std::uint8_t>{} : shared_with_neighbours(b, parent, whole);
     const std::size_t before = simplified.triangles.size();
-    simplified = simplify_mesh(whole.positions, whole.triangles, looser, seams);
+    simplified = simplify_mesh_kept(params.simplified, whole.positions, whole.triangles, looser, seams);
     log::debug("3D Tiles: {} of {} triangles past the cap of {}: {} -> {} triangles {}", parent.name(),
                whole.triangles.size(), params.max_parent_triangles, before, simplified.triangles.size(),
                sloppy ? std::string("by clustering (its seams may crack)")

@@ -320,19 +320,20 @@ TEST(TilesetExport, ALeafAtATimeGivesTheBytesOfTheWholeMesh) {
   expect_same_files(tmp / "whole", tmp / "leaves");
 }
 
-/// Encoded primitives in memory, counting what was found and kept.
-class CountingPrimitives final : public GlbPrimitiveCache {
+/// A cache (GlbPrimitiveCache, SimplifyCache) in memory, counting what was found and kept.
+template <class Cache, class Value>
+class Counting final : public Cache {
  public:
-  [[nodiscard]] std::optional<GlbPrimitive> find(std::uint64_t digest) const override {
+  [[nodiscard]] std::optional<Value> find(std::uint64_t digest) const override {
     const std::lock_guard lock(mutex_);
     const auto it = kept_.find(digest);
     if (it == kept_.end()) return std::nullopt;
     ++found;
     return it->second;
   }
-  void keep(std::uint64_t digest, const GlbPrimitive& primitive) override {
+  void keep(std::uint64_t digest, const Value& value) override {
     const std::lock_guard lock(mutex_);
-    kept_[digest] = primitive;
+    kept_[digest] = value;
     ++made;
   }
   mutable std::size_t found = 0;
@@ -340,8 +341,10 @@ class CountingPrimitives final : public GlbPrimitiveCache {
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::uint64_t, GlbPrimitive> kept_;
+  std::map<std::uint64_t, Value> kept_;
 };
+using CountingPrimitives = Counting<GlbPrimitiveCache, GlbPrimitive>;
+using CountingSimplified = Counting<SimplifyCache, SimplifiedMesh>;
 
 TEST(TilesetExport, KeptPrimitivesGiveTheBytesOfEncodingAndOnlyChangedTilesAreEncodedAgain) {
   test::TempDir tmp;
@@ -376,6 +379,43 @@ TEST(TilesetExport, KeptPrimitivesGiveTheBytesOfEncodingAndOnlyChangedTilesAreEn
   EXPECT_EQ(made + found, changed.tiles);
   EXPECT_GE(made, 2u) << "the leaf and its parents";
   EXPECT_GE(found, changed.leaves - 1) << "the other leaves";
+}
+
+TEST(TilesetExport, KeptSimplificationsGiveTheSameTilesAndOnlyParentsOfChangedLeavesAreSimplifiedAgain) {
+  test::TempDir tmp;
+  Scene s = scene();
+  const SceneLeaves plain_leaves(s, params(tmp.path()).grid);
+  CountingSimplified cache;
+  TilesetExportParams with = params(tmp / "first");
+  with.tree.simplified = &cache;
+  const TilesetExportStats first = export_tileset(plain_leaves, lambert93(), with);
+  (void)export_tileset(plain_leaves, lambert93(), params(tmp / "plain"));
+  expect_same_files(tmp / "first", tmp / "plain");
+  const std::size_t parents = first.tiles - first.leaves;
+  ASSERT_GE(parents, 3u);
+  EXPECT_GE(cache.made, parents) << "every parent simplified once at least";
+  EXPECT_EQ(cache.found, 0u);
+  const std::size_t simplifications = cache.made;
+
+  with.dir = tmp / "again";
+  (void)export_tileset(plain_leaves, lambert93(), with);
+  expect_same_files(tmp / "again", tmp / "plain");
+  EXPECT_EQ(cache.found, simplifications) << "every simplification found";
+  EXPECT_EQ(cache.made, simplifications);
+
+  // A bump inside the first leaf (vertex (10, 10)): the parents above it are simplified
+  // again, the others found, and the tiles are those of simplifying everything.
+  s.mesh.positions[10 * (kSide + 1) + 10].z += 0.5f;
+  const SceneLeaves bumped(s, params(tmp.path()).grid);
+  const std::size_t found_before = cache.found, made_before = cache.made;
+  with.dir = tmp / "bumped";
+  (void)export_tileset(bumped, lambert93(), with);
+  (void)export_tileset(bumped, lambert93(), params(tmp / "bumped-plain"));
+  expect_same_files(tmp / "bumped", tmp / "bumped-plain");
+  const std::size_t made = cache.made - made_before, found = cache.found - found_before;
+  EXPECT_EQ(made + found, simplifications);
+  EXPECT_GE(made, 1u) << "the parents above the bump";
+  EXPECT_GE(found, 1u) << "the parents away from it";
 }
 
 TEST(TilesetExport, LeavesMappedAndCellsBuiltByOtherProcessesGiveTheBytesOfOneProcess) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -39,5 +40,26 @@ struct SimplifiedMesh {
 /// whatever `lock_border` says, except with `sloppy`, which keeps nothing in place.
 SimplifiedMesh simplify_mesh(std::span<const Vec3f> positions, std::span<const Triangle> triangles,
                              const SimplifyParams& params = {}, std::span<const std::uint8_t> locked = {});
+
+/// The digest SimplifyCache finds a result by: everything simplify_mesh() reads (positions,
+/// triangles, every parameter, the lock flags) and meshoptimizer's version.
+std::uint64_t simplify_digest(std::span<const Vec3f> positions, std::span<const Triangle> triangles,
+                              const SimplifyParams& params, std::span<const std::uint8_t> locked = {});
+
+/// Simplified meshes kept by simplify_digest(), e.g. between runs of an export whose tiles
+/// mostly did not change. Called from several threads at once.
+class SimplifyCache {
+ public:
+  virtual ~SimplifyCache() = default;
+  [[nodiscard]] virtual std::optional<SimplifiedMesh> find(std::uint64_t digest) const = 0;
+  virtual void keep(std::uint64_t digest, const SimplifiedMesh& mesh) = 0;
+};
+
+/// simplify_mesh(), looked up in `cache` first and kept there after (null: simplify_mesh()). A
+/// result found that indexes past `positions` (another build's, despite the digest) is
+/// simplified again.
+SimplifiedMesh simplify_mesh_kept(SimplifyCache* cache, std::span<const Vec3f> positions,
+                                  std::span<const Triangle> triangles, const SimplifyParams& params,
+                                  std::span<const std::uint8_t> locked = {});
 
 }  // namespace citymesh

@@ -84,6 +84,10 @@ struct TileTreeParams {
   /// output (a 112 M-triangle city's root held 1.06 M triangles). Only a clustered tile may
   /// leave cracks against its neighbours (`citymesh check` measures them).
   std::size_t max_parent_triangles = 262144;
+  /// Where parents' simplifications are looked up first and kept after (null: none): a parent
+  /// whose children did not change since the run that kept it is not simplified again. Never
+  /// changes a tile.
+  SimplifyCache* simplified = nullptr;
 };
 
 /// Called once per node as soon as the tree no longer reads its mesh (its parent is built, or
