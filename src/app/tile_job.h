@@ -106,6 +106,10 @@ struct TileResultSections {
 /// before acquisitions were appended gets empty pieces for them.
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t digest,
                                            const TileStore& store, TileResultSections sections = {});
+/// Whether `file` holds a whole result made under `digest`: its checksum (which covers every
+/// section), magic, digest and section sizes pass, nothing decoded. What resuming asks of
+/// every tile; a city's results took seconds to decode for that.
+bool tile_result_is_finished(const std::filesystem::path& file, std::uint64_t digest, const TileStore& store);
 /// Only the labels of that result (same checks; the other sections are not decoded): what
 /// a later-phase neighbour needs.
 std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t digest,

@@ -290,6 +290,10 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   return r;
 }
 
+bool tile_result_is_finished(const std::filesystem::path& file, std::uint64_t digest, const TileStore& store) {
+  return checked_result(file, digest, store).has_value();
+}
+
 std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t digest,
                                                         const TileStore& store) {
   const std::optional<CheckedResult> checked = checked_result(file, digest, store);

@@ -100,10 +100,9 @@ SettledSelection settled_selection(const Config& config, const TileStore& store,
 }
 
 /// Whether tile `key` has a finished result made under `digest`: complete (the checksum
-/// covers the whole file) and decodable, its consistent pairs left undecoded (the largest
-/// section, which only the labelled PLYs read).
+/// covers the whole file); it is decoded once, by the final pass.
 bool has_finished_result(const Config& config, const TileStore& store, TileKey key, std::uint64_t digest) {
-  return read_tile_result(result_path(config, key), digest, store, {.pairs = false}).has_value();
+  return tile_result_is_finished(result_path(config, key), digest, store);
 }
 
 /// Per item of `tiles` (positions in store.tiles): 1 when its tile has a finished result.

@@ -65,7 +65,13 @@ void write_labels(const Config& config, const TileAssembly& assembly, const Pict
 /// Adds one tile's result to the assembly and its entry to the run report.
 void add_tile_result(const Config& config, const TileContents& tile, bool processed, std::optional<TileResult> r,
                      TileAssembly& assembly, std::vector<nlohmann::json>& per_tile) {
-  if (!r) throw ProcessingError(fmt::format("{}: the tile result vanished", result_path(config, tile.key).string()));
+  if (!r) {
+    // Checked whole before the pass began: gone since, or whole but not decodable (a warning
+    // above says why; only a fault of citymesh writes such a file).
+    throw ProcessingError(
+        fmt::format("{}: the tile result cannot be read any more; remove it and run again to process the tile anew",
+                    result_path(config, tile.key).string()));
+  }
   nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
   if (processed) {
     entry["seconds"] = {{"read", r->seconds_read}, {"detect", r->seconds_detect}, {"mosaic", r->seconds_mosaic}};
@@ -370,9 +376,8 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
   const std::vector<std::uint64_t> digests = tile_digests(*store, fingerprints.settings, fingerprints.acquisitions);
   std::vector<std::string> missing;
   for (std::size_t k = 0; k < store->tiles.size(); ++k) {
-    // Whole and decodable (the checksum covers every section): the pairs, the largest, are
-    // decoded once, when the outputs read the results.
-    if (!read_tile_result(result_path(config, store->tiles[k].key), digests[k], *store, {.pairs = false}))
+    // Whole (the checksum covers every section): decoded once, when the outputs read them.
+    if (!tile_result_is_finished(result_path(config, store->tiles[k].key), digests[k], *store))
       missing.push_back(store->tiles[k].key.name());
   }
   if (!missing.empty()) {

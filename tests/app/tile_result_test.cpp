@@ -112,6 +112,28 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
     // Another config's result is not this run's.
     EXPECT_FALSE(read_tile_result(tmp / "t.bin", kFingerprint + 1, store).has_value());
     EXPECT_FALSE(read_tile_labels(tmp / "t.bin", kFingerprint + 1, store).has_value());
+    // Resuming asks only whether it is whole and this run's.
+    EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
+    EXPECT_FALSE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 1, store));
+    EXPECT_FALSE(tile_result_is_finished(tmp / "none.bin", kFingerprint, store));
+  }
+}
+
+TEST(TileResult, ATornOrDamagedResultIsNotFinished) {
+  test::TempDir tmp;
+  const TileStore store = two_acquisitions();
+  write_tile_result(tmp / "t.bin", random_result(6, true), kFingerprint);
+  const std::string good = *read_file_bytes(tmp / "t.bin");
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::string bytes = good;
+    if (trial % 2 == 0) {
+      bytes.resize(rng() % bytes.size());  // a write cut short
+    } else {
+      bytes[rng() % bytes.size()] ^= static_cast<char>(1 + rng() % 255);  // any byte, the checksum's too
+    }
+    std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
+    EXPECT_FALSE(tile_result_is_finished(tmp / "bad.bin", kFingerprint, store)) << "trial " << trial;
   }
 }
 
