@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/FindActiveValues.h>
 
 #include <array>
 #include <cmath>
@@ -30,7 +31,8 @@ openvdb::CoordBBox coord_box(const VoxelBox& v) {
   return {openvdb::Coord(v.lo[0], v.lo[1], v.lo[2]), openvdb::Coord(v.hi[0], v.hi[1], v.hi[2])};
 }
 
-/// Above this many voxels a box query walks the active voxels instead of the box.
+/// Up to this many voxels a box query asks each voxel through the cached accessor; above it,
+/// it descends the tree's node masks.
 constexpr std::int64_t kDenseQueryLimit = 4096;
 /// Boxes remembered to skip marking the same box twice in a row.
 constexpr std::size_t kRecentBoxes = 1024;
@@ -110,12 +112,9 @@ bool any_on(const openvdb::BoolGrid& grid, openvdb::BoolGrid::ConstAccessor& acc
     }
     return false;
   }
-  for (auto it = grid.tree().cbeginValueOn(); it; ++it) {
-    openvdb::CoordBBox active;
-    it.getBoundingBox(active);  // a voxel or a whole active tile
-    if (box.hasOverlap(active)) return true;
-  }
-  return false;
+  // Only the nodes the box meets: walking every active value of the grid instead made each
+  // query cost the whole grid (with 5 cm voxels, a street's change step went 0.3 -> 21 s).
+  return openvdb::tools::anyActiveValues(grid.tree(), box);  // voxels and active tiles alike
 }
 
 }  // namespace
