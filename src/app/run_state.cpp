@@ -66,6 +66,27 @@ std::string trim(std::string s) {
   return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
 }
 
+/// How an acquisition's file is named in the keys: the file, not the spelling, so that the
+/// same config given as out/config.toml or as /data/out/config.toml (another working
+/// directory) resumes the same work; and relative to the config's folder when the file lies
+/// under it, so that a project folder moved or renamed whole (config, acquisitions, work)
+/// resumes too. A file elsewhere is named by its absolute path.
+std::string path_key(const std::filesystem::path& file, const std::filesystem::path& config_dir) {
+  const std::filesystem::path absolute = std::filesystem::absolute(file).lexically_normal();
+  if (config_dir.empty()) return absolute.generic_string();
+  const std::filesystem::path relative =
+      absolute.lexically_relative(std::filesystem::absolute(config_dir).lexically_normal());
+  const bool under = !relative.empty() && *relative.begin() != "..";
+  return under ? relative.generic_string() : absolute.generic_string();
+}
+
+/// Whether `before`, an absolute path, names the file `now` names relative to the config's
+/// folder (a work folder recorded before session 60).
+bool named_before_relative_paths(const std::string& before, const std::string& now) {
+  const std::filesystem::path old_path(before), new_path(now);
+  return old_path.is_absolute() && new_path.is_relative() && before.ends_with("/" + now);
+}
+
 }  // namespace
 
 std::map<std::string, std::string> result_keys(const Config& config) {
@@ -86,9 +107,7 @@ std::map<std::string, std::string> result_keys(const Config& config) {
   }
   for (std::size_t k = 0; k < config.acquisitions.size(); ++k) {
     const auto& path = config.acquisitions[k].path;
-    // The file, not the spelling: the same config given as out/config.toml or as
-    // /data/out/config.toml (another working directory) resumes the same work.
-    keys[fmt::format("acquisition[{}].path", k)] = std::filesystem::absolute(path).lexically_normal().generic_string();
+    keys[fmt::format("acquisition[{}].path", k)] = path_key(path, config.base_dir);
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     const auto time = std::filesystem::last_write_time(path, ec).time_since_epoch().count();
@@ -146,6 +165,10 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
                     v);
         continue;
       }
+      // Before session 60 every file was named by its absolute path: the same file, now named
+      // relative to the config's folder, is no changed key (its tiles are redone once, their
+      // digests having changed).
+      if (k.ends_with(".path") && it != before.end() && named_before_relative_paths(it->second, v)) continue;
       const std::string what = it == before.end() ? fmt::format("{} (new: {})", k, v)
                                : it->second != v  ? fmt::format("{} ({} -> {})", k, it->second, v)
                                                   : std::string();

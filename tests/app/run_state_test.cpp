@@ -57,6 +57,22 @@ TEST(RunState, AnAcquisitionAppendedResumesAndOneChangedRemovedOrInsertedIsRefus
   EXPECT_NO_THROW(check_run_config(work.path(), keys_of(2), true));
 }
 
+TEST(RunState, AFileNamedByItsAbsolutePathBeforeAndRelativeNowIsTheSameFile) {
+  test::TempDir work;
+  Keys before = keys_of(2);
+  before["acquisition[1].path"] = "/data/city/pass1.ply";
+  check_run_config(work.path(), before, false);
+  Keys now = before;
+  now["acquisition[1].path"] = "pass1.ply";  // under the config's folder, /data/city
+  EXPECT_NO_THROW(check_run_config(work.path(), now, false));
+  for (const char* name : {"pass2.ply", "ass1.ply", "city/pass2.ply"}) {
+    check_run_config(work.path(), before, true);  // recorded by absolute path again
+    Keys other = before;
+    other["acquisition[1].path"] = name;
+    EXPECT_THROW(check_run_config(work.path(), other, false), ConfigError) << name << ": another file";
+  }
+}
+
 TEST(RunState, AppendingAnAcquisitionKeepsTheOtherFingerprints) {
   const RunFingerprints three = run_fingerprints(keys_of(3), 3), four = run_fingerprints(keys_of(4), 4);
   EXPECT_EQ(three.settings, four.settings);
