@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/tiler/tiler.h"
@@ -17,7 +18,7 @@
 namespace citymesh {
 
 namespace {
-constexpr int kManifestVersion = 2;  // 2: one block file per acquisition
+constexpr int kManifestVersion = 3;  // 2: one block file per acquisition; 3: checksummed
 constexpr const char* kManifestFile = "manifest.json";
 constexpr const char* kSummaryFile = "summary.json";
 constexpr int kSummaryVersion = 2;
@@ -95,6 +96,15 @@ std::optional<std::size_t> acquisition_folder_index(const std::string& name) {
     k = k * 10 + static_cast<std::size_t>(name[c] - '0');
   }
   return k;
+}
+
+/// The XXH3 of a manifest's content (every member but "checksum", as compact JSON; members
+/// are sorted and numbers written to round-trip, so parsing and dumping again gives the same
+/// text), in hex.
+std::string manifest_checksum(nlohmann::json j) {
+  j.erase("checksum");
+  const std::string text = j.dump();
+  return fmt::format("{:016x}", bulk_checksum(text.data(), text.size()));
 }
 
 /// Whether the manifest in `dir` is readable, of this build's version and made with
@@ -188,6 +198,7 @@ void write_tile_manifest(const TileStore& store) {
     tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}, {"blocks", std::move(blocks)}});
   }
   j["tiles"] = std::move(tiles);
+  j["checksum"] = manifest_checksum(j);
   write_file_atomically(store.dir / kManifestFile, j.dump(1) + "\n");
 }
 
@@ -209,6 +220,11 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
           fmt::format("{}: manifest version {} (this build writes {}); delete the work folder or run "
                       "with --force",
                       file.string(), j.at("version").dump(), kManifestVersion));
+    }
+    // Every block is found through it: damage that still parses would read other bytes.
+    if (!j.contains("checksum") || j.at("checksum") != manifest_checksum(j)) {
+      log::warn("{}: damaged (its checksum does not match): the tile store is made again", file.string());
+      return std::nullopt;
     }
     TileStore store;
     store.dir = dir;
@@ -234,6 +250,10 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
       store.tiles.push_back(std::move(c));
     }
     return store;
+  } catch (const nlohmann::json::parse_error& e) {
+    // Written atomically by citymesh: a file that does not parse was damaged since.
+    log::warn("{}: damaged ({}): the tile store is made again", file.string(), e.what());
+    return std::nullopt;
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: malformed tile manifest: {}", file.string(), e.what()));
   } catch (const std::invalid_argument& e) {

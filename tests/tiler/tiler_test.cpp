@@ -260,15 +260,39 @@ TEST(Tiler, AManifestOfAnOlderLayoutIsNoFinishedStoreAndOneOfANewerIsAnError) {
   const std::string text = test::read_text(manifest);
   const auto with_version = [&](int version) {
     std::string changed = text;
-    const std::size_t at = changed.find("\"version\": 2");
+    const std::size_t at = changed.find("\"version\": 3");
     EXPECT_NE(at, std::string::npos);
     changed.replace(at, 12, "\"version\": " + std::to_string(version));
     test::write_text(manifest, changed);
   };
   with_version(1);  // a file per tile and acquisition: its acquisitions are tiled again
   EXPECT_FALSE(read_tile_manifest(store.dir).has_value());
-  with_version(3);  // a newer build's: not ours to replace
+  with_version(2);  // no checksum
+  EXPECT_FALSE(read_tile_manifest(store.dir).has_value());
+  with_version(4);  // a newer build's: not ours to replace
   EXPECT_THROW((void)read_tile_manifest(store.dir), InputError);
+}
+
+TEST(Tiler, ADamagedManifestIsNoFinishedStoreEvenWhenItStillParses) {
+  Fixture f;
+  TileStore store = tile_acquisitions(f.acquisitions, f.params);
+  write_tile_manifest(store);
+  ASSERT_TRUE(read_tile_manifest(store.dir).has_value());
+  const auto manifest = store.dir / "manifest.json";
+  const std::string text = test::read_text(manifest);
+  // A digit of a block's offset changed: still valid JSON, but the blocks would be misread.
+  const std::size_t blocks = text.find("\"blocks\"");
+  ASSERT_NE(blocks, std::string::npos);
+  std::size_t digit = text.find_first_of("123456789", blocks);
+  ASSERT_NE(digit, std::string::npos);
+  std::string changed = text;
+  changed[digit] = changed[digit] == '9' ? '8' : static_cast<char>(changed[digit] + 1);
+  test::write_text(manifest, changed);
+  EXPECT_FALSE(read_tile_manifest(store.dir).has_value());
+  test::write_text(manifest, text.substr(0, text.size() / 2));  // cut short: does not parse
+  EXPECT_FALSE(read_tile_manifest(store.dir).has_value());
+  test::write_text(manifest, text);
+  EXPECT_TRUE(read_tile_manifest(store.dir).has_value());
 }
 
 TEST(Tiler, DamagedBlocksAreInputErrorsNamingTheFileAndTile) {

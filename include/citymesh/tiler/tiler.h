@@ -119,9 +119,10 @@ std::filesystem::path acquisition_blocks_path(const std::filesystem::path& dir, 
 
 /// Writes <store.dir>/manifest.json atomically: the store counts as finished only then.
 void write_tile_manifest(const TileStore& store);
-/// The finished store in `dir`, or nothing when it has no manifest or one of an older layout
-/// (its acquisitions are then tiled again). Throws InputError naming the manifest when it is
-/// malformed or of a newer layout.
+/// The finished store in `dir`, or nothing when it has no manifest, one of an older layout, or
+/// a damaged one (it does not parse, or its checksum does not match: said in a warning); its
+/// acquisitions are then tiled again. Throws InputError naming the manifest when it is of a
+/// newer layout, or checksummed but inconsistent (a fault of citymesh).
 std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir);
 
 /// Reads one tile: a piece per acquisition (empty when the tile holds none of it), all in the
