@@ -21,7 +21,16 @@ namespace {
 constexpr int kManifestVersion = 3;  // 2: one block file per acquisition; 3: checksummed
 constexpr const char* kManifestFile = "manifest.json";
 constexpr const char* kSummaryFile = "summary.json";
-constexpr int kSummaryVersion = 2;
+constexpr int kSummaryVersion = 3;  // 3: checksummed, as the manifest
+
+/// The XXH3 of a manifest's or summary's content (every member but "checksum", as compact JSON; members
+/// are sorted and numbers written to round-trip, so parsing and dumping again gives the same
+/// text), in hex.
+std::string content_checksum(nlohmann::json j) {
+  j.erase("checksum");
+  const std::string text = j.dump();
+  return fmt::format("{:016x}", bulk_checksum(text.data(), text.size()));
+}
 
 nlohmann::json stats_json(const TilingStats& s) {
   return {{"input_bytes", s.input_bytes},
@@ -71,6 +80,8 @@ std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folde
     if (j.at("version").get<int>() != kSummaryVersion || j.at("fingerprint").get<std::string>() != fingerprint) {
       return std::nullopt;
     }
+    // Its block ranges go into the manifest: damage that still parses would misdirect them.
+    if (j.at("checksum") != content_checksum(j)) throw std::runtime_error("its checksum does not match");
     AcquisitionTiling t;
     t.fingerprint = fingerprint;
     t.triangles = j.at("triangles").get<std::uint64_t>();
@@ -98,15 +109,6 @@ std::optional<std::size_t> acquisition_folder_index(const std::string& name) {
   return k;
 }
 
-/// The XXH3 of a manifest's content (every member but "checksum", as compact JSON; members
-/// are sorted and numbers written to round-trip, so parsing and dumping again gives the same
-/// text), in hex.
-std::string manifest_checksum(nlohmann::json j) {
-  j.erase("checksum");
-  const std::string text = j.dump();
-  return fmt::format("{:016x}", bulk_checksum(text.data(), text.size()));
-}
-
 /// Whether the manifest in `dir` is readable, of this build's version and made with
 /// `fingerprint` (read_tile_manifest() has said what it thinks of it already).
 bool manifest_made_with(const std::filesystem::path& dir, const std::string& fingerprint) {
@@ -131,7 +133,9 @@ void write_acquisition_tiling(const std::filesystem::path& dir, const Acquisitio
                          {"triangles", tiling.triangles},
                          {"stats", stats_json(tiling.stats)},
                          {"tiles", std::move(tiles)}};
-  write_file_atomically(dir / kSummaryFile, j.dump() + "\n");
+  nlohmann::json with_checksum = j;
+  with_checksum["checksum"] = content_checksum(j);
+  write_file_atomically(dir / kSummaryFile, with_checksum.dump() + "\n");
 }
 
 std::optional<AcquisitionTiling> read_acquisition_tiling(const std::filesystem::path& dir, std::uint32_t acquisition,
@@ -198,7 +202,7 @@ void write_tile_manifest(const TileStore& store) {
     tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}, {"blocks", std::move(blocks)}});
   }
   j["tiles"] = std::move(tiles);
-  j["checksum"] = manifest_checksum(j);
+  j["checksum"] = content_checksum(j);
   write_file_atomically(store.dir / kManifestFile, j.dump(1) + "\n");
 }
 
@@ -222,7 +226,7 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
                       file.string(), j.at("version").dump(), kManifestVersion));
     }
     // Every block is found through it: damage that still parses would read other bytes.
-    if (!j.contains("checksum") || j.at("checksum") != manifest_checksum(j)) {
+    if (!j.contains("checksum") || j.at("checksum") != content_checksum(j)) {
       log::warn("{}: damaged (its checksum does not match): the tile store is made again", file.string());
       return std::nullopt;
     }

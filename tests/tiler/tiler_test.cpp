@@ -481,5 +481,24 @@ TEST(Tiler, PruneKeepsEachAcquisitionTiledWithItsOwnFingerprint) {
   EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 0, "other").has_value());
 }
 
+TEST(Tiler, ADamagedAcquisitionSummaryIsNotReusedEvenWhenItStillParses) {
+  Fixture f;
+  std::filesystem::remove_all(f.params.dir);
+  (void)tile_acquisition(f.acquisitions[0], f.params, "a0");
+  ASSERT_TRUE(read_acquisition_tiling(f.params.dir, 0, "a0").has_value());
+  const auto summary = acquisition_tiles_path(f.params.dir, 0) / "summary.json";
+  const std::string text = test::read_text(summary);
+  const std::size_t blocks = text.find("\"blocks\"");
+  ASSERT_NE(blocks, std::string::npos);
+  const std::size_t digit = text.find_first_of("123456789", blocks);
+  ASSERT_NE(digit, std::string::npos);
+  std::string changed = text;
+  changed[digit] = changed[digit] == '9' ? '8' : static_cast<char>(changed[digit] + 1);
+  test::write_text(summary, changed);
+  EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 0, "a0").has_value()) << "a block's range changed";
+  test::write_text(summary, text);
+  EXPECT_TRUE(read_acquisition_tiling(f.params.dir, 0, "a0").has_value());
+}
+
 }  // namespace
 }  // namespace citymesh
