@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
@@ -30,6 +31,7 @@
 #include "tile_job.h"
 #include "tiled_detect_output.h"
 #include "tileset_output.h"
+#include "work_lock.h"
 
 namespace citymesh::app {
 
@@ -334,6 +336,9 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   Stopwatch clock;
   check_seam_pass(config);
   const auto keys = result_keys(config);
+  // The root holds the lock for the whole job (its ranks share the work); subsets share it.
+  std::optional<WorkFolderLock> lock;
+  if (cluster.root()) lock.emplace(config.project.work, !options.subset);
   if (cluster.root()) {
     check_run_config(config.project.work, keys, options.force);
     remove_leftovers_of_ended_runs(config);
@@ -363,6 +368,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
 void merge_tiled(const Config& config, const PictureOptions& pictures) {
   check_seam_pass(config);
   const auto keys = result_keys(config);
+  const WorkFolderLock lock(config.project.work, true);
   check_run_config(config.project.work, keys, false);
   remove_leftovers_of_ended_runs(config);
   const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
