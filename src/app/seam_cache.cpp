@@ -16,8 +16,28 @@ namespace citymesh::app {
 
 namespace {
 
-constexpr std::string_view kCacheMagic = "CMSTCH01";
+constexpr std::string_view kCacheMagic = "CMSTCH02";  // 02: new vertices named by their part's rank
 constexpr std::string_view kCacheSuffix = ".part";
+
+}  // namespace
+
+namespace {
+
+/// Part keys as [level, x, y] rows.
+nlohmann::json key_parts_json(std::span<const BlockPartKey> keys) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const BlockPartKey& k : keys) rows.push_back({k.level, k.x, k.y});
+  return rows;
+}
+
+std::vector<BlockPartKey> key_parts_from(const nlohmann::json& rows) {
+  std::vector<BlockPartKey> keys;
+  for (const auto& r : rows) {
+    if (r.size() != 3) throw ProcessingError("a seam part's outcome: a part key is not [level, x, y]");
+    keys.push_back({r.at(0).get<int>(), r.at(1).get<std::int64_t>(), r.at(2).get<std::int64_t>()});
+  }
+  return keys;
+}
 
 }  // namespace
 
@@ -31,7 +51,8 @@ nlohmann::json outcome_json(const PartOutcome& o) {
           {"box", box_bits(o.box)},
           {"cut_triangles", o.cut_triangles},
           {"digest", o.digest},
-          {"reused", o.reused}};
+          {"reused", o.reused},
+          {"key_parts", key_parts_json(o.key_parts)}};
 }
 
 PartOutcome outcome_from(const nlohmann::json& j) {
@@ -46,6 +67,7 @@ PartOutcome outcome_from(const nlohmann::json& j) {
   o.cut_triangles = j.at("cut_triangles").get<std::size_t>();
   o.digest = j.at("digest").get<std::uint64_t>();
   o.reused = j.at("reused").get<bool>();
+  o.key_parts = key_parts_from(j.at("key_parts"));
   return o;
 }
 

@@ -120,9 +120,11 @@ KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces) {
   return out;
 }
 
-std::uint64_t keyed_piece_digest(const KeyedPiece& piece) {
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece) { return keyed_piece_digest(piece, piece.keys); }
+
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> keys) {
   BulkChecksum sum;
-  sum.add_array(std::span(piece.keys));
+  sum.add_array(keys);
   sum.add_array(std::span(piece.positions));
   sum.add_array(std::span(piece.sensors));
   sum.add_array(std::span(piece.times));

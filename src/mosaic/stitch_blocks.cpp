@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <tuple>
 
@@ -146,29 +147,108 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.rejected += s.rejected;
 }
 
+/// The part index a new vertex's key names (kNewVertexKey | part << 32 | k).
+std::uint64_t part_of_new_key(std::uint64_t key) { return (key & ~kNewVertexKey) >> 32; }
+
+/// Keys whose new vertices name their part by its rank among `parts` (in key order) instead
+/// of by its index in a run's list: what two runs agree on when parts appeared or went
+/// elsewhere in the list. Ranks keep the keys' order (the list is in key order).
+struct RelativeKeys {
+  std::vector<std::uint64_t> keys;
+  std::vector<BlockPartKey> parts;
+};
+
+RelativeKeys relative_keys(std::span<const std::uint64_t> keys, std::span<const BlockPart> parts) {
+  std::vector<std::uint64_t> named;  // part indices, ascending
+  for (const std::uint64_t k : keys) {
+    if (k >= kNewVertexKey && (named.empty() || named.back() != part_of_new_key(k)))
+      named.push_back(part_of_new_key(k));
+  }
+  std::sort(named.begin(), named.end());
+  named.erase(std::unique(named.begin(), named.end()), named.end());
+  RelativeKeys out;
+  out.keys.reserve(keys.size());
+  for (const std::uint64_t k : keys) {
+    if (k < kNewVertexKey) {
+      out.keys.push_back(k);
+      continue;
+    }
+    const auto rank =
+        static_cast<std::uint64_t>(std::lower_bound(named.begin(), named.end(), part_of_new_key(k)) - named.begin());
+    out.keys.push_back(kNewVertexKey | rank << 32 | (k & 0xFFFFFFFFu));
+  }
+  for (const std::uint64_t q : named) {
+    if (q >= parts.size()) throw ProcessingError("stitching block by block: a new vertex names no part of the run");
+    out.parts.push_back(parts[q].key);
+  }
+  return out;
+}
+
+/// The keys of this run from relative ones; nothing when a part they name is not in the
+/// run's list (`parts`, in key order).
+std::optional<std::vector<std::uint64_t>> absolute_keys(std::span<const std::uint64_t> keys,
+                                                        std::span<const BlockPartKey> named,
+                                                        std::span<const BlockPart> parts) {
+  std::vector<std::uint64_t> index;
+  for (const BlockPartKey& key : named) {
+    const auto it = std::lower_bound(parts.begin(), parts.end(), key,
+                                     [](const BlockPart& part, const BlockPartKey& k) { return part.key < k; });
+    if (it == parts.end() || it->key != key) return std::nullopt;
+    index.push_back(static_cast<std::uint64_t>(it - parts.begin()));
+  }
+  std::vector<std::uint64_t> out;
+  out.reserve(keys.size());
+  for (const std::uint64_t k : keys) {
+    if (k < kNewVertexKey) {
+      out.push_back(k);
+      continue;
+    }
+    const std::uint64_t rank = part_of_new_key(k);
+    if (rank >= index.size()) return std::nullopt;
+    out.push_back(kNewVertexKey | index[rank] << 32 | (k & 0xFFFFFFFFu));
+  }
+  return out;
+}
+
+/// A digest of `piece` with its new vertices named by their part's key (relative_keys).
+std::uint64_t piece_digest_by_part_keys(const KeyedPiece& piece, std::span<const BlockPart> parts) {
+  const RelativeKeys relative = relative_keys(piece.keys, parts);
+  BulkChecksum sum;
+  sum.add_value(keyed_piece_digest(piece, relative.keys));
+  for (const BlockPartKey& k : relative.parts) {
+    sum.add_value(std::int64_t{k.level});  // field by field: the struct has padding
+    sum.add_value(k.x);
+    sum.add_value(k.y);
+  }
+  return sum.value();
+}
+
 /// The digest a PartCache finds part p by: everything its stitching reads besides the
 /// settings. Clipping compares the sources' sizes only, so of those the order of the sources
 /// present counts, not the sizes: a pass appended elsewhere changes every size, not this.
-std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double context, const KeyedPiece& own,
-                          std::span<const BlockPartKey> around_keys, std::span<const Neighbour> around,
-                          std::span<const std::uint64_t> source_sizes) {
+/// Parts are named by their keys, never by their index: an index is only the part's place in
+/// this run's list, and stitching depends on the order of the parts only.
+std::uint64_t part_digest(std::span<const BlockPart> parts, std::size_t p, const Vec3d& origin, double context,
+                          const KeyedPiece& own, std::span<const std::uint32_t> around_parts,
+                          std::span<const Neighbour> around, std::span<const std::uint64_t> source_sizes) {
   // Bumped when stitching a part reads something more (the cache also mixes in the build).
-  constexpr std::uint64_t kFormat = 1;
+  constexpr std::uint64_t kFormat = 2;
   BulkChecksum sum;
   sum.add_value(kFormat);
-  sum.add_value(std::uint64_t{p});
-  sum.add_value(std::int64_t{level});
+  const auto add_key = [&](const BlockPartKey& k) {
+    sum.add_value(std::int64_t{k.level});  // field by field: the struct has padding
+    sum.add_value(k.x);
+    sum.add_value(k.y);
+  };
+  add_key(parts[p].key);
   sum.add_value(origin);
   sum.add_value(context);
-  sum.add_value(keyed_piece_digest(own));
+  sum.add_value(piece_digest_by_part_keys(own, parts));
   std::vector<std::int32_t> sources(own.source_acq.begin(), own.source_acq.end());
   for (std::size_t i = 0; i < around.size(); ++i) {
-    // The part around by key, not index: an index is only the part's place in this run's list.
-    sum.add_value(std::int64_t{around_keys[i].level});  // field by field: the struct has padding
-    sum.add_value(around_keys[i].x);
-    sum.add_value(around_keys[i].y);
+    add_key(parts[around_parts[i]].key);
     sum.add_value(around[i].role);
-    sum.add_value(keyed_piece_digest(*around[i].piece));
+    sum.add_value(piece_digest_by_part_keys(*around[i].piece, parts));
     sources.insert(sources.end(), around[i].piece->source_acq.begin(), around[i].piece->source_acq.end());
   }
   std::sort(sources.begin(), sources.end());
@@ -181,6 +261,29 @@ std::uint64_t part_digest(std::size_t p, int level, const Vec3d& origin, double 
   });
   sum.add_array(std::span<const std::int32_t>(sources));
   return sum.value();
+}
+
+/// Part p as `cache` kept it, its keys those of this run; nothing when it is not kept (or
+/// names a part this run does not have).
+std::optional<std::pair<KeyedPiece, PartOutcome>> find_kept(const PartCache& cache, std::span<const BlockPart> parts,
+                                                            std::size_t p, std::uint64_t digest) {
+  auto kept = cache.find(parts[p].key, digest);
+  if (!kept) return std::nullopt;
+  std::optional<std::vector<std::uint64_t>> keys = absolute_keys(kept->first.keys, kept->second.key_parts, parts);
+  if (!keys) return std::nullopt;
+  kept->first.keys = std::move(*keys);
+  kept->second.key_parts.clear();
+  return kept;
+}
+
+/// Keeps stitched part p in `cache`, its new vertices named by their part's rank.
+void keep_stitched(PartCache& cache, std::span<const BlockPart> parts, std::size_t p, const KeyedPiece& stitched,
+                   PartOutcome outcome) {
+  RelativeKeys relative = relative_keys(stitched.keys, parts);
+  KeyedPiece kept = stitched;
+  kept.keys = std::move(relative.keys);
+  outcome.key_parts = std::move(relative.parts);
+  cache.keep(parts[p].key, kept, outcome);
 }
 
 /// Loads part p and the parts around it as level `level` sees them, stitches it (or takes it
@@ -200,10 +303,8 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   const Vec3d origin = run.frame ? *run.frame : whole_metre_origin(parts[p].box.min);
   PartOutcome out;
   if (run.cache != nullptr) {
-    std::vector<BlockPartKey> around_keys;
-    for (const std::uint32_t q : around_parts) around_keys.push_back(parts[q].key);
-    out.digest = part_digest(p, level, origin, context, *own, around_keys, around, run.source_sizes);
-    if (auto kept = run.cache->find(parts[p].key, out.digest)) {
+    out.digest = part_digest(parts, p, origin, context, *own, around_parts, around, run.source_sizes);
+    if (auto kept = find_kept(*run.cache, parts, p, out.digest)) {
       kept->second.digest = out.digest;
       kept->second.reused = true;
       store.save_stitched(p, std::move(kept->first));
@@ -216,7 +317,7 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   out.stats = stitch_cut(cut, run.params, run.source_sizes);
   KeyedPiece stitched = mosaic_detail::stitched_piece(cut, p);
   out.box = stitched.box();
-  if (run.cache != nullptr) run.cache->keep(parts[p].key, stitched, out);
+  if (run.cache != nullptr) keep_stitched(*run.cache, parts, p, stitched, out);
   store.save_stitched(p, std::move(stitched));
   return out;
 }

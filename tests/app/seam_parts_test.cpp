@@ -293,6 +293,13 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   EXPECT_EQ(counted, gathered.mesh.triangle_count());
 }
 
+/// Triangle t's centroid in the frame of the parts (the scene's world positions).
+Vec3d centroid_of(const MergedMesh& m, std::uint32_t t) {
+  Vec3d c{};
+  for (const std::uint32_t v : m.mesh.triangles[t]) c = c + m.mesh.world_position(v) * (1.0 / 3.0);
+  return c;
+}
+
 /// The four-source scene without the triangles `drop` names, stitched from files (cache:
 /// optional), the cache pruned to what this run used; the output gathered.
 struct CachedStitch {
@@ -301,8 +308,8 @@ struct CachedStitch {
   std::size_t parts = 0;
 };
 template <class Drop>
-CachedStitch stitch_scene(const test::TempDir& dir, const std::string& name, Drop drop, SeamPartCache* cache) {
-  const MergedMesh scene = test::four_source_scene();
+CachedStitch stitch_scene(const test::TempDir& dir, const std::string& name, Drop drop, SeamPartCache* cache,
+                          const MergedMesh& scene = test::four_source_scene()) {
   SeamPartFiles files(dir / name, blocks());
   files.add_tile({0, 0}, tile_pieces(scene, [&](std::uint32_t t) { return !drop(scene, t); }));
   std::vector<BlockPart> parts = files.finish();
@@ -381,6 +388,47 @@ TEST(SeamCache, PartsWhoseInputsChangedAreStitchedAgainTheOthersTakenToTheSameOu
   // Other settings: nothing of the earlier runs is theirs.
   SeamPartCache other(dir / "cache", 8);
   EXPECT_EQ(stitch_scene(dir, "other", hole, &other).stats.reused_parts, 0u);
+}
+
+TEST(SeamCache, PartsAreReusedWhenAPartAppearsOrGoesBeforeThemInTheList) {
+  // The first part of the list (the block interior with the smallest key) emptied, then
+  // filled again: every later part moves one place in the list, and the new vertices of the
+  // parts stitched before them are named after their index. Parts away from it are reused
+  // all the same, and the output is that of stitching without the cache.
+  test::TempDir dir;
+  const auto none = [](const MergedMesh&, std::uint32_t) { return false; };
+  // Source 2 with another spacing than source 0's beside it: snapping splits their edges.
+  MergedMesh scene;
+  test::add_grid(scene, 0, 0, 30, 30, 0.1f, 0, 0);
+  test::add_grid(scene, 3.015f, 0.013f, 19, 23, 0.13f, 1, 0.01f);
+  test::add_grid(scene, 0, 3.015f, 21, 12, 0.1428571f, 2, 0.01f);
+  // Small pieces of source 3 half over source 0's side y = 0: clipping cuts them along it,
+  // making new vertices in several parts.
+  for (const float x0 : {0.15f, 1.05f, 2.05f, 2.55f}) test::add_grid(scene, x0, -0.33f, 4, 7, 0.1f, 3, 0.05f);
+  BlockPartKey first{INT32_MAX, 0, 0};
+  for (std::uint32_t t = 0; t < scene.mesh.triangle_count(); ++t) {
+    first = std::min(first, block_part_of(centroid_of(scene, t), blocks()));
+  }
+  ASSERT_EQ(first.level, 0);
+  const auto empty_first = [&](const MergedMesh& m, std::uint32_t t) {
+    return block_part_of(centroid_of(m, t), blocks()) == first;
+  };
+  SeamPartCache cache(dir / "cache", 7);
+  const CachedStitch whole = stitch_scene(dir, "whole", none, &cache, scene);
+  const CachedStitch without_plain = stitch_scene(dir, "without-plain", empty_first, nullptr, scene);
+  const CachedStitch without = stitch_scene(dir, "without", empty_first, &cache, scene);
+  ASSERT_EQ(without.parts + 1, whole.parts) << "the first part is gone";
+  ASSERT_GT(whole.stats.stitch.edges_split, 0u) << "new vertices";
+  expect_same_output(without.out, without_plain.out);
+  EXPECT_GT(without.stats.reused_parts, without.parts / 3) << "parts away from it";
+  EXPECT_LT(without.stats.reused_parts, without.parts) << "its neighbours see it gone";
+
+  const CachedStitch back_plain = stitch_scene(dir, "back-plain", none, nullptr, scene);
+  const CachedStitch back = stitch_scene(dir, "back", none, &cache, scene);
+  ASSERT_EQ(back.parts, whole.parts);
+  expect_same_output(back.out, back_plain.out);
+  EXPECT_GT(back.stats.reused_parts, back.parts / 3);
+  EXPECT_LT(back.stats.reused_parts, back.parts);
 }
 
 }  // namespace

@@ -45,6 +45,8 @@ struct KeyedPiece {
 
 /// A digest of every array of `piece` (XXH3): equal pieces, equal digests.
 std::uint64_t keyed_piece_digest(const KeyedPiece& piece);
+/// The same with `keys` (one per vertex) in place of the piece's own.
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> keys);
 
 /// The triangles `triangles` of `piece` (in that order) on the vertices they use.
 KeyedPiece subset(const KeyedPiece& piece, std::span<const std::uint32_t> triangles);

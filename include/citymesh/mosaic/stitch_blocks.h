@@ -124,11 +124,17 @@ struct PartOutcome {
   /// whether the stitched part came from the cache.
   std::uint64_t digest = 0;
   bool reused = false;
+  /// With a PartCache: the parts whose new vertices the kept piece holds, in key order; the
+  /// kept piece names them by their rank here instead of by their index in the run's list
+  /// (kNewVertexKey | rank << 32 | k), so that a part is reused when parts appear or go
+  /// before it in the list.
+  std::vector<BlockPartKey> key_parts;
 };
 
 /// Stitched parts kept from earlier runs, found by a digest of everything a part's stitching
 /// reads (the part, the parts around it as its level sees them, the order of precedence of
-/// the sources among them, its index, level and frame): a run that changed only some parts
+/// the sources among them, its key and frame; new vertices named by the key of the part that
+/// made them, not by its index): a run that changed only some parts
 /// (an acquisition appended over one district) stitches again only the parts whose inputs
 /// changed, and gets the bytes of stitching them all. The implementation adds the settings.
 class PartCache {
