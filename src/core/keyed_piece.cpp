@@ -120,11 +120,14 @@ KeyedPiece merge_pieces(std::span<const KeyedPiece* const> pieces) {
   return out;
 }
 
-std::uint64_t keyed_piece_digest(const KeyedPiece& piece) { return keyed_piece_digest(piece, piece.keys); }
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece) { return keyed_piece_digest(piece, piece.keys, {}); }
 
-std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> keys) {
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> head,
+                                 std::span<const std::uint64_t> tail) {
   BulkChecksum sum;
-  sum.add_array(keys);
+  sum.add_value(std::uint64_t{head.size() + tail.size()});  // as add_array of the keys whole
+  sum.add(head.data(), head.size_bytes());
+  sum.add(tail.data(), tail.size_bytes());
   sum.add_array(std::span(piece.positions));
   sum.add_array(std::span(piece.sensors));
   sum.add_array(std::span(piece.times));

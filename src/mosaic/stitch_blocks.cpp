@@ -210,11 +210,14 @@ std::optional<std::vector<std::uint64_t>> absolute_keys(std::span<const std::uin
   return out;
 }
 
-/// A digest of `piece` with its new vertices named by their part's key (relative_keys).
+/// A digest of `piece` with its new vertices named by their part's key (relative_keys). Keys
+/// ascend, so the new vertices come last: only they are renamed.
 std::uint64_t piece_digest_by_part_keys(const KeyedPiece& piece, std::span<const BlockPart> parts) {
-  const RelativeKeys relative = relative_keys(piece.keys, parts);
+  const auto first_new = std::lower_bound(piece.keys.begin(), piece.keys.end(), kNewVertexKey);
+  const std::span<const std::uint64_t> head(piece.keys.begin(), first_new);
+  const RelativeKeys relative = relative_keys(std::span<const std::uint64_t>(first_new, piece.keys.end()), parts);
   BulkChecksum sum;
-  sum.add_value(keyed_piece_digest(piece, relative.keys));
+  sum.add_value(keyed_piece_digest(piece, head, relative.keys));
   for (const BlockPartKey& k : relative.parts) {
     sum.add_value(std::int64_t{k.level});  // field by field: the struct has padding
     sum.add_value(k.x);

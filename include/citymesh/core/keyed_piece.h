@@ -45,8 +45,10 @@ struct KeyedPiece {
 
 /// A digest of every array of `piece` (XXH3): equal pieces, equal digests.
 std::uint64_t keyed_piece_digest(const KeyedPiece& piece);
-/// The same with `keys` (one per vertex) in place of the piece's own.
-std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> keys);
+/// The same with `head` then `tail` (one key per vertex in all) in place of the piece's keys:
+/// a caller renaming some keys need not copy the others.
+std::uint64_t keyed_piece_digest(const KeyedPiece& piece, std::span<const std::uint64_t> head,
+                                 std::span<const std::uint64_t> tail);
 
 /// The triangles `triangles` of `piece` (in that order) on the vertices they use.
 KeyedPiece subset(const KeyedPiece& piece, std::span<const std::uint32_t> triangles);
