@@ -151,7 +151,10 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
       before = nlohmann::json::parse(in).at("keys").get<std::map<std::string, std::string>>();
     } catch (const nlohmann::json::exception& e) {
       if (!force)
-        throw InputError(fmt::format("{}: malformed ({}); run with --force to start over", file.string(), e.what()));
+        throw InputError(fmt::format(
+            "{}: malformed ({}); run with --force to record this config anew (the finished work whose inputs "
+            "match is still reused)",
+            file.string(), e.what()));
     }
     std::vector<std::string> changed;
     const std::size_t recorded = acquisition_count(before);
