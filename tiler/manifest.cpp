@@ -32,6 +32,15 @@ std::string content_checksum(nlohmann::json j) {
   return fmt::format("{:016x}", bulk_checksum(text.data(), text.size()));
 }
 
+/// Adds the "checksum" member to a manifest or summary about to be written.
+void stamp_checksum(nlohmann::json& j) { j["checksum"] = content_checksum(j); }
+
+/// Whether a manifest or summary read back holds its content's checksum: one damaged since it
+/// was written, even one that still parses, does not.
+bool checksum_matches(const nlohmann::json& j) {
+  return j.contains("checksum") && j.at("checksum") == content_checksum(j);
+}
+
 nlohmann::json stats_json(const TilingStats& s) {
   return {{"input_bytes", s.input_bytes},
           {"halo_copies", s.halo_copies},
@@ -81,7 +90,7 @@ std::optional<AcquisitionTiling> read_summary(const std::filesystem::path& folde
       return std::nullopt;
     }
     // Its block ranges go into the manifest: damage that still parses would misdirect them.
-    if (j.at("checksum") != content_checksum(j)) throw std::runtime_error("its checksum does not match");
+    if (!checksum_matches(j)) throw std::runtime_error("its checksum does not match");
     AcquisitionTiling t;
     t.fingerprint = fingerprint;
     t.triangles = j.at("triangles").get<std::uint64_t>();
@@ -128,14 +137,13 @@ void write_acquisition_tiling(const std::filesystem::path& dir, const Acquisitio
   for (const auto& [key, t] : tiling.tiles) {
     tiles.push_back({{"i", key.i}, {"j", key.j}, {"triangles", t.counts}, {"blocks", ranges_json(t.blocks)}});
   }
-  const nlohmann::json j{{"version", kSummaryVersion},
-                         {"fingerprint", tiling.fingerprint},
-                         {"triangles", tiling.triangles},
-                         {"stats", stats_json(tiling.stats)},
-                         {"tiles", std::move(tiles)}};
-  nlohmann::json with_checksum = j;
-  with_checksum["checksum"] = content_checksum(j);
-  write_file_atomically(dir / kSummaryFile, with_checksum.dump() + "\n");
+  nlohmann::json j{{"version", kSummaryVersion},
+                   {"fingerprint", tiling.fingerprint},
+                   {"triangles", tiling.triangles},
+                   {"stats", stats_json(tiling.stats)},
+                   {"tiles", std::move(tiles)}};
+  stamp_checksum(j);
+  write_file_atomically(dir / kSummaryFile, j.dump() + "\n");
 }
 
 std::optional<AcquisitionTiling> read_acquisition_tiling(const std::filesystem::path& dir, std::uint32_t acquisition,
@@ -202,7 +210,7 @@ void write_tile_manifest(const TileStore& store) {
     tiles.push_back({{"i", t.key.i}, {"j", t.key.j}, {"triangles", t.triangles}, {"blocks", std::move(blocks)}});
   }
   j["tiles"] = std::move(tiles);
-  j["checksum"] = content_checksum(j);
+  stamp_checksum(j);
   write_file_atomically(store.dir / kManifestFile, j.dump(1) + "\n");
 }
 
@@ -226,7 +234,7 @@ std::optional<TileStore> read_tile_manifest(const std::filesystem::path& dir) {
                       file.string(), j.at("version").dump(), kManifestVersion));
     }
     // Every block is found through it: damage that still parses would read other bytes.
-    if (!j.contains("checksum") || j.at("checksum") != content_checksum(j)) {
+    if (!checksum_matches(j)) {
       log::warn("{}: damaged (its checksum does not match): the tile store is made again", file.string());
       return std::nullopt;
     }

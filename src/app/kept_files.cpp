@@ -26,6 +26,10 @@ static_assert(sizeof(KeptHeader) == 24);
 
 }  // namespace
 
+void warn_made_again(const std::filesystem::path& path, std::string_view what, std::string_view why) {
+  log::warn("{}: {} of an earlier run, but {}: it is made again", path.string(), what, why);
+}
+
 void write_kept_file(const std::filesystem::path& path, std::string_view magic, std::string_view json,
                      std::string_view bytes) {
   KeptHeader h{};
@@ -62,7 +66,7 @@ std::optional<std::pair<nlohmann::json, std::string>> read_kept_file(const std::
   const std::optional<std::string> bytes = read_file_bytes(path);
   if (!bytes) return std::nullopt;
   const auto refuse = [&](std::string_view why) -> std::optional<std::pair<nlohmann::json, std::string>> {
-    log::warn("{}: {} of an earlier run, but {}: it is made again", path.string(), what, why);
+    warn_made_again(path, what, why);
     return std::nullopt;
   };
   KeptHeader h{};
@@ -101,10 +105,6 @@ void KeptFolder::keep(std::uint64_t digest, std::string_view json, std::string_v
   write_kept_file(file(digest), kind_.magic, json, bytes);
 }
 
-void KeptFolder::refuse(std::uint64_t digest, std::string_view why) const {
-  log::warn("{}: {} of an earlier run, but {}: it is made again", file(digest).string(), kind_.what, why);
-}
-
 void KeptFolder::prune(std::filesystem::file_time_type since) const {
   // Another node of a cluster may stamp by a clock a little behind this one's.
   const std::filesystem::file_time_type before = since - std::chrono::minutes(10);
@@ -123,15 +123,10 @@ ExportPrimitiveCache::ExportPrimitiveCache(const std::filesystem::path& dir)
     : files_(dir, {".glbp", "CMGLBP01", "an encoded tile"}) {}
 
 std::optional<GlbPrimitive> ExportPrimitiveCache::find(std::uint64_t digest) const {
-  auto kept = files_.find(digest);
-  if (!kept) return std::nullopt;
-  try {
-    return GlbPrimitive{kept->first.at("primitive"), kept->first.at("accessors"),
-                        std::vector<std::uint8_t>(kept->second.begin(), kept->second.end())};
-  } catch (const std::exception& e) {
-    files_.refuse(digest, e.what());
-    return std::nullopt;
-  }
+  return files_.find_as<GlbPrimitive>(digest, [](const nlohmann::json& json, const std::string& bytes) {
+    return GlbPrimitive{json.at("primitive"), json.at("accessors"),
+                        std::vector<std::uint8_t>(bytes.begin(), bytes.end())};
+  });
 }
 
 void ExportPrimitiveCache::keep(std::uint64_t digest, const GlbPrimitive& primitive) {
@@ -143,20 +138,15 @@ ExportSimplifyCache::ExportSimplifyCache(const std::filesystem::path& dir)
     : files_(dir, {".simp", "CMSIMP01", "a simplified tile"}) {}
 
 std::optional<SimplifiedMesh> ExportSimplifyCache::find(std::uint64_t digest) const {
-  auto kept = files_.find(digest);
-  if (!kept) return std::nullopt;
-  try {
+  return files_.find_as<SimplifiedMesh>(digest, [](const nlohmann::json& json, const std::string& bytes) {
     SimplifiedMesh mesh;
-    mesh.error = kept->first.at("error").get<double>();
-    const auto triangles = kept->first.at("triangles").get<std::uint64_t>();
-    if (kept->second.size() != triangles * sizeof(Triangle)) throw std::runtime_error("its triangles are cut short");
+    mesh.error = json.at("error").get<double>();
+    const auto triangles = json.at("triangles").get<std::uint64_t>();
+    if (bytes.size() != triangles * sizeof(Triangle)) throw std::runtime_error("its triangles are cut short");
     mesh.triangles.resize(triangles);
-    std::memcpy(mesh.triangles.data(), kept->second.data(), kept->second.size());
+    std::memcpy(mesh.triangles.data(), bytes.data(), bytes.size());
     return mesh;
-  } catch (const std::exception& e) {
-    files_.refuse(digest, e.what());
-    return std::nullopt;
-  }
+  });
 }
 
 void ExportSimplifyCache::keep(std::uint64_t digest, const SimplifiedMesh& mesh) {

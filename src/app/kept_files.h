@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Work kept in the work folder for later runs (stitched parts, encoded tiles): one file per
-// item, found by a digest of its inputs. A file is written under a temporary name and renamed
+// Work kept in the work folder for later runs (stitched parts, encoded tiles, simplified
+// parents): one file per item, found by a digest of its inputs. A file is written under a temporary name and renamed
 // (no fsync: a torn one fails its checksum and the item is made again, like a missing one).
 #pragma once
 
@@ -26,6 +26,9 @@ void write_kept_file(const std::filesystem::path& path, std::string_view magic, 
 std::optional<std::pair<nlohmann::json, std::string>> read_kept_file(const std::filesystem::path& path,
                                                                      std::string_view magic, std::string_view what);
 
+/// Warns that `path`, `what` an earlier run kept, cannot be used (`why`): it is made again.
+void warn_made_again(const std::filesystem::path& path, std::string_view what, std::string_view why);
+
 /// <work>/export-cache: where the export's caches keep encoded tiles and simplified parents.
 std::filesystem::path export_cache_folder(const std::filesystem::path& work);
 
@@ -43,9 +46,20 @@ class KeptFolder {
   KeptFolder(std::filesystem::path dir, Kind kind);
   /// The JSON and bytes kept for `digest`; nullopt when none is (or it is damaged).
   [[nodiscard]] std::optional<std::pair<nlohmann::json, std::string>> find(std::uint64_t digest) const;
+  /// The item kept for `digest` as `decode(json, bytes)` makes it; nullopt when none is, or
+  /// when decode throws (the file is then made again, with a warning).
+  template <class T, class Decode>
+  [[nodiscard]] std::optional<T> find_as(std::uint64_t digest, Decode decode) const {
+    auto kept = find(digest);
+    if (!kept) return std::nullopt;
+    try {
+      return decode(kept->first, kept->second);
+    } catch (const std::exception& e) {
+      warn_made_again(file(digest), kind_.what, e.what());
+      return std::nullopt;
+    }
+  }
   void keep(std::uint64_t digest, std::string_view json, std::string_view bytes) const;
-  /// Warns that the item kept for `digest` cannot be read (`why`); it is made again.
-  void refuse(std::uint64_t digest, std::string_view why) const;
   /// Removes the items neither kept nor found since `since` (less a margin for the clocks of
   /// a cluster's nodes). Best effort.
   void prune(std::filesystem::file_time_type since) const;

@@ -19,10 +19,6 @@ namespace {
 constexpr std::string_view kCacheMagic = "CMSTCH02";  // 02: new vertices named by their part's rank
 constexpr std::string_view kCacheSuffix = ".part";
 
-}  // namespace
-
-namespace {
-
 /// Part keys as [level, x, y] rows.
 nlohmann::json key_parts_json(std::span<const BlockPartKey> keys) {
   nlohmann::json rows = nlohmann::json::array();
@@ -88,7 +84,7 @@ std::optional<std::pair<KeyedPiece, PartOutcome>> SeamPartCache::find(const Bloc
   try {
     return std::pair(decode_keyed_piece(kept->second, path.string()), outcome_from(kept->first));
   } catch (const std::exception& e) {
-    log::warn("{}: a stitched part of an earlier run, but {}: it is stitched again", path.string(), e.what());
+    warn_made_again(path, "a stitched part", e.what());
     return std::nullopt;
   }
 }

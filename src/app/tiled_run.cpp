@@ -336,10 +336,10 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   Stopwatch clock;
   check_seam_pass(config);
   const auto keys = result_keys(config);
-  // The root holds the lock for the whole job (its ranks share the work); subsets share it.
   std::optional<WorkFolderLock> lock;
-  if (cluster.root()) lock.emplace(config.project.work, !options.subset);
   if (cluster.root()) {
+    // The root holds the lock for the whole job (its ranks share the work); subsets share it.
+    lock.emplace(config.project.work, !options.subset);
     check_run_config(config.project.work, keys, options.force);
     remove_leftovers_of_ended_runs(config);
   }

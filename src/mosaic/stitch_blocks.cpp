@@ -147,6 +147,13 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.rejected += s.rejected;
 }
 
+/// Adds a part's key to a digest, field by field (the struct has padding).
+void add_part_key(BulkChecksum& sum, const BlockPartKey& k) {
+  sum.add_value(std::int64_t{k.level});
+  sum.add_value(k.x);
+  sum.add_value(k.y);
+}
+
 /// The part index a new vertex's key names (kNewVertexKey | part << 32 | k).
 std::uint64_t part_of_new_key(std::uint64_t key) { return (key & ~kNewVertexKey) >> 32; }
 
@@ -184,30 +191,24 @@ RelativeKeys relative_keys(std::span<const std::uint64_t> keys, std::span<const 
   return out;
 }
 
-/// The keys of this run from relative ones; nothing when a part they name is not in the
-/// run's list (`parts`, in key order).
-std::optional<std::vector<std::uint64_t>> absolute_keys(std::span<const std::uint64_t> keys,
-                                                        std::span<const BlockPartKey> named,
-                                                        std::span<const BlockPart> parts) {
+/// Renames the new vertices of `keys` (relative ones, as relative_keys made them, naming
+/// `named`) after this run's parts (`parts`, in key order), in place; false when a part they
+/// name is not in this run. Keys ascend, so the new vertices come last: only they change.
+bool rename_for_this_run(std::vector<std::uint64_t>& keys, std::span<const BlockPartKey> named,
+                         std::span<const BlockPart> parts) {
   std::vector<std::uint64_t> index;
   for (const BlockPartKey& key : named) {
     const auto it = std::lower_bound(parts.begin(), parts.end(), key,
                                      [](const BlockPart& part, const BlockPartKey& k) { return part.key < k; });
-    if (it == parts.end() || it->key != key) return std::nullopt;
+    if (it == parts.end() || it->key != key) return false;
     index.push_back(static_cast<std::uint64_t>(it - parts.begin()));
   }
-  std::vector<std::uint64_t> out;
-  out.reserve(keys.size());
-  for (const std::uint64_t k : keys) {
-    if (k < kNewVertexKey) {
-      out.push_back(k);
-      continue;
-    }
-    const std::uint64_t rank = part_of_new_key(k);
-    if (rank >= index.size()) return std::nullopt;
-    out.push_back(kNewVertexKey | index[rank] << 32 | (k & 0xFFFFFFFFu));
+  for (auto k = std::lower_bound(keys.begin(), keys.end(), kNewVertexKey); k != keys.end(); ++k) {
+    const std::uint64_t rank = part_of_new_key(*k);
+    if (rank >= index.size()) return false;
+    *k = kNewVertexKey | index[rank] << 32 | (*k & 0xFFFFFFFFu);
   }
-  return out;
+  return true;
 }
 
 /// A digest of `piece` with its new vertices named by their part's key (relative_keys). Keys
@@ -218,11 +219,7 @@ std::uint64_t piece_digest_by_part_keys(const KeyedPiece& piece, std::span<const
   const RelativeKeys relative = relative_keys(std::span<const std::uint64_t>(first_new, piece.keys.end()), parts);
   BulkChecksum sum;
   sum.add_value(keyed_piece_digest(piece, head, relative.keys));
-  for (const BlockPartKey& k : relative.parts) {
-    sum.add_value(std::int64_t{k.level});  // field by field: the struct has padding
-    sum.add_value(k.x);
-    sum.add_value(k.y);
-  }
+  for (const BlockPartKey& k : relative.parts) add_part_key(sum, k);
   return sum.value();
 }
 
@@ -238,18 +235,13 @@ std::uint64_t part_digest(std::span<const BlockPart> parts, std::size_t p, const
   constexpr std::uint64_t kFormat = 2;
   BulkChecksum sum;
   sum.add_value(kFormat);
-  const auto add_key = [&](const BlockPartKey& k) {
-    sum.add_value(std::int64_t{k.level});  // field by field: the struct has padding
-    sum.add_value(k.x);
-    sum.add_value(k.y);
-  };
-  add_key(parts[p].key);
+  add_part_key(sum, parts[p].key);
   sum.add_value(origin);
   sum.add_value(context);
   sum.add_value(piece_digest_by_part_keys(own, parts));
   std::vector<std::int32_t> sources(own.source_acq.begin(), own.source_acq.end());
   for (std::size_t i = 0; i < around.size(); ++i) {
-    add_key(parts[around_parts[i]].key);
+    add_part_key(sum, parts[around_parts[i]].key);
     sum.add_value(around[i].role);
     sum.add_value(piece_digest_by_part_keys(*around[i].piece, parts));
     sources.insert(sources.end(), around[i].piece->source_acq.begin(), around[i].piece->source_acq.end());
@@ -271,10 +263,7 @@ std::uint64_t part_digest(std::span<const BlockPart> parts, std::size_t p, const
 std::optional<std::pair<KeyedPiece, PartOutcome>> find_kept(const PartCache& cache, std::span<const BlockPart> parts,
                                                             std::size_t p, std::uint64_t digest) {
   auto kept = cache.find(parts[p].key, digest);
-  if (!kept) return std::nullopt;
-  std::optional<std::vector<std::uint64_t>> keys = absolute_keys(kept->first.keys, kept->second.key_parts, parts);
-  if (!keys) return std::nullopt;
-  kept->first.keys = std::move(*keys);
+  if (!kept || !rename_for_this_run(kept->first.keys, kept->second.key_parts, parts)) return std::nullopt;
   kept->second.key_parts.clear();
   return kept;
 }
