@@ -3,8 +3,8 @@
 // epochs; the paper reports 2107 s with QPBO-I at that size): wall time per phase, energy,
 // unlabelled fraction before and after improvement; and our max-flow against Boost.Graph's
 // boykov_kolmogorov_max_flow on the same two-mesh graphs.
-//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--threads N] [--mosaic-only 1]
-//                [--seen-through-quality 0.2] [--crease-weight 3]
+//   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--max-flow-repeat 9]
+//                [--threads N] [--mosaic-only 1] [--seen-through-quality 0.2] [--crease-weight 3]
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -30,17 +30,33 @@ namespace {
 
 void print_selection(const std::string& label, const MosaicSelection& s, double wall) {
   const MosaicStats& t = s.stats;
-  fmt::print("{:<22} {:6.3f} s | build {:.3f}, solve {:.3f}, fill {:.3f} | {} variables, {} seam and {} overlap terms | {}\n",
-             label, wall, t.seconds_build, t.seconds_solve, t.seconds_fill, t.candidates, t.seam_terms, t.overlap_terms,
-             t.solver.exact ? "exact (flipped single cut)"
-                            : fmt::format("{} group moves in {} sweeps ({} exact, {} improving; {} cuts)", t.moves.moves,
-                                          t.moves.sweeps, t.moves.exact_moves, t.moves.improving_moves, t.moves.solves));
-  fmt::print("  energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f}); {} selected\n", t.energy,
-             t.quality, t.boundary, t.seam, t.overlap, t.selected);
+  fmt::print(
+      "{:<22} {:6.3f} s | build {:.3f}, solve {:.3f}, fill {:.3f} | {} variables, {} seam and {} overlap terms | {}\n",
+      label, wall, t.seconds_build, t.seconds_solve, t.seconds_fill, t.candidates, t.seam_terms, t.overlap_terms,
+      t.solver.exact ? "exact (flipped single cut)"
+                     : fmt::format("{} group moves in {} sweeps ({} exact, {} improving; {} cuts)", t.moves.moves,
+                                   t.moves.sweeps, t.moves.exact_moves, t.moves.improving_moves, t.moves.solves));
+  fmt::print("  energy {:.1f} (quality {:.1f}, boundary {:.1f}, seams {:.1f}, overlaps {:.1f}); {} selected\n",
+             t.energy, t.quality, t.boundary, t.seam, t.overlap, t.selected);
 }
 
-/// Our max-flow and Boost's on the flipped two-mesh graphs of consecutive epochs.
-void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& change_params, const MosaicParams& params) {
+/// Seconds of our max-flow on the cut graph, and the flow it found.
+std::pair<double, double> our_max_flow(const CutGraph& graph) {
+  Stopwatch clock;
+  MaxFlow g(graph.nodes);
+  for (std::size_t i = 0; i < graph.nodes; ++i) {
+    g.add_terminal(static_cast<MaxFlow::Node>(i), graph.terminal[i][0], graph.terminal[i][1]);
+  }
+  for (const CutGraph::Arc& a : graph.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
+  clock.restart();  // the solve alone, as for Boost
+  const double flow = g.solve();
+  return {clock.seconds(), flow};
+}
+
+/// Our max-flow and Boost's on the flipped two-mesh graphs of consecutive epochs; each solve
+/// timed `repeat` times (one solve of 15-60 ms varies by +-20 % on this VM), medians summed.
+void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& change_params, const MosaicParams& params,
+                       int repeat) {
   double ours = 0, theirs = 0;
   for (std::size_t k = 0; k + 1 < scene.meshes.size(); k += 2) {
     const std::vector<Mesh> two(scene.meshes.begin() + static_cast<std::ptrdiff_t>(k),
@@ -52,28 +68,31 @@ void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& chang
     const auto flips = submodular_flips(e.energy);
     if (!flips) continue;
     const CutGraph graph = cut_graph(e.energy, /*doubled=*/false, *flips);
-    Stopwatch clock;
-    MaxFlow g(graph.nodes);
-    for (std::size_t i = 0; i < graph.nodes; ++i) {
-      g.add_terminal(static_cast<MaxFlow::Node>(i), graph.terminal[i][0], graph.terminal[i][1]);
-    }
-    for (const CutGraph::Arc& a : graph.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
-    const double build = clock.restart();
-    const double flow = g.solve();
-    const double solve = clock.seconds();
-    ours += solve;
-    fmt::print("  epochs {}+{}: {} nodes, {} arcs: ours {:.4f} s (+{:.4f} s build), flow {:.6f}", k, k + 1, graph.nodes,
-               graph.arcs.size(), solve, build, flow);
+    std::vector<double> our_seconds, their_seconds;
+    double flow = 0, their_flow = 0;
+    for (int r = 0; r < std::max(1, repeat); ++r) {
+      const auto [seconds, f] = our_max_flow(graph);
+      our_seconds.push_back(seconds);
+      flow = f;
 #ifdef CITYMESH_BENCH_BOOST_GRAPH
-    const bench::BoostRun boost = bench::boost_max_flow(graph);
-    theirs += boost.seconds_solve;
-    fmt::print(" | Boost {:.4f} s (+{:.4f} s build), flow {:.6f}", boost.seconds_solve, boost.seconds_build, boost.flow);
+      const bench::BoostRun boost = bench::boost_max_flow(graph);
+      their_seconds.push_back(boost.seconds_solve);
+      their_flow = boost.flow;
 #endif
+    }
+    ours += bench::median(our_seconds);
+    fmt::print("  epochs {}+{}: {} nodes, {} arcs: ours {:.4f} s, flow {:.6f}", k, k + 1, graph.nodes,
+               graph.arcs.size(), bench::median(our_seconds), flow);
+    if (!their_seconds.empty()) {
+      theirs += bench::median(their_seconds);
+      fmt::print(" | Boost {:.4f} s, flow {:.6f}", bench::median(their_seconds), their_flow);
+    }
     fmt::print("\n");
   }
   if (theirs > 0) {
-    fmt::print("max-flow on two-mesh graphs: ours {:.4f} s, Boost {:.4f} s: {:.2f}x (target >= 2x)\n", ours, theirs,
-               theirs / ours);
+    fmt::print(
+        "max-flow on two-mesh graphs (medians of {} solves): ours {:.4f} s, Boost {:.4f} s: {:.2f}x (target >= 2x)\n",
+        std::max(1, repeat), ours, theirs, theirs / ours);
   } else {
     fmt::print("max-flow on two-mesh graphs: ours {:.4f} s (Boost.Graph not found at build time)\n", ours);
   }
@@ -85,7 +104,8 @@ int main(int argc, char** argv) {
   float length = 30.0f;
   int epochs = 7;
   int repeat = 5;
-  unsigned threads = 0;       // 0: every core
+  int max_flow_repeat = 9;   // solves per graph in the max-flow race
+  unsigned threads = 0;      // 0: every core
   bool mosaic_only = false;  // skips the baseline, the whole-energy QPBO and the max-flow race
   MosaicParams params;
   bool keep_freed = true;  // as the citymesh binary does (--keep-freed 0: glibc's defaults)
@@ -94,6 +114,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--length") == 0) length = std::stof(argv[i + 1]);
     if (std::strcmp(argv[i], "--epochs") == 0) epochs = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--repeat") == 0) repeat = std::stoi(argv[i + 1]);
+    if (std::strcmp(argv[i], "--max-flow-repeat") == 0) max_flow_repeat = std::stoi(argv[i + 1]);
     if (std::strcmp(argv[i], "--threads") == 0) threads = static_cast<unsigned>(std::stoul(argv[i + 1]));
     if (std::strcmp(argv[i], "--mosaic-only") == 0) mosaic_only = std::strcmp(argv[i + 1], "0") != 0;
     if (std::strcmp(argv[i], "--seen-through-quality") == 0) params.seen_through_quality = std::stod(argv[i + 1]);
@@ -115,7 +136,8 @@ int main(int argc, char** argv) {
     Stopwatch run_clock;
     energy = select_mosaic(input, params);
     walls.push_back(run_clock.seconds());
-    print_selection(fmt::format("mosaic ({} threads)", threads == 0 ? available_threads() : threads), energy, walls.back());
+    print_selection(fmt::format("mosaic ({} threads)", threads == 0 ? available_threads() : threads), energy,
+                    walls.back());
   }
   const double wall = bench::median(walls);
   fmt::print("mosaic median of {} runs: {:.3f} s\n", walls.size(), wall);
@@ -130,9 +152,9 @@ int main(int argc, char** argv) {
     const MosaicEnergy e = build_mosaic_energy(input, params);
     const std::vector<std::int8_t> partial = qpbo(e.energy);
     const auto unlabelled = std::count(partial.begin(), partial.end(), kUnlabelled);
-    fmt::print("for reference, QPBO (roof duality) on the whole energy: {:.3f} s, {:.2f} % left unlabelled\n", q.seconds(),
-               100.0 * double(unlabelled) / double(partial.size()));
+    fmt::print("for reference, QPBO (roof duality) on the whole energy: {:.3f} s, {:.2f} % left unlabelled\n",
+               q.seconds(), 100.0 * double(unlabelled) / double(partial.size()));
   }
-  compare_max_flows(scene, change_params, params);
+  compare_max_flows(scene, change_params, params, max_flow_repeat);
   return 0;
 }
