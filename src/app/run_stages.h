@@ -36,17 +36,21 @@ TileStore prepare_tile_store(const Config& config, const RunFingerprints& finger
 struct TileStageReport {
   std::vector<std::uint8_t> processed;  ///< per store tile: processed now (not reused)
   std::size_t count = 0;                ///< tiles processed now
+  /// Tiles whose result was kept when a neighbour was redone (counted on the root: under MPI
+  /// another rank's kept tiles count as processed).
+  std::size_t kept = 0;
 };
 
 /// Processes every tile of `tiles` (indices into store.tiles, closed under
-/// tile_dependencies) that has no finished result under its digest (`digests`, per store
-/// tile: tile_digests), each once its dependencies are done,
+/// tile_dependencies) that has no finished result under its digest (`digests.result`), each
+/// once its dependencies are done; a result made from the same inputs and the same decisions
+/// of the neighbours on the tile's halo is kept instead (written again under the new digest),
 /// largest first, on the worker threads of every rank within each rank's memory budget.
 /// Results go to <work>/results. Collective; the report is complete on the root only.
 /// `theirs` (per store tile, or empty): tiles another process owns (a subset's dependencies
 /// in other subsets). They are taken only when nothing else is ready, and skipped when their
 /// result has appeared meanwhile, so subsets started together redo fewer of each other's.
-TileStageReport process_tiles(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
+TileStageReport process_tiles(const Config& config, const TileStore& store, const TileDigests& digests,
                               Cluster& cluster, const std::vector<std::size_t>& tiles,
                               std::span<const std::uint8_t> theirs = {});
 

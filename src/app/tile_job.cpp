@@ -5,6 +5,7 @@
 #include <functional>
 #include <unordered_map>
 
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/mosaic.h"
 
@@ -65,7 +66,33 @@ TriangleUse use_of(TileRole role) {
   }
 }
 
+/// What `settled` says of the tile's halo triangles, in the tile's order: the only part of
+/// it that the tile job reads.
+std::uint64_t settled_fingerprint(std::span<const TilePiece> pieces, const SettledSelection& settled) {
+  std::vector<std::uint8_t> answers;  // per halo triangle: 0 undecided, 1 not selected, 2 selected
+  for (std::uint32_t a = 0; a < pieces.size(); ++a) {
+    for (std::size_t t = 0; t < pieces[a].roles.size(); ++t) {
+      if (pieces[a].roles[t] != TileRole::halo) continue;
+      const std::optional<bool> selected = settled.selected(a, pieces[a].triangle_index[t]);
+      answers.push_back(!selected ? 0 : *selected ? 2 : 1);
+    }
+  }
+  return bulk_checksum(answers.data(), answers.size());
+}
+
 }  // namespace
+
+std::uint64_t tile_settled_fingerprint(const TileStore& store, TileKey key, const SettledSelection& settled) {
+  return settled_fingerprint(read_tile(store, key), settled);
+}
+
+bool keep_if_still_right(const std::filesystem::path& file, const TileStore& store, TileKey key, ResultDigests digests,
+                         const SettledSelection& settled) {
+  const std::optional<ResultOrigin> origin = tile_result_origin(file, store);
+  if (!origin || origin->inputs != digests.inputs) return false;
+  if (origin->settled != tile_settled_fingerprint(store, key, settled)) return false;
+  return restamp_tile_result(file, store, digests.result);
+}
 
 bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
   return std::pair{x.acquisition, x.index} < std::pair{y.acquisition, y.index};
@@ -105,6 +132,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
     for (const TileRole role : pieces[a].roles) uses.push_back(use_of(role));
   }
   r.seconds_read = clock.restart();
+  r.settled_fingerprint = settled_fingerprint(pieces, settled);
   ChangeResult change = detect_changes({meshes, dates, uses}, config.change);
   r.seconds_detect = clock.restart();
   r.change = change.stats;

@@ -75,6 +75,9 @@ struct TileResult {
   double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
   std::uint64_t triangles_in_tile = 0;  ///< owned, halo and empty space
   ChangeStats change;                   ///< the change step's figures on the whole tile
+  /// What the earlier-phase neighbours' decisions said of the halo (tile_settled_fingerprint):
+  /// with the tile's own inputs, all the result depends on.
+  std::uint64_t settled_fingerprint = 0;
 };
 
 /// The phase of a tile: tiles of one phase never touch (no shared border or corner), so they
@@ -91,8 +94,35 @@ inline constexpr int kTilePhases = 4;
 /// tile border agree.
 TileResult process_tile(const TileStore& store, TileKey key, const Config& config, const SettledSelection& settled);
 
-/// Writes the result atomically with the tile's digest (tile_digests).
-void write_tile_result(const std::filesystem::path& file, const TileResult& result, std::uint64_t digest);
+/// A digest of what `settled` says of tile `key`'s halo triangles (reads the tile): equal
+/// for two selections, the tile job gives the same result from both.
+std::uint64_t tile_settled_fingerprint(const TileStore& store, TileKey key, const SettledSelection& settled);
+
+/// The digests a result is written under (tile_digests): `result` is what resuming checks,
+/// `inputs` the tile's own inputs, kept beside the result's settled_fingerprint so that a
+/// result can be recognised as still right when only a neighbour was redone.
+struct ResultDigests {
+  std::uint64_t result = 0, inputs = 0;
+};
+
+/// Writes the result atomically with the tile's digests.
+void write_tile_result(const std::filesystem::path& file, const TileResult& result, ResultDigests digests);
+/// What a finished result (checked whole, of this version) was made from, and the digest it
+/// was written under; nothing when there is no such result.
+struct ResultOrigin {
+  std::uint64_t result = 0, inputs = 0, settled = 0;
+};
+std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file, const TileStore& store);
+/// Writes the result in `file` again under the digest `result` (atomically), unchanged
+/// otherwise; false when `file` holds no finished result.
+bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result);
+/// Whether the result of tile `key` in `file`, made under another digest, is still right under
+/// `digests`: made from the same inputs and from the same decisions of the earlier-phase
+/// neighbours on the tile's halo (`settled`), all the tile job reads. It is then written
+/// again under digests.result and kept: when a neighbour was redone to the same decisions
+/// along their border, the tile need not be.
+bool keep_if_still_right(const std::filesystem::path& file, const TileStore& store, TileKey key, ResultDigests digests,
+                         const SettledSelection& settled);
 /// Which sections of a tile result to decode (the checksum covers the whole file whatever
 /// is decoded).
 struct TileResultSections {

@@ -30,9 +30,8 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
   return after;
 }
 
-std::vector<std::uint64_t> tile_digests(const TileStore& store, std::uint64_t settings,
-                                        std::span<const std::uint64_t> acquisitions) {
-  std::vector<std::uint64_t> digests(store.tiles.size());
+TileDigests tile_digests(const TileStore& store, std::uint64_t settings, std::span<const std::uint64_t> acquisitions) {
+  TileDigests digests{std::vector<std::uint64_t>(store.tiles.size()), std::vector<std::uint64_t>(store.tiles.size())};
   // A tile's dependencies are of earlier phases: phase by phase, their digests are known.
   for (int phase = 0; phase < kTilePhases; ++phase) {
     for (std::size_t k = 0; k < store.tiles.size(); ++k) {
@@ -49,8 +48,9 @@ std::vector<std::uint64_t> tile_digests(const TileStore& store, std::uint64_t se
         if (counts[0] + counts[1] + counts[2] == 0) continue;
         words.insert(words.end(), {a, acquisitions[a], counts[0], counts[1], counts[2]});
       }
-      for (const std::size_t d : tile_dependencies(store, k)) words.push_back(digests[d]);
-      digests[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
+      digests.inputs[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
+      for (const std::size_t d : tile_dependencies(store, k)) words.push_back(digests.result[d]);
+      digests.result[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
     }
   }
   return digests;

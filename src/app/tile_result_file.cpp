@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstddef>
 #include <cstring>
 
 #include "citymesh/core/atomic_file.h"
@@ -27,7 +28,12 @@ namespace {
 // run sums; older results would leave it zeros.
 // Version 07: the copies refuted by the tile's owned triangles (TileResult::refuted); older
 // results counted refutes differently.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '7'};
+// Version 08: what the result was made from (the tile's inputs digest, the fingerprint of its
+// neighbours' decisions on its halo), so that a result is kept when only a neighbour was
+// redone, to the same decisions. Version 07 results (the same but for those two fields, at
+// the end of the header) are still read; they are never kept that way.
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '8'};
+constexpr char kMagic07[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '7'};
 
 /// ChangeStats as stored, in the order of kChangeCounts and kChangeSeconds.
 struct ChangeFigures {
@@ -58,9 +64,11 @@ struct ResultHeader {
   double seconds_read, seconds_detect, seconds_mosaic;
   std::uint64_t label_bytes, pair_bytes;  ///< the two varint sections that follow the header
   ChangeFigures change;
-  std::uint64_t refuted, refuted_bytes;  ///< the third varint section, after the pairs
+  std::uint64_t refuted, refuted_bytes;                   ///< the third varint section, after the pairs
+  std::uint64_t inputs_fingerprint, settled_fingerprint;  ///< ResultOrigin (version 08)
 };
-static_assert(sizeof(ResultHeader) == 200);
+static_assert(sizeof(ResultHeader) == 216);
+constexpr std::size_t kHeader07Bytes = 200;  ///< a version 07 header: this one's first bytes
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
 std::uint64_t label_bits(const OwnedLabel& l) {
@@ -167,12 +175,12 @@ void append_raw(std::string& bytes, const T& value) {
 
 }  // namespace
 
-void write_tile_result(const std::filesystem::path& file, const TileResult& r, std::uint64_t digest) {
+void write_tile_result(const std::filesystem::path& file, const TileResult& r, ResultDigests digests) {
   const VarintWriter labels = encode_labels(r.labels), pairs = encode_deltas<LabelPair>(r.pairs, kPairFields),
                      refuted = encode_deltas<RefutedCopy>(r.refuted, kRefutedFields);
   ResultHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
-  h.fingerprint = digest;
+  h.fingerprint = digests.result;
   h.i = r.key.i;
   h.j = r.key.j;
   h.labels = r.labels.size();
@@ -187,6 +195,8 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, s
   h.change = figures_of(r.change);
   h.refuted = r.refuted.size();
   h.refuted_bytes = refuted.bytes().size();
+  h.inputs_fingerprint = digests.inputs;
+  h.settled_fingerprint = r.settled_fingerprint;
   std::string bytes;
   append_raw(bytes, h);
   bytes += labels.bytes();
@@ -207,6 +217,7 @@ namespace {
 /// the bytes, for the sections to be decoded.
 struct CheckedResult {
   ResultHeader header{};
+  std::size_t header_bytes = sizeof(ResultHeader);  ///< where the sections start
   std::string bytes;
 };
 
@@ -216,22 +227,29 @@ std::nullopt_t stale(const std::filesystem::path& file, std::string_view why) {
   return std::nullopt;
 }
 
-std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::uint64_t digest,
+/// The result in `file` when it is whole and was made under `digest` (any digest: nothing).
+std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::optional<std::uint64_t> digest,
                                             const TileStore& store) {
   std::optional<std::string> read = read_file_bytes(file);
   if (!read) return std::nullopt;
   const std::string_view bytes = *read;
   ResultHeader h{};
   std::uint64_t sum = 0;
-  if (bytes.size() < sizeof h + sizeof sum) return stale(file, "truncated");
+  if (bytes.size() < kHeader07Bytes + sizeof sum) return stale(file, "truncated");
   std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
   if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale(file, "checksum mismatch");
-  std::memcpy(&h, bytes.data(), sizeof h);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return older_version(file);
+  std::size_t header_bytes = sizeof h;
+  if (std::memcmp(bytes.data(), kMagic07, sizeof kMagic07) == 0) {
+    header_bytes = kHeader07Bytes;
+  } else if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
+    return older_version(file);
+  }
+  if (bytes.size() < header_bytes + sizeof sum) return stale(file, "truncated");
+  std::memcpy(&h, bytes.data(), header_bytes);
   // Made from other inputs: another config (--force was given), a rewritten or added
   // acquisition in this tile, or a dependency redone.
-  if (h.fingerprint != digest) return std::nullopt;
-  const std::size_t body = bytes.size() - sizeof sum - sizeof h;
+  if (digest && h.fingerprint != *digest) return std::nullopt;
+  const std::size_t body = bytes.size() - sizeof sum - header_bytes;
   // Counts are checked against the section sizes (a varint takes a byte at least) before
   // anything is allocated. A result made before acquisitions were appended holds fewer
   // pieces: the digest says the tile has none of the new ones.
@@ -240,7 +258,7 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
       h.pairs > h.pair_bytes / kPairFields.size() || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
   }
-  return CheckedResult{h, std::move(*read)};
+  return CheckedResult{h, header_bytes, std::move(*read)};
 }
 
 }  // namespace
@@ -259,7 +277,8 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   r.seconds_detect = h.seconds_detect;
   r.seconds_mosaic = h.seconds_mosaic;
   r.change = stats_of(h.change);
-  std::size_t at = sizeof h;
+  r.settled_fingerprint = h.settled_fingerprint;
+  std::size_t at = checked->header_bytes;
   if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;
   if (sections.pairs && !decode_deltas(bytes.substr(at, h.pair_bytes), h.pairs, kPairFields, r.pairs)) {
@@ -300,10 +319,28 @@ std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::p
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
   std::vector<OwnedLabel> labels;
-  if (!decode_labels(std::string_view(checked->bytes).substr(sizeof h, h.label_bytes), h.labels, labels)) {
+  if (!decode_labels(std::string_view(checked->bytes).substr(checked->header_bytes, h.label_bytes), h.labels, labels)) {
     return stale(file, "damaged labels");
   }
   return labels;
+}
+
+std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file, const TileStore& store) {
+  const std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
+  if (!checked || checked->header_bytes != sizeof(ResultHeader)) return std::nullopt;
+  const ResultHeader& h = checked->header;
+  return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint};
+}
+
+bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result) {
+  std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
+  if (!checked) return false;
+  std::string& bytes = checked->bytes;
+  std::memcpy(bytes.data() + offsetof(ResultHeader, fingerprint), &result, sizeof result);
+  const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - sizeof sum);
+  std::memcpy(bytes.data() + bytes.size() - sizeof sum, &sum, sizeof sum);
+  write_file_atomically(file, bytes);
+  return true;
 }
 
 }  // namespace citymesh::app

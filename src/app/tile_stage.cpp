@@ -4,8 +4,10 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <memory>
 #include <mutex>
 #include <thread>
 
@@ -54,10 +56,24 @@ class Progress {
  public:
   Progress(std::size_t tiles, std::uint64_t triangles, std::size_t reused)
       : tiles_(tiles), reused_(reused), triangles_(triangles) {}
+  /// A tile to process found still right (keep_if_still_right): reused after all. Called
+  /// under the work channel's lock.
+  void kept(std::uint64_t owned) {
+    --tiles_;
+    ++reused_;
+    triangles_ -= std::min(triangles_, owned);
+    say_if_due();
+  }
   /// Called under the work channel's lock.
   void done(std::uint64_t owned) {
     ++done_;
     triangles_done_ += owned;
+    say_if_due();
+  }
+
+ private:
+  /// A line a second, and one when the last tile is done.
+  void say_if_due() {
     if (done_ < tiles_ && since_line_.seconds() < 1.0) return;
     since_line_.restart();
     const double rate = static_cast<double>(triangles_done_) / std::max(clock_.seconds(), 1e-9);
@@ -68,7 +84,6 @@ class Progress {
               static_cast<double>(resident_bytes()) / (1 << 20));
   }
 
- private:
   std::size_t tiles_, reused_, done_ = 0;
   std::uint64_t triangles_, triangles_done_ = 0;
   Stopwatch clock_, since_line_;
@@ -153,10 +168,12 @@ std::filesystem::path result_path(const Config& config, TileKey key) {
   return config.project.work / "results" / (key.name() + ".bin");
 }
 
-TileStageReport process_tiles(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
+TileStageReport process_tiles(const Config& config, const TileStore& store, const TileDigests& digests,
                               Cluster& cluster, const std::vector<std::size_t>& tiles,
                               std::span<const std::uint8_t> theirs) {
-  if (digests.size() != store.tiles.size()) throw ProcessingError("process_tiles: one digest per tile is needed");
+  if (digests.result.size() != store.tiles.size() || digests.inputs.size() != store.tiles.size()) {
+    throw ProcessingError("process_tiles: one digest per tile is needed");
+  }
   if (!theirs.empty() && theirs.size() != store.tiles.size()) {
     throw ProcessingError("process_tiles: the other processes' tiles are not given per tile");
   }
@@ -167,7 +184,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   std::size_t pending = tiles.size();
   std::uint64_t input = 0;
   if (cluster.root()) {
-    std::vector<std::uint8_t> done = finished_items(config, store, digests, tiles);
+    std::vector<std::uint8_t> done = finished_items(config, store, digests.result, tiles);
     for (std::size_t item = 0; item < tiles.size(); ++item) {
       if (done[item] == 0) input += store.tiles[tiles[item]].owned();
     }
@@ -177,19 +194,27 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
   }
   Progress progress(pending, input, tiles.size() - pending);
   MemoryGate gate(config.run.memory);
+  // Per item, each written by its worker only: made by its owner meanwhile, or kept.
+  std::vector<std::uint8_t> finished_elsewhere(tiles.size(), 0);
+  const std::unique_ptr<std::atomic<bool>[]> kept(new std::atomic<bool>[tiles.size()] {});
   const auto on_finish = [&](std::size_t item) {
+    // Kept tiles of this process's workers count as reused (another rank's count as made).
+    if (kept[item].load()) {
+      ++report.kept;
+      progress.kept(store.tiles[tiles[item]].owned());
+      return;
+    }
     report.processed[tiles[item]] = 1;
     ++report.count;
     progress.done(store.tiles[tiles[item]].owned());
   };
-  std::vector<std::uint8_t> finished_elsewhere(tiles.size(), 0);  // per item; each written by its worker only
   // The channel ends (every rank's workers stopped) before the report is returned.
   auto channel = cluster.share(schedule ? &*schedule : nullptr, on_finish);
   run_workers(*channel, available_threads(), [&](std::size_t item) {
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
     throw_if_interrupted("tile processing");
-    if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, digests[k])) {
+    if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, digests.result[k])) {
       finished_elsewhere[item] = 1;  // its owner made it while this process did its own
       return;
     }
@@ -203,8 +228,16 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, std:
       release_freed_memory();
     }
     try {
-      const TileResult r = process_tile(store, tile.key, config, settled_selection(config, store, k, digests));
-      write_tile_result(result_path(config, tile.key), r, digests[k]);
+      const SettledSelection settled = settled_selection(config, store, k, digests.result);
+      if (keep_if_still_right(result_path(config, tile.key), store, tile.key, {digests.result[k], digests.inputs[k]},
+                              settled)) {
+        log::debug("tile {}: a neighbour was redone to the same decisions on its border: its result is kept",
+                   tile.key.name());
+        kept[item] = true;
+      } else {
+        const TileResult r = process_tile(store, tile.key, config, settled);
+        write_tile_result(result_path(config, tile.key), r, {digests.result[k], digests.inputs[k]});
+      }
     } catch (...) {
       gate.release(estimate);
       throw;

@@ -275,6 +275,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   nlohmann::json report;
   report["tiles"] = store.tiles.size();
   report["reused_tiles"] = reused;
+  report["kept_tiles"] = tiles.kept;  // of the reused: kept when a neighbour was redone
   report["input_triangles"] = assembly.owned();
   report["output_triangles"] = output_triangles;
   report["ranks"] = ranks;
@@ -313,8 +314,8 @@ std::vector<std::size_t> all_tiles(const TileStore& store) {
 
 /// A subset's share: its tiles and, where they wait for tiles of other subsets that are not
 /// finished yet, those too (the same bytes whoever makes them). No outputs: `merge` writes them.
-void run_subset(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
-                const Subset& subset, Cluster& cluster) {
+void run_subset(const Config& config, const TileStore& store, const TileDigests& digests, const Subset& subset,
+                Cluster& cluster) {
   Stopwatch clock;
   const std::vector<std::size_t> own = subset_tiles(store, subset);
   const std::vector<std::size_t> needed = with_dependencies(store, own);
@@ -345,7 +346,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   }
   const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
   const TileStore store = prepare_tile_store(config, fingerprints, cluster, options.subset);
-  const std::vector<std::uint64_t> digests = tile_digests(store, fingerprints.settings, fingerprints.acquisitions);
+  const TileDigests digests = tile_digests(store, fingerprints.settings, fingerprints.acquisitions);
   // Each stage's arrays differ from the last one's: the memory one freed goes back to the
   // system instead of staying resident under the next one's peak.
   release_freed_memory();
@@ -357,7 +358,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   // The seam pass and the outputs need every tile: the root writes them, the other ranks
   // help it stitch.
   if (cluster.root()) {
-    write_run_outputs(config, store, digests, tiles, options.pictures, seconds, &cluster);
+    write_run_outputs(config, store, digests.result, tiles, options.pictures, seconds, &cluster);
   } else if (seam_pass_in_blocks(config)) {
     help_seam_pass(config, cluster);
     help_outputs(config, cluster);
@@ -379,7 +380,8 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     "(citymesh run CONFIG --subset i/N)",
                     (config.project.work / "tiles").string()));
   }
-  const std::vector<std::uint64_t> digests = tile_digests(*store, fingerprints.settings, fingerprints.acquisitions);
+  const std::vector<std::uint64_t> digests =
+      tile_digests(*store, fingerprints.settings, fingerprints.acquisitions).result;
   std::vector<std::string> missing;
   for (std::size_t k = 0; k < store->tiles.size(); ++k) {
     // Whole (the checksum covers every section): decoded once, when the outputs read them.
@@ -395,7 +397,7 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
                     shown < missing.size() ? ", ..." : ""));
   }
-  const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0};
+  const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0, 0};
   write_run_outputs(config, *store, digests, none, pictures, nlohmann::json::object(), nullptr);
 }
 

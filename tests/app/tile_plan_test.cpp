@@ -199,15 +199,17 @@ TEST(TilePlan, AChangedAcquisitionChangesTheDigestsOfTheTilesItReachesAndOfTheir
     const std::uint64_t owned = t.key.i < 3 ? 1 + rng() % 50 : 0;
     t.triangles.push_back({owned, owned > 0 ? rng() % 9 : 0, t.key.i == 3 ? rng() % 2 : 0});
   }
-  const std::vector<std::uint64_t> before = tile_digests(store, 7, std::vector<std::uint64_t>{100, 200});
-  EXPECT_EQ(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200}), before);
-  const std::vector<std::uint64_t> after = tile_digests(store, 7, std::vector<std::uint64_t>{100, 201});
-  // Brute force: the tiles holding acquisition 1, then whatever waits for a changed tile.
-  std::set<std::size_t> changed;
+  const TileDigests before = tile_digests(store, 7, std::vector<std::uint64_t>{100, 200});
+  EXPECT_EQ(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200}).result, before.result);
+  const TileDigests after = tile_digests(store, 7, std::vector<std::uint64_t>{100, 201});
+  // Brute force: the tiles holding acquisition 1 (their inputs changed), then whatever waits
+  // for a changed tile.
+  std::set<std::size_t> reached;
   for (std::size_t k = 0; k < store.tiles.size(); ++k) {
     const auto& counts = store.tiles[k].triangles[1];
-    if (counts[0] + counts[1] + counts[2] > 0) changed.insert(k);
+    if (counts[0] + counts[1] + counts[2] > 0) reached.insert(k);
   }
+  std::set<std::size_t> changed = reached;
   for (bool grew = true; grew;) {
     grew = false;
     for (std::size_t k = 0; k < store.tiles.size(); ++k) {
@@ -216,19 +218,24 @@ TEST(TilePlan, AChangedAcquisitionChangesTheDigestsOfTheTilesItReachesAndOfTheir
       }
     }
   }
+  EXPECT_GT(changed.size(), reached.size()) << "later neighbours of reached tiles";
   std::size_t differ = 0;
   for (std::size_t k = 0; k < store.tiles.size(); ++k) {
-    EXPECT_EQ(after[k] != before[k], changed.contains(k)) << store.tiles[k].key.name();
-    differ += after[k] != before[k] ? 1 : 0;
+    EXPECT_EQ(after.result[k] != before.result[k], changed.contains(k)) << store.tiles[k].key.name();
+    EXPECT_EQ(after.inputs[k] != before.inputs[k], reached.contains(k)) << store.tiles[k].key.name();
+    differ += after.result[k] != before.result[k] ? 1 : 0;
   }
   EXPECT_GT(differ, 0u);
   EXPECT_LT(differ, store.tiles.size()) << "the eastern tiles are far from acquisition 1";
   // The settings reach every tile; a tile's own counts reach it.
-  const std::vector<std::uint64_t> settings = tile_digests(store, 8, std::vector<std::uint64_t>{100, 200});
-  for (std::size_t k = 0; k < store.tiles.size(); ++k) EXPECT_NE(settings[k], before[k]);
+  const TileDigests settings = tile_digests(store, 8, std::vector<std::uint64_t>{100, 200});
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    EXPECT_NE(settings.result[k], before.result[k]);
+    EXPECT_NE(settings.inputs[k], before.inputs[k]);
+  }
   const std::size_t last = store.tiles.size() - 1;
   ++store.tiles[last].triangles[0][1];
-  EXPECT_NE(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200})[last], before[last]);
+  EXPECT_NE(tile_digests(store, 7, std::vector<std::uint64_t>{100, 200}).inputs[last], before.inputs[last]);
   EXPECT_THROW((void)tile_digests(store, 7, std::vector<std::uint64_t>{100}), ProcessingError);
 }
 

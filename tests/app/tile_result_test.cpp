@@ -18,6 +18,7 @@ namespace citymesh::app {
 namespace {
 
 constexpr std::uint64_t kFingerprint = 0x1234;
+constexpr ResultDigests kDigests{kFingerprint, 0x5678};
 
 /// A store of two acquisitions on 50 m tiles (what read_tile_result checks against).
 TileStore two_acquisitions() {
@@ -81,7 +82,7 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
   const TileStore store = two_acquisitions();
   for (const bool scan_order : {false, true}) {
     const TileResult r = random_result(scan_order ? 1 : 2, scan_order);
-    write_tile_result(tmp / "t.bin", r, kFingerprint);
+    write_tile_result(tmp / "t.bin", r, kDigests);
     const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint, store);
     ASSERT_TRUE(back.has_value());
     EXPECT_EQ(back->key, r.key);
@@ -122,7 +123,7 @@ TEST(TileResult, LabelsAndPairsOfAnyValueRoundTrip) {
 TEST(TileResult, ATornOrDamagedResultIsNotFinished) {
   test::TempDir tmp;
   const TileStore store = two_acquisitions();
-  write_tile_result(tmp / "t.bin", random_result(6, true), kFingerprint);
+  write_tile_result(tmp / "t.bin", random_result(6, true), kDigests);
   const std::string good = *read_file_bytes(tmp / "t.bin");
   std::mt19937 rng(7);
   for (int trial = 0; trial < 50; ++trial) {
@@ -140,7 +141,7 @@ TEST(TileResult, ATornOrDamagedResultIsNotFinished) {
 TEST(TileResult, AResultMadeBeforeAnAcquisitionWasAddedReadsWithAnEmptyPieceForIt) {
   test::TempDir tmp;
   const TileResult r = random_result(4, true);  // two acquisitions' pieces
-  write_tile_result(tmp / "t.bin", r, kFingerprint);
+  write_tile_result(tmp / "t.bin", r, kDigests);
   TileStore three = two_acquisitions();
   three.triangles.push_back(500);
   const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint, three);
@@ -160,7 +161,7 @@ TEST(TileResult, ScanOrderedLabelsTakeUnderAQuarterOfTheFixedLayout) {
   test::TempDir tmp;
   TileResult r = random_result(3, true);
   r.pairs.clear();
-  write_tile_result(tmp / "t.bin", r, kFingerprint);
+  write_tile_result(tmp / "t.bin", r, kDigests);
   // Version 04 took 32 bytes per label after an 80-byte header.
   EXPECT_LT(std::filesystem::file_size(tmp / "t.bin"), (80 + 32 * r.labels.size()) / 4);
 }
@@ -169,18 +170,18 @@ TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
   test::TempDir tmp;
   const TileStore store = two_acquisitions();
   const TileResult r = random_result(4, true);
-  write_tile_result(tmp / "good.bin", r, kFingerprint);
+  write_tile_result(tmp / "good.bin", r, kDigests);
   const std::string good = *read_file_bytes(tmp / "good.bin");
   std::mt19937 rng(5);
   int refused = 0;
   for (int trial = 0; trial < 500; ++trial) {
     std::string bytes = good;
     // A count or section size in the header (bytes 24-56, 80-96 and 184-200), or the varint
-    // sections.
+    // sections (after the 216-byte header).
     const std::size_t at = trial % 5 == 0   ? 24 + rng() % 32
                            : trial % 5 == 1 ? 80 + rng() % 16
                            : trial % 5 == 2 ? 184 + rng() % 16
-                                            : 200 + rng() % 3000;
+                                            : 216 + rng() % 3000;
     bytes[at] = static_cast<char>(rng());
     const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
     std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
@@ -192,6 +193,64 @@ TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
     if (labels && back) expect_same_labels(*labels, back->labels);
   }
   EXPECT_GT(refused, 250);
+}
+
+TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged) {
+  test::TempDir tmp;
+  const TileStore store = two_acquisitions();
+  TileResult r = random_result(8, true);
+  r.settled_fingerprint = 0x9abc;
+  write_tile_result(tmp / "t.bin", r, kDigests);
+  const std::optional<ResultOrigin> origin = tile_result_origin(tmp / "t.bin", store);
+  ASSERT_TRUE(origin.has_value());
+  EXPECT_EQ(origin->inputs, kDigests.inputs);
+  EXPECT_EQ(origin->settled, r.settled_fingerprint);
+  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, kFingerprint + 7));
+  EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 7, store));
+  EXPECT_FALSE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
+  const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint + 7, store);
+  ASSERT_TRUE(back.has_value());
+  expect_same_labels(back->labels, r.labels);
+  EXPECT_EQ(back->refuted, r.refuted);
+  EXPECT_EQ(back->settled_fingerprint, r.settled_fingerprint);
+  const std::optional<ResultOrigin> again = tile_result_origin(tmp / "t.bin", store);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_EQ(again->inputs, kDigests.inputs);
+  // Nothing to write again: no file, or a damaged one (left as it is).
+  EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, 1));
+  EXPECT_FALSE(tile_result_origin(tmp / "none.bin", store).has_value());
+  std::string bytes = *read_file_bytes(tmp / "t.bin");
+  bytes[300] ^= 1;
+  std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
+  EXPECT_FALSE(tile_result_origin(tmp / "bad.bin", store).has_value());
+  EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, 1));
+  EXPECT_EQ(*read_file_bytes(tmp / "bad.bin"), bytes);
+}
+
+TEST(TileResult, AVersion07ResultIsStillReadButNeverKeptAfterANeighbour) {
+  test::TempDir tmp;
+  const TileStore store = two_acquisitions();
+  const TileResult r = random_result(9, true);
+  write_tile_result(tmp / "t.bin", r, kDigests);
+  // Version 07: the same header without its last 16 bytes (what the result was made from).
+  std::string bytes = *read_file_bytes(tmp / "t.bin");
+  bytes.erase(200, 16);
+  bytes[7] = '7';
+  const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
+  std::ofstream(tmp / "v7.bin", std::ios::binary) << bytes;
+  const std::optional<TileResult> back = read_tile_result(tmp / "v7.bin", kFingerprint, store);
+  ASSERT_TRUE(back.has_value());
+  expect_same_labels(back->labels, r.labels);
+  EXPECT_EQ(back->refuted, r.refuted);
+  EXPECT_TRUE(tile_result_is_finished(tmp / "v7.bin", kFingerprint, store));
+  EXPECT_FALSE(tile_result_origin(tmp / "v7.bin", store).has_value());
+  // Version 06 is another layout: processed again.
+  bytes[7] = '6';
+  const std::uint64_t sum6 = bulk_checksum(bytes.data(), bytes.size() - 8);
+  std::memcpy(bytes.data() + bytes.size() - 8, &sum6, 8);
+  std::ofstream(tmp / "v6.bin", std::ios::binary) << bytes;
+  EXPECT_FALSE(tile_result_is_finished(tmp / "v6.bin", kFingerprint, store));
 }
 
 TEST(SettledSelection, AnswersAsAMapOfEveryNeighboursLabels) {

@@ -8,6 +8,8 @@
 #include <cfloat>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
+#include <set>
+#include <string>
 
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
@@ -319,22 +321,26 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
 }
 
 /// `mesh` with only the triangles whose centroid lies in the first `share` of its longer
-/// horizontal extent (a pass that drove part of the street).
-Mesh first_part(const Mesh& mesh, double share) {
+/// horizontal extent (a pass that drove part of the street), or in the first `far_share` of it
+/// on the far half of the other extent (default: the same share).
+Mesh first_part(const Mesh& mesh, double share, double far_share = -1) {
   double lo[2] = {DBL_MAX, DBL_MAX}, hi[2] = {-DBL_MAX, -DBL_MAX};
   for (const Vec3f& p : mesh.positions) {
     lo[0] = std::min(lo[0], double(p.x)), hi[0] = std::max(hi[0], double(p.x));
     lo[1] = std::min(lo[1], double(p.y)), hi[1] = std::max(hi[1], double(p.y));
   }
-  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1;
+  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1, other = 1 - axis;
+  const double middle = (lo[other] + hi[other]) / 2;
   const double end = lo[axis] + share * (hi[axis] - lo[axis]);
+  const double far_end = lo[axis] + (far_share < 0 ? share : far_share) * (hi[axis] - lo[axis]);
   Mesh part = mesh;
   part.triangles.clear();
   part.triangle_ids.clear();
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
     const auto [a, b, c] = mesh.corners(t);
     const Vec3d centroid = (a + b + c) / 3.0;
-    if ((axis == 0 ? centroid.x : centroid.y) >= end) continue;
+    const double along = axis == 0 ? centroid.x : centroid.y, across = axis == 0 ? centroid.y : centroid.x;
+    if (along >= (across >= middle ? far_end : end)) continue;
     part.triangles.push_back(mesh.triangles[t]);
     part.triangle_ids.push_back(mesh.triangle_ids[t]);
   }
@@ -345,7 +351,11 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
-  // Five passes first; then a sixth over the first quarter of the street is appended.
+  // Five passes first; then a sixth over the first 21 m of the street on one side and 26 m on
+  // the other is appended: it ends in the third of six 10 m tile columns, whose later-phase
+  // neighbours in the fourth wait for it. Their border with the third is 9 m from the pass's
+  // end on the first side (decisions there unchanged: those tiles are kept) and 4 m on the
+  // other (changed: redone).
   const std::string config = test::read_text(dir / "sim/config.toml");
   const std::size_t last = config.rfind("[[acquisition]]");
   ASSERT_NE(last, std::string::npos);
@@ -355,7 +365,7 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   sixth.replace(path, 9, "acq_5_part.ply");
   test::write_text(dir / "sim/five.toml", config.substr(0, last));
   test::write_text(dir / "sim/six.toml", config.substr(0, last) + sixth);
-  write_mesh_ply(dir / "sim/acq_5_part.ply", first_part(read_mesh(dir / "sim/acq_5.ply").mesh, 0.25));
+  write_mesh_ply(dir / "sim/acq_5_part.ply", first_part(read_mesh(dir / "sim/acq_5.ply").mesh, 0.35, 27.8 / 60));
   const auto run = [&](const std::string& file, const std::string& name, const std::string& extra = "") {
     return test::run_citymesh(
         fmt::format("run {}/{} --no-pictures --set tiling.tile_size=10 --set project.output={} "
@@ -378,6 +388,26 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
       appended.err.find(fmt::format("tiles {}/{} ({} reused)", redone, redone, report["reused_tiles"].get<int>())),
       std::string::npos)
       << appended.err;
+
+  // The tiles redone are those the new pass reaches (their inputs changed) and later-phase
+  // neighbours whose border decisions changed; the other later-phase neighbours of redone
+  // tiles keep their results (kept_after_neighbours).
+  const nlohmann::json manifest = read_json(dir / "sim/work-u/tiles/manifest.json");
+  std::set<std::string> reached;
+  for (const auto& tile : manifest["tiles"]) {
+    const auto& counts = tile["triangles"];
+    if (counts.size() > 5 && counts[5][0].get<int>() + counts[5][1].get<int>() + counts[5][2].get<int>() > 0) {
+      reached.insert(fmt::format("{}_{}", tile["i"].get<int>(), tile["j"].get<int>()));
+    }
+  }
+  std::set<std::string> processed;
+  for (const auto& entry : report["per_tile"]) {
+    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
+  }
+  EXPECT_FALSE(reached.empty());
+  for (const std::string& tile : reached) EXPECT_TRUE(processed.contains(tile)) << tile << " is reached";
+  EXPECT_GT(report["kept_tiles"].get<int>(), 0) << "later-phase neighbours of reached tiles, decisions unchanged";
+  EXPECT_EQ(processed.size() + report["reused_tiles"].get<std::size_t>(), report["tiles"].get<std::size_t>());
 
   const auto fresh = run("six.toml", "f");
   ASSERT_EQ(fresh.exit_code, 0) << fresh.err;

@@ -32,7 +32,7 @@ echo "every acquisition but the last:"
 run append-before.toml append
 echo "the district appended to that work folder:"
 run append-after.toml append
-python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']}\")"
+python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} kept when a neighbour was redone)\")"
 echo "a fresh run of the same config:"
 run append-after.toml fresh
 if cmp -s "$dir/out-append/mosaic/mosaic.ply" "$dir/out-fresh/mosaic/mosaic.ply" &&
