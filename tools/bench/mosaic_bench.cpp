@@ -40,24 +40,33 @@ void print_selection(const std::string& label, const MosaicSelection& s, double 
              t.energy, t.quality, t.boundary, t.seam, t.overlap, t.selected);
 }
 
-/// Seconds of our max-flow on the cut graph, and the flow it found.
-std::pair<double, double> our_max_flow(const CutGraph& graph) {
+struct MaxFlowRun {
+  double flow = 0, seconds_build = 0, seconds_solve = 0;
+};
+
+/// Our max-flow on the cut graph: seconds building the graph and solving (which lays the arcs
+/// out per node first), and the flow found.
+MaxFlowRun our_max_flow(const CutGraph& graph) {
   Stopwatch clock;
   MaxFlow g(graph.nodes);
   for (std::size_t i = 0; i < graph.nodes; ++i) {
     g.add_terminal(static_cast<MaxFlow::Node>(i), graph.terminal[i][0], graph.terminal[i][1]);
   }
   for (const CutGraph::Arc& a : graph.arcs) g.add_edge(a.from, a.to, a.capacity, a.reverse_capacity);
-  clock.restart();  // the solve alone, as for Boost
-  const double flow = g.solve();
-  return {clock.seconds(), flow};
+  MaxFlowRun run;
+  run.seconds_build = clock.restart();
+  run.flow = g.solve();
+  run.seconds_solve = clock.seconds();
+  return run;
 }
 
 /// Our max-flow and Boost's on the flipped two-mesh graphs of consecutive epochs; each solve
-/// timed `repeat` times (one solve of 15-60 ms varies by +-20 % on this VM), medians summed.
+/// timed `repeat` times (one solve of 15-60 ms varies by +-20 % on this VM), medians summed:
+/// the solves alone, and with the graph built (Boost's adjacency list takes longer to build
+/// than the search takes).
 void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& change_params, const MosaicParams& params,
                        int repeat) {
-  double ours = 0, theirs = 0;
+  double ours = 0, theirs = 0, ours_built = 0, theirs_built = 0;
   for (std::size_t k = 0; k + 1 < scene.meshes.size(); k += 2) {
     const std::vector<Mesh> two(scene.meshes.begin() + static_cast<std::ptrdiff_t>(k),
                                 scene.meshes.begin() + static_cast<std::ptrdiff_t>(k + 2));
@@ -68,31 +77,37 @@ void compare_max_flows(const bench::BenchScene& scene, const ChangeParams& chang
     const auto flips = submodular_flips(e.energy);
     if (!flips) continue;
     const CutGraph graph = cut_graph(e.energy, /*doubled=*/false, *flips);
-    std::vector<double> our_seconds, their_seconds;
+    std::vector<double> our_solve, our_total, their_solve, their_total;
     double flow = 0, their_flow = 0;
     for (int r = 0; r < std::max(1, repeat); ++r) {
-      const auto [seconds, f] = our_max_flow(graph);
-      our_seconds.push_back(seconds);
-      flow = f;
+      const MaxFlowRun run = our_max_flow(graph);
+      our_solve.push_back(run.seconds_solve);
+      our_total.push_back(run.seconds_build + run.seconds_solve);
+      flow = run.flow;
 #ifdef CITYMESH_BENCH_BOOST_GRAPH
       const bench::BoostRun boost = bench::boost_max_flow(graph);
-      their_seconds.push_back(boost.seconds_solve);
+      their_solve.push_back(boost.seconds_solve);
+      their_total.push_back(boost.seconds_build + boost.seconds_solve);
       their_flow = boost.flow;
 #endif
     }
-    ours += bench::median(our_seconds);
-    fmt::print("  epochs {}+{}: {} nodes, {} arcs: ours {:.4f} s, flow {:.6f}", k, k + 1, graph.nodes,
-               graph.arcs.size(), bench::median(our_seconds), flow);
-    if (!their_seconds.empty()) {
-      theirs += bench::median(their_seconds);
-      fmt::print(" | Boost {:.4f} s, flow {:.6f}", bench::median(their_seconds), their_flow);
+    ours += bench::median(our_solve);
+    ours_built += bench::median(our_total);
+    fmt::print("  epochs {}+{}: {} nodes, {} arcs: ours {:.4f} s (built and solved {:.4f} s), flow {:.6f}", k, k + 1,
+               graph.nodes, graph.arcs.size(), bench::median(our_solve), bench::median(our_total), flow);
+    if (!their_solve.empty()) {
+      theirs += bench::median(their_solve);
+      theirs_built += bench::median(their_total);
+      fmt::print(" | Boost {:.4f} s ({:.4f} s), flow {:.6f}", bench::median(their_solve), bench::median(their_total),
+                 their_flow);
     }
     fmt::print("\n");
   }
   if (theirs > 0) {
     fmt::print(
-        "max-flow on two-mesh graphs (medians of {} solves): ours {:.4f} s, Boost {:.4f} s: {:.2f}x (target >= 2x)\n",
-        std::max(1, repeat), ours, theirs, theirs / ours);
+        "max-flow on two-mesh graphs (medians of {} solves): ours {:.4f} s, Boost {:.4f} s: {:.2f}x (target >= 2x); "
+        "graphs built and solved: ours {:.4f} s, Boost {:.4f} s: {:.2f}x\n",
+        std::max(1, repeat), ours, theirs, theirs / ours, ours_built, theirs_built, theirs_built / ours_built);
   } else {
     fmt::print("max-flow on two-mesh graphs: ours {:.4f} s (Boost.Graph not found at build time)\n", ours);
   }
