@@ -298,10 +298,11 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s",
                                                      static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6)
                                        : std::string("no rate: tiles reused");
+  const std::string kept = tiles.kept > 0 ? fmt::format(", {} kept after a neighbour was redone", tiles.kept) : "";
   std::cout << fmt::format(
-      "run: {} tiles ({} reused), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak memory "
-      "{:.0f} MiB (rank 0)\n",
-      store.tiles.size(), reused, assembly.owned(), output_triangles, wall, rate, ranks,
+      "run: {} tiles ({} reused{}), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak "
+      "memory {:.0f} MiB (rank 0)\n",
+      store.tiles.size(), reused, kept, assembly.owned(), output_triangles, wall, rate, ranks,
       static_cast<double>(peak_resident_bytes()) / (1 << 20));
 }
 
