@@ -88,7 +88,7 @@ std::uint64_t tile_settled_fingerprint(const TileStore& store, TileKey key, cons
 
 bool keep_if_still_right(const std::filesystem::path& file, const TileStore& store, TileKey key, ResultDigests digests,
                          const SettledSelection& settled) {
-  const std::optional<ResultOrigin> origin = tile_result_origin(file, store);
+  const std::optional<ResultOrigin> origin = tile_result_origin(file);
   if (!origin || origin->inputs != digests.inputs) return false;
   if (origin->settled != tile_settled_fingerprint(store, key, settled)) return false;
   return restamp_tile_result(file, store, digests.result);

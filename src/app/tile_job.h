@@ -107,14 +107,15 @@ struct ResultDigests {
 
 /// Writes the result atomically with the tile's digests.
 void write_tile_result(const std::filesystem::path& file, const TileResult& result, ResultDigests digests);
-/// What a finished result (checked whole, of this version) was made from, and the digest it
-/// was written under; nothing when there is no such result.
+/// What a result of this version says in its header it was made from, and the digest it was
+/// written under; nothing when there is no such header (the rest of the file is not read, nor
+/// checked: restamp_tile_result checks it).
 struct ResultOrigin {
   std::uint64_t result = 0, inputs = 0, settled = 0;
 };
-std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file, const TileStore& store);
+std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file);
 /// Writes the result in `file` again under the digest `result` (atomically), unchanged
-/// otherwise; false when `file` holds no finished result.
+/// otherwise; false when `file` holds no finished result (checked whole, as resuming does).
 bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result);
 /// Whether the result of tile `key` in `file`, made under another digest, is still right under
 /// `digests`: made from the same inputs and from the same decisions of the earlier-phase

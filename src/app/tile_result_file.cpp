@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstddef>
 #include <cstring>
+#include <fstream>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
@@ -325,10 +326,13 @@ std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::p
   return labels;
 }
 
-std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file, const TileStore& store) {
-  const std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
-  if (!checked || checked->header_bytes != sizeof(ResultHeader)) return std::nullopt;
-  const ResultHeader& h = checked->header;
+std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file) {
+  // The header alone: after a change of settings every tile asks, and reading its whole
+  // result (megabytes) to be told "other inputs" would cost a city's worth of reads.
+  ResultHeader h{};
+  std::ifstream in(file, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return std::nullopt;
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
   return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint};
 }
 

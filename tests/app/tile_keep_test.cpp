@@ -22,7 +22,7 @@ namespace {
 
 /// The labels of a finished result, whatever digest it was written under.
 std::vector<app::OwnedLabel> labels_of(const std::filesystem::path& file, const TileStore& store) {
-  const std::optional<app::ResultOrigin> origin = app::tile_result_origin(file, store);
+  const std::optional<app::ResultOrigin> origin = app::tile_result_origin(file);
   if (!origin) return {};
   return app::read_tile_labels(file, origin->result, store).value_or(std::vector<app::OwnedLabel>{});
 }
@@ -72,7 +72,7 @@ TEST(TileKeep, AResultIsKeptAfterANeighbourOnlyForTheSameInputsAndTheSameDecisio
       return settled;
     };
     const std::filesystem::path file = result_file(key);
-    const std::optional<app::ResultOrigin> origin = app::tile_result_origin(file, *store);
+    const std::optional<app::ResultOrigin> origin = app::tile_result_origin(file);
     ASSERT_TRUE(origin.has_value()) << key.name();
     const std::vector<app::OwnedLabel> before = labels_of(file, *store);
     // What the tile job recorded is what the neighbours' results say of its halo.
