@@ -36,8 +36,7 @@ TileStore prepare_tile_store(const Config& config, const RunFingerprints& finger
 struct TileStageReport {
   std::vector<std::uint8_t> processed;  ///< per store tile: processed now (not reused)
   std::size_t count = 0;                ///< tiles processed now
-  /// Tiles whose result was kept when a neighbour was redone (counted on the root: under MPI
-  /// another rank's kept tiles count as processed).
+  /// Tiles whose result was kept when a neighbour was redone (not among `processed`).
   std::size_t kept = 0;
 };
 

@@ -112,6 +112,7 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& resu
 /// checked: restamp_tile_result checks it).
 struct ResultOrigin {
   std::uint64_t result = 0, inputs = 0, settled = 0;
+  bool kept = false;  ///< last written by restamp_tile_result (kept, not processed)
 };
 std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file);
 /// Writes the result in `file` again under the digest `result` (atomically), unchanged

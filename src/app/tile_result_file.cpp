@@ -67,8 +67,9 @@ struct ResultHeader {
   ChangeFigures change;
   std::uint64_t refuted, refuted_bytes;                   ///< the third varint section, after the pairs
   std::uint64_t inputs_fingerprint, settled_fingerprint;  ///< ResultOrigin (version 08)
+  std::uint64_t kept;                                     ///< 1 when last written by restamp_tile_result (version 08)
 };
-static_assert(sizeof(ResultHeader) == 216);
+static_assert(sizeof(ResultHeader) == 224);
 constexpr std::size_t kHeader07Bytes = 200;  ///< a version 07 header: this one's first bytes
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
@@ -333,7 +334,7 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
   std::ifstream in(file, std::ios::binary);
   if (!in.read(reinterpret_cast<char*>(&h), sizeof h)) return std::nullopt;
   if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
-  return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint};
+  return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
 }
 
 bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result) {
@@ -341,6 +342,8 @@ bool restamp_tile_result(const std::filesystem::path& file, const TileStore& sto
   if (!checked) return false;
   std::string& bytes = checked->bytes;
   std::memcpy(bytes.data() + offsetof(ResultHeader, fingerprint), &result, sizeof result);
+  const std::uint64_t kept = 1;
+  std::memcpy(bytes.data() + offsetof(ResultHeader, kept), &kept, sizeof kept);
   const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - sizeof sum);
   std::memcpy(bytes.data() + bytes.size() - sizeof sum, &sum, sizeof sum);
   write_file_atomically(file, bytes);

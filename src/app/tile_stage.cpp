@@ -114,6 +114,20 @@ SettledSelection settled_selection(const Config& config, const TileStore& store,
   return settled;
 }
 
+/// Tiles another rank kept were reported to the root as done like the ones it processed: their
+/// results say which they are.
+void count_kept_elsewhere(const Config& config, const TileStore& store, const std::vector<std::size_t>& tiles,
+                          TileStageReport& report) {
+  for (const std::size_t k : tiles) {
+    if (report.processed[k] == 0) continue;
+    const std::optional<ResultOrigin> origin = tile_result_origin(result_path(config, store.tiles[k].key));
+    if (!origin || !origin->kept) continue;
+    report.processed[k] = 0;
+    --report.count;
+    ++report.kept;
+  }
+}
+
 /// Whether tile `key` has a finished result made under `digest`: complete (the checksum
 /// covers the whole file); it is decoded once, by the final pass.
 bool has_finished_result(const Config& config, const TileStore& store, TileKey key, std::uint64_t digest) {
@@ -198,7 +212,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
   std::vector<std::uint8_t> finished_elsewhere(tiles.size(), 0);
   const std::unique_ptr<std::atomic<bool>[]> kept(new std::atomic<bool>[tiles.size()] {});
   const auto on_finish = [&](std::size_t item) {
-    // Kept tiles of this process's workers count as reused (another rank's count as made).
+    // Kept tiles of this process's workers count as reused (another rank's: after the stage).
     if (kept[item].load()) {
       ++report.kept;
       progress.kept(store.tiles[tiles[item]].owned());
@@ -250,6 +264,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
     report.processed[tiles[item]] = 0;
     --report.count;
   }
+  if (cluster.root() && cluster.size() > 1) count_kept_elsewhere(config, store, tiles, report);
   return report;
 }
 

@@ -177,11 +177,11 @@ TEST(TileResult, DamageUnderAValidChecksumIsProcessedAgainNeverACrash) {
   for (int trial = 0; trial < 500; ++trial) {
     std::string bytes = good;
     // A count or section size in the header (bytes 24-56, 80-96 and 184-200), or the varint
-    // sections (after the 216-byte header).
+    // sections (after the 224-byte header).
     const std::size_t at = trial % 5 == 0   ? 24 + rng() % 32
                            : trial % 5 == 1 ? 80 + rng() % 16
                            : trial % 5 == 2 ? 184 + rng() % 16
-                                            : 216 + rng() % 3000;
+                                            : 224 + rng() % 3000;
     bytes[at] = static_cast<char>(rng());
     const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
     std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
@@ -205,6 +205,7 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   ASSERT_TRUE(origin.has_value());
   EXPECT_EQ(origin->inputs, kDigests.inputs);
   EXPECT_EQ(origin->settled, r.settled_fingerprint);
+  EXPECT_FALSE(origin->kept);
   ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, kFingerprint + 7));
   EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 7, store));
   EXPECT_FALSE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
@@ -216,6 +217,7 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   const std::optional<ResultOrigin> again = tile_result_origin(tmp / "t.bin");
   ASSERT_TRUE(again.has_value());
   EXPECT_EQ(again->inputs, kDigests.inputs);
+  EXPECT_TRUE(again->kept) << "the report tells kept results from processed ones by it";
   // Nothing to write again: no file, or a damaged one (left as it is).
   EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, 1));
   EXPECT_FALSE(tile_result_origin(tmp / "none.bin").has_value());
@@ -232,9 +234,9 @@ TEST(TileResult, AVersion07ResultIsStillReadButNeverKeptAfterANeighbour) {
   const TileStore store = two_acquisitions();
   const TileResult r = random_result(9, true);
   write_tile_result(tmp / "t.bin", r, kDigests);
-  // Version 07: the same header without its last 16 bytes (what the result was made from).
+  // Version 07: the same header without its last 24 bytes (what the result was made from).
   std::string bytes = *read_file_bytes(tmp / "t.bin");
-  bytes.erase(200, 16);
+  bytes.erase(200, 24);
   bytes[7] = '7';
   const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
   std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
