@@ -9,6 +9,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "mesh_parts.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -154,6 +155,35 @@ TEST_F(ClusterRun, SubsetsThenMergeGiveTheBytesOfOneProcess) {
   const auto merged = test::run_citymesh("merge " + run);
   ASSERT_EQ(merged.exit_code, 0) << merged.err;
   EXPECT_TRUE(test::result_bytes(output("sub")) == *reference_) << "subsets + merge differ from one process";
+}
+
+TEST_F(ClusterRun, AnAppendedPassUnderMpiKeepsWhatOneProcessKeepsToTheSameBytes) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  // The sixth pass over the first 21 m (as in TiledRun.AnAppendedAcquisition...): tiles of the
+  // fourth column wait for the third, which it reaches, and are kept.
+  ASSERT_TRUE(test::write_append_configs(*dir_ / "sim", 0.35));
+  const auto config = [&](const char* file, const char* name) {
+    return fmt::format(
+        "{}/{} --no-pictures --set project.output={} --set project.work=work-{} "
+        "--set tiling.tile_size=10",
+        sim_, file, name, name);
+  };
+  std::map<std::string, nlohmann::json> reports;
+  for (const char* name : {"append-one", "append-mpi"}) {
+    const auto five = test::run_citymesh("run " + config("five.toml", name));
+    ASSERT_EQ(five.exit_code, 0) << five.err;
+    const std::string six = std::string(name) == "append-one" ? std::string(CITYMESH_BINARY) : mpirun(3);
+    const std::string cmd = fmt::format("{} run {} > {} 2>&1", six, config("six.toml", name),
+                                        (*dir_ / (std::string(name) + ".log")).string());
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(*dir_ / (std::string(name) + ".log"));
+    reports[name] = read_json(output(name) / "run.json");
+  }
+  EXPECT_TRUE(test::result_bytes(output("append-mpi")) == test::result_bytes(output("append-one")))
+      << "3 ranks appending differ from one process";
+  EXPECT_GT(reports["append-one"]["kept_tiles"].get<int>(), 0);
+  // The root counts the tiles the other ranks kept (their results say so).
+  EXPECT_EQ(reports["append-mpi"]["kept_tiles"], reports["append-one"]["kept_tiles"]);
+  EXPECT_EQ(reports["append-mpi"]["reused_tiles"], reports["append-one"]["reused_tiles"]);
 }
 
 TEST_F(ClusterRun, BadSubsetsAreUsageErrors) {

@@ -13,6 +13,7 @@
 
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
+#include "mesh_parts.h"
 #include "mosaic_ply.h"
 #include "test_support.h"
 
@@ -320,52 +321,16 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
 }
 
-/// `mesh` with only the triangles whose centroid lies in the first `share` of its longer
-/// horizontal extent (a pass that drove part of the street), or in the first `far_share` of it
-/// on the far half of the other extent (default: the same share).
-Mesh first_part(const Mesh& mesh, double share, double far_share = -1) {
-  double lo[2] = {DBL_MAX, DBL_MAX}, hi[2] = {-DBL_MAX, -DBL_MAX};
-  for (const Vec3f& p : mesh.positions) {
-    lo[0] = std::min(lo[0], double(p.x)), hi[0] = std::max(hi[0], double(p.x));
-    lo[1] = std::min(lo[1], double(p.y)), hi[1] = std::max(hi[1], double(p.y));
-  }
-  const int axis = hi[0] - lo[0] >= hi[1] - lo[1] ? 0 : 1, other = 1 - axis;
-  const double middle = (lo[other] + hi[other]) / 2;
-  const double end = lo[axis] + share * (hi[axis] - lo[axis]);
-  const double far_end = lo[axis] + (far_share < 0 ? share : far_share) * (hi[axis] - lo[axis]);
-  Mesh part = mesh;
-  part.triangles.clear();
-  part.triangle_ids.clear();
-  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const auto [a, b, c] = mesh.corners(t);
-    const Vec3d centroid = (a + b + c) / 3.0;
-    const double along = axis == 0 ? centroid.x : centroid.y, across = axis == 0 ? centroid.y : centroid.x;
-    if (along >= (across >= middle ? far_end : end)) continue;
-    part.triangles.push_back(mesh.triangles[t]);
-    part.triangle_ids.push_back(mesh.triangle_ids[t]);
-  }
-  return part;
-}
-
 TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFreshRun) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
-  // Five passes first; then a sixth over the first 21 m of the street on one side and 26 m on
-  // the other is appended: it ends in the third of six 10 m tile columns, whose later-phase
+  // Five passes first; then a sixth over the first 21 m of the street on one side and 27.8 m
+  // on the other is appended: it ends in the third of six 10 m tile columns, whose later-phase
   // neighbours in the fourth wait for it. Their border with the third is 9 m from the pass's
-  // end on the first side (decisions there unchanged: those tiles are kept) and 4 m on the
-  // other (changed: redone).
-  const std::string config = test::read_text(dir / "sim/config.toml");
-  const std::size_t last = config.rfind("[[acquisition]]");
-  ASSERT_NE(last, std::string::npos);
-  std::string sixth = config.substr(last);
-  const std::size_t path = sixth.find("acq_5.ply");
-  ASSERT_NE(path, std::string::npos);
-  sixth.replace(path, 9, "acq_5_part.ply");
-  test::write_text(dir / "sim/five.toml", config.substr(0, last));
-  test::write_text(dir / "sim/six.toml", config.substr(0, last) + sixth);
-  write_mesh_ply(dir / "sim/acq_5_part.ply", first_part(read_mesh(dir / "sim/acq_5.ply").mesh, 0.35, 27.8 / 60));
+  // end on the first side (decisions there unchanged: those tiles are kept) and 2.2 m on the
+  // other (a decision on their halo changed: redone).
+  ASSERT_TRUE(test::write_append_configs(dir / "sim", 0.35, 27.8 / 60));
   const auto run = [&](const std::string& file, const std::string& name, const std::string& extra = "") {
     return test::run_citymesh(
         fmt::format("run {}/{} --no-pictures --set tiling.tile_size=10 --set project.output={} "
