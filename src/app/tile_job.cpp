@@ -91,7 +91,7 @@ bool keep_if_still_right(const std::filesystem::path& file, const TileStore& sto
   const std::optional<ResultOrigin> origin = tile_result_origin(file);
   if (!origin || origin->inputs != digests.inputs) return false;
   if (origin->settled != tile_settled_fingerprint(store, key, settled)) return false;
-  return restamp_tile_result(file, store, digests.result);
+  return restamp_tile_result(file, store, *origin, digests.result);
 }
 
 bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {

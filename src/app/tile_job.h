@@ -115,9 +115,11 @@ struct ResultOrigin {
   bool kept = false;  ///< last written by restamp_tile_result (kept, not processed)
 };
 std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file);
-/// Writes the result in `file` again under the digest `result` (atomically), unchanged
-/// otherwise; false when `file` holds no finished result (checked whole, as resuming does).
-bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result);
+/// Writes the result in `file` again under the digest `result` (atomically), marked kept and
+/// unchanged otherwise; false, leaving it as it is, unless `file` holds a whole result of this
+/// version (checked as resuming does) made from `made_from`'s inputs and settled fingerprint.
+bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, const ResultOrigin& made_from,
+                         std::uint64_t result);
 /// Whether the result of tile `key` in `file`, made under another digest, is still right under
 /// `digests`: made from the same inputs and from the same decisions of the earlier-phase
 /// neighbours on the tile's halo (`settled`), all the tile job reads. It is then written

@@ -30,9 +30,9 @@ namespace {
 // Version 07: the copies refuted by the tile's owned triangles (TileResult::refuted); older
 // results counted refutes differently.
 // Version 08: what the result was made from (the tile's inputs digest, the fingerprint of its
-// neighbours' decisions on its halo), so that a result is kept when only a neighbour was
-// redone, to the same decisions. Version 07 results (the same but for those two fields, at
-// the end of the header) are still read; they are never kept that way.
+// neighbours' decisions on its halo) and whether it was kept that way, so that a result is
+// kept when only a neighbour was redone, to the same decisions. Version 07 results (the same
+// but for those three fields, at the end of the header) are still read; they are never kept.
 constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '8'};
 constexpr char kMagic07[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '7'};
 
@@ -337,9 +337,14 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
   return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
 }
 
-bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, std::uint64_t result) {
+bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, const ResultOrigin& made_from,
+                         std::uint64_t result) {
   std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
-  if (!checked) return false;
+  // Only a whole result of this version (a version 07 header has no room for the kept flag)
+  // made from what the caller was told: the file may have been replaced since it looked.
+  if (!checked || checked->header_bytes != sizeof(ResultHeader)) return false;
+  const ResultHeader& h = checked->header;
+  if (h.inputs_fingerprint != made_from.inputs || h.settled_fingerprint != made_from.settled) return false;
   std::string& bytes = checked->bytes;
   std::memcpy(bytes.data() + offsetof(ResultHeader, fingerprint), &result, sizeof result);
   const std::uint64_t kept = 1;

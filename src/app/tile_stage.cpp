@@ -243,14 +243,14 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
     }
     try {
       const SettledSelection settled = settled_selection(config, store, k, digests.result);
-      if (keep_if_still_right(result_path(config, tile.key), store, tile.key, {digests.result[k], digests.inputs[k]},
-                              settled)) {
+      const ResultDigests own{digests.result[k], digests.inputs[k]};
+      if (keep_if_still_right(result_path(config, tile.key), store, tile.key, own, settled)) {
         log::debug("tile {}: a neighbour was redone to the same decisions on its border: its result is kept",
                    tile.key.name());
         kept[item] = true;
       } else {
         const TileResult r = process_tile(store, tile.key, config, settled);
-        write_tile_result(result_path(config, tile.key), r, {digests.result[k], digests.inputs[k]});
+        write_tile_result(result_path(config, tile.key), r, own);
       }
     } catch (...) {
       gate.release(estimate);

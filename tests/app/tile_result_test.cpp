@@ -206,7 +206,12 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   EXPECT_EQ(origin->inputs, kDigests.inputs);
   EXPECT_EQ(origin->settled, r.settled_fingerprint);
   EXPECT_FALSE(origin->kept);
-  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, kFingerprint + 7));
+  // Not when the file holds a result made from something else than the caller saw.
+  ResultOrigin other = *origin;
+  ++other.settled;
+  EXPECT_FALSE(restamp_tile_result(tmp / "t.bin", store, other, kFingerprint + 7));
+  EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store)) << "left as it was";
+  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, *origin, kFingerprint + 7));
   EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 7, store));
   EXPECT_FALSE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
   const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint + 7, store);
@@ -219,13 +224,13 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   EXPECT_EQ(again->inputs, kDigests.inputs);
   EXPECT_TRUE(again->kept) << "the report tells kept results from processed ones by it";
   // Nothing to write again: no file, or a damaged one (left as it is).
-  EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, 1));
+  EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, *origin, 1));
   EXPECT_FALSE(tile_result_origin(tmp / "none.bin").has_value());
   std::string bytes = *read_file_bytes(tmp / "t.bin");
   bytes[300] ^= 1;
   std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
   EXPECT_TRUE(tile_result_origin(tmp / "bad.bin").has_value()) << "the header alone is read";
-  EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, 1)) << "but the whole file is checked";
+  EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, *origin, 1)) << "but the whole file is checked";
   EXPECT_EQ(*read_file_bytes(tmp / "bad.bin"), bytes);
 }
 
@@ -247,6 +252,9 @@ TEST(TileResult, AVersion07ResultIsStillReadButNeverKeptAfterANeighbour) {
   EXPECT_EQ(back->refuted, r.refuted);
   EXPECT_TRUE(tile_result_is_finished(tmp / "v7.bin", kFingerprint, store));
   EXPECT_FALSE(tile_result_origin(tmp / "v7.bin").has_value());
+  // Its header has no room for the kept flag: never written again that way (nor damaged).
+  EXPECT_FALSE(restamp_tile_result(tmp / "v7.bin", store, ResultOrigin{}, kFingerprint + 1));
+  EXPECT_EQ(*read_file_bytes(tmp / "v7.bin"), bytes);
   // Version 06 is another layout: processed again.
   bytes[7] = '6';
   const std::uint64_t sum6 = bulk_checksum(bytes.data(), bytes.size() - 8);
