@@ -4,7 +4,8 @@
 // unlabelled fraction before and after improvement; and our max-flow against Boost.Graph's
 // boykov_kolmogorov_max_flow on the same two-mesh graphs.
 //   mosaic_bench [--length 30] [--epochs 7] [--sweeps 3] [--repeat 5] [--max-flow-repeat 9]
-//                [--threads N] [--mosaic-only 1] [--seen-through-quality 0.2] [--crease-weight 3]
+//                [--threads N] [--mosaic-only 1] [--max-flow-only 1] [--seen-through-quality 0.2]
+//                [--crease-weight 3]
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -122,6 +123,7 @@ int main(int argc, char** argv) {
   int max_flow_repeat = 9;   // solves per graph in the max-flow race
   unsigned threads = 0;      // 0: every core
   bool mosaic_only = false;  // skips the baseline, the whole-energy QPBO and the max-flow race
+  bool max_flow_only = false;  // runs the max-flow race alone
   MosaicParams params;
   bool keep_freed = true;  // as the citymesh binary does (--keep-freed 0: glibc's defaults)
   for (int i = 1; i + 1 < argc; i += 2) {
@@ -134,6 +136,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--mosaic-only") == 0) mosaic_only = std::strcmp(argv[i + 1], "0") != 0;
     if (std::strcmp(argv[i], "--seen-through-quality") == 0) params.seen_through_quality = std::stod(argv[i + 1]);
     if (std::strcmp(argv[i], "--crease-weight") == 0) params.crease_weight = std::stod(argv[i + 1]);
+    if (std::strcmp(argv[i], "--max-flow-only") == 0) max_flow_only = std::strcmp(argv[i + 1], "0") != 0;
     if (std::strcmp(argv[i], "--keep-freed") == 0) keep_freed = std::strcmp(argv[i + 1], "0") != 0;
   }
   if (keep_freed) keep_freed_memory_for_reuse();
@@ -141,6 +144,10 @@ int main(int argc, char** argv) {
   const bench::BenchScene scene = bench::simulated_street(length, epochs);
   fmt::print("scene: {:.0f} m street, {} epochs, {} triangles\n", length, scene.meshes.size(), scene.triangles);
   const ChangeParams change_params;
+  if (max_flow_only) {
+    compare_max_flows(scene, change_params, params, max_flow_repeat);
+    return 0;
+  }
   const ChangeResult change = detect_changes({scene.meshes, scene.dates}, change_params);
   const MosaicInput input{scene.meshes, scene.dates, &change, change_params.distance_threshold, {}};
   // The target is judged on the median of `repeat` runs: single runs on this shared VM vary
