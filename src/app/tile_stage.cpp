@@ -114,14 +114,19 @@ SettledSelection settled_selection(const Config& config, const TileStore& store,
   return settled;
 }
 
-/// Tiles another rank kept were reported to the root as done like the ones it processed: their
-/// results say which they are.
+/// Whether another rank kept tile `key` (it reported the tile done like one it processed; the
+/// result's header says which). False when the result cannot be read yet, as may happen for a
+/// moment on a shared file system: the stage's report is mended at its end.
+bool kept_elsewhere(const Config& config, TileKey key) {
+  const std::optional<ResultOrigin> origin = tile_result_origin(result_path(config, key));
+  return origin && origin->kept;
+}
+
+/// Tiles another rank kept and the progress counted as processed: their results say which.
 void count_kept_elsewhere(const Config& config, const TileStore& store, const std::vector<std::size_t>& tiles,
                           TileStageReport& report) {
   for (const std::size_t k : tiles) {
-    if (report.processed[k] == 0) continue;
-    const std::optional<ResultOrigin> origin = tile_result_origin(result_path(config, store.tiles[k].key));
-    if (!origin || !origin->kept) continue;
+    if (report.processed[k] == 0 || !kept_elsewhere(config, store.tiles[k].key)) continue;
     report.processed[k] = 0;
     --report.count;
     ++report.kept;
@@ -211,9 +216,12 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
   // Per item, each written by its worker only: made by its owner meanwhile, or kept.
   std::vector<std::uint8_t> finished_elsewhere(tiles.size(), 0);
   const std::unique_ptr<std::atomic<bool>[]> kept(new std::atomic<bool>[tiles.size()] {});
+  const std::unique_ptr<std::atomic<bool>[]> mine(new std::atomic<bool>[tiles.size()] {});
+  const bool several_ranks = cluster.size() > 1;
   const auto on_finish = [&](std::size_t item) {
-    // Kept tiles of this process's workers count as reused (another rank's: after the stage).
-    if (kept[item].load()) {
+    // Kept tiles count as reused: this process's workers say so, another rank's result does.
+    const TileKey key = store.tiles[tiles[item]].key;
+    if (kept[item].load() || (several_ranks && !mine[item].load() && kept_elsewhere(config, key))) {
       ++report.kept;
       progress.kept(store.tiles[tiles[item]].owned());
       return;
@@ -227,6 +235,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
   run_workers(*channel, available_threads(), [&](std::size_t item) {
     const std::size_t k = tiles[item];
     const TileContents& tile = store.tiles[k];
+    mine[item] = true;
     throw_if_interrupted("tile processing");
     if (!theirs.empty() && theirs[k] != 0 && has_finished_result(config, store, tile.key, digests.result[k])) {
       finished_elsewhere[item] = 1;  // its owner made it while this process did its own
@@ -264,7 +273,7 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
     report.processed[tiles[item]] = 0;
     --report.count;
   }
-  if (cluster.root() && cluster.size() > 1) count_kept_elsewhere(config, store, tiles, report);
+  if (cluster.root() && several_ranks) count_kept_elsewhere(config, store, tiles, report);
   return report;
 }
 

@@ -169,6 +169,7 @@ TEST_F(ClusterRun, AnAppendedPassUnderMpiKeepsWhatOneProcessKeepsToTheSameBytes)
         sim_, file, name, name);
   };
   std::map<std::string, nlohmann::json> reports;
+  std::map<std::string, std::string> last_progress;  // "info: tiles 12/12 (12 reused)"
   for (const char* name : {"append-one", "append-mpi"}) {
     const auto five = test::run_citymesh("run " + config("five.toml", name));
     ASSERT_EQ(five.exit_code, 0) << five.err;
@@ -177,9 +178,15 @@ TEST_F(ClusterRun, AnAppendedPassUnderMpiKeepsWhatOneProcessKeepsToTheSameBytes)
                                         (*dir_ / (std::string(name) + ".log")).string());
     ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(*dir_ / (std::string(name) + ".log"));
     reports[name] = read_json(output(name) / "run.json");
+    const std::string log = test::read_text(*dir_ / (std::string(name) + ".log"));
+    const std::size_t line = log.rfind("info: tiles ");
+    ASSERT_NE(line, std::string::npos) << log;
+    last_progress[name] = log.substr(line, log.find(',', line) - line);
   }
   EXPECT_TRUE(test::result_bytes(output("append-mpi")) == test::result_bytes(output("append-one")))
       << "3 ranks appending differ from one process";
+  // So do the progress lines: a tile another rank kept is reused, not processed.
+  EXPECT_EQ(last_progress["append-mpi"], last_progress["append-one"]);
   EXPECT_GT(reports["append-one"]["kept_tiles"].get<int>(), 0);
   // The root counts the tiles the other ranks kept (their results say so).
   EXPECT_EQ(reports["append-mpi"]["kept_tiles"], reports["append-one"]["kept_tiles"]);

@@ -56,7 +56,9 @@ ReferenceFlow reference_max_flow(std::vector<std::vector<double>> cap) {
 /// node n + 1 the sink).
 struct TwinGraph {
   explicit TwinGraph(int nodes)
-      : n(nodes), dense(static_cast<std::size_t>(nodes + 2), std::vector<double>(nodes + 2, 0.0)), g(static_cast<std::size_t>(nodes)) {}
+      : n(nodes),
+        dense(static_cast<std::size_t>(nodes + 2), std::vector<double>(nodes + 2, 0.0)),
+        g(static_cast<std::size_t>(nodes)) {}
   void terminal(int i, double a, double b) {
     g.add_terminal(static_cast<MaxFlow::Node>(i), a, b);
     dense[0][static_cast<std::size_t>(i + 1)] += a;
@@ -112,7 +114,8 @@ TEST(MaxFlow, EqualsEdmondsKarpAndItsCutOnRandomGraphs) {
     }
     const int edges = static_cast<int>(rng() % static_cast<unsigned>(4 * n + 1));
     for (int k = 0; k < edges; ++k) {
-      const int i = static_cast<int>(rng() % static_cast<unsigned>(n)), j = static_cast<int>(rng() % static_cast<unsigned>(n));
+      const int i = static_cast<int>(rng() % static_cast<unsigned>(n)),
+                j = static_cast<int>(rng() % static_cast<unsigned>(n));
       if (i == j) continue;
       const double c = capacity(), r = rng() % 2 == 0 ? 0.0 : capacity();
       t.edge(i, j, c, r);

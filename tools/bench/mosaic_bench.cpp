@@ -120,9 +120,9 @@ int main(int argc, char** argv) {
   float length = 30.0f;
   int epochs = 7;
   int repeat = 5;
-  int max_flow_repeat = 9;   // solves per graph in the max-flow race
-  unsigned threads = 0;      // 0: every core
-  bool mosaic_only = false;  // skips the baseline, the whole-energy QPBO and the max-flow race
+  int max_flow_repeat = 9;     // solves per graph in the max-flow race
+  unsigned threads = 0;        // 0: every core
+  bool mosaic_only = false;    // skips the baseline, the whole-energy QPBO and the max-flow race
   bool max_flow_only = false;  // runs the max-flow race alone
   MosaicParams params;
   bool keep_freed = true;  // as the citymesh binary does (--keep-freed 0: glibc's defaults)
