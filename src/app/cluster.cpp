@@ -21,6 +21,7 @@ class SingleProcess final : public Cluster {
   int rank() const override { return 0; }
   int size() const override { return 1; }
   void barrier() override {}
+  bool same_everywhere(std::uint64_t) override { return true; }
   std::unique_ptr<WorkChannel> share(WorkSchedule* schedule, std::function<void(std::size_t)> on_finish) override {
     return std::make_unique<LocalChannel>(*schedule, std::move(on_finish));
   }
@@ -45,9 +46,10 @@ std::unique_ptr<Cluster> join_cluster() {
   if (ranks == 0) return single_process();
   if (std::unique_ptr<Cluster> mpi = join_mpi()) return mpi;
   if (ranks > 1) {
-    throw ConfigError(fmt::format("started as one of {} MPI ranks, but this citymesh was built without MPI "
-                                  "(install libopenmpi-dev and rebuild), or use --subset i/N",
-                                  ranks));
+    throw ConfigError(
+        fmt::format("started as one of {} MPI ranks, but this citymesh was built without MPI "
+                    "(install libopenmpi-dev and rebuild), or use --subset i/N",
+                    ranks));
   }
   return single_process();
 }

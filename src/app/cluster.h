@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <functional>
 #include <memory>
 
@@ -21,6 +22,10 @@ class Cluster {
   /// Returns once every rank has called it. Ranks wait asleep, so an idle rank leaves its
   /// cores to the others.
   virtual void barrier() = 0;
+
+  /// True on every rank when every rank gave the same value, false on every rank otherwise.
+  /// Collective.
+  virtual bool same_everywhere(std::uint64_t value) = 0;
 
   /// Shares the root's `schedule` (the other ranks pass nullptr) with the worker threads of
   /// every rank: rank 0 hands out items, the others pull. Collective. `on_finish` runs on the

@@ -5,9 +5,8 @@
 // its cores to the ranks that work.
 #define OMPI_SKIP_MPICXX 1
 #define MPICH_SKIP_MPICXX 1
-#include <mpi.h>
-
 #include <fmt/format.h>
+#include <mpi.h>
 
 #include <atomic>
 #include <chrono>
@@ -54,9 +53,7 @@ class RootChannel final : public WorkChannel {
  public:
   RootChannel(int ranks, WorkSchedule& schedule, std::function<void(std::size_t)> on_finish)
       : local_(schedule, std::move(on_finish)), remaining_(ranks - 1), server_([this] { serve(); }) {}
-  ~RootChannel() override {
-    server_.join();
-  }
+  ~RootChannel() override { server_.join(); }
   std::optional<std::size_t> next(std::optional<std::size_t> finished) override { return local_.next(finished); }
   void abort() override {
     stop_ = true;
@@ -73,8 +70,8 @@ class RootChannel final : public WorkChannel {
         if (flag != 0) {
           std::int64_t finished = 0;
           MPI_Recv(&finished, 1, MPI_INT64_T, status.MPI_SOURCE, kRequest, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
-          const WorkReply reply = local_.poll(finished >= 0 ? std::optional<std::size_t>(static_cast<std::size_t>(finished))
-                                                           : std::nullopt);
+          const WorkReply reply = local_.poll(
+              finished >= 0 ? std::optional<std::size_t>(static_cast<std::size_t>(finished)) : std::nullopt);
           send(status.MPI_SOURCE, kReply,
                reply.kind == WorkReply::Kind::item   ? static_cast<std::int64_t>(reply.item)
                : reply.kind == WorkReply::Kind::wait ? kWait
@@ -160,6 +157,19 @@ class MpiCluster final : public Cluster {
     }
     for (int r = 1; r < size_; ++r) (void)receive(r, kArrive, 5);
     for (int r = 1; r < size_; ++r) send(r, kGo, 0);
+  }
+
+  bool same_everywhere(std::uint64_t value) override {
+    // A barrier whose messages carry the values: the root compares them and sends the answer.
+    const auto sent = static_cast<std::int64_t>(value);
+    if (rank_ != 0) {
+      send(0, kArrive, sent);
+      return receive(0, kGo, 5) == 1;
+    }
+    bool same = true;
+    for (int r = 1; r < size_; ++r) same = receive(r, kArrive, 5) == sent && same;
+    for (int r = 1; r < size_; ++r) send(r, kGo, same ? 1 : 0);
+    return same;
   }
 
   std::unique_ptr<WorkChannel> share(WorkSchedule* schedule, std::function<void(std::size_t)> on_finish) override {

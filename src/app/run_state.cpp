@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "tiled_run.h"
@@ -118,8 +119,11 @@ std::map<std::string, std::string> result_keys(const Config& config) {
 
 RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys, std::size_t acquisitions) {
   // The formats' versions are part of each: work made by an older build is redone, not misread.
+  // The tile results also depend on the build itself (its code decides what they hold): another
+  // build's are made again, never mixed with this one's. The tile store's layout is all its
+  // version says, so it is kept across builds.
   const std::string versions = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
-  std::string settings = versions, tiling = versions;
+  std::string settings = versions + fmt::format("build {:016x}\n", executable_identity()), tiling = versions;
   std::vector<std::string> own(acquisitions);
   for (const auto& [k, v] : keys) {
     const std::string line = k + "=" + v + "\n";
@@ -145,10 +149,18 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
   const std::filesystem::path file = work / kRunConfigFile;
   std::ifstream in(file);
+  const std::string build = fmt::format("{:016x}", executable_identity());
   if (in) {
     std::map<std::string, std::string> before;
     try {
-      before = nlohmann::json::parse(in).at("keys").get<std::map<std::string, std::string>>();
+      const nlohmann::json recorded = nlohmann::json::parse(in);
+      before = recorded.at("keys").get<std::map<std::string, std::string>>();
+      if (recorded.value("build", std::string()) != build) {
+        log::info(
+            "{}: the work there was made by another build of citymesh: its tile results, stitched parts "
+            "and encoded tiles are made again (its tiling is kept)",
+            work.string());
+      }
     } catch (const nlohmann::json::exception& e) {
       if (!force)
         throw InputError(fmt::format(
@@ -196,7 +208,7 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     }
   }
   std::filesystem::create_directories(work);
-  write_file_atomically(file, nlohmann::json{{"keys", keys}}.dump(1) + "\n");
+  write_file_atomically(file, nlohmann::json{{"keys", keys}, {"build", build}}.dump(1) + "\n");
 }
 
 }  // namespace citymesh::app

@@ -35,7 +35,8 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
 /// Compares `keys` with <work>/run-config.json. When they differ: throws ConfigError naming
 /// every changed key, unless `force`. Acquisitions added after the last one recorded and
 /// rewritten input files are not changes: they are logged, and the work they touch is redone.
-/// Then records `keys` there.
+/// Says when another build of citymesh did the work (its results are made again: the run
+/// fingerprint holds the build). Then records `keys` and this build there.
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force);
 
 }  // namespace citymesh::app

@@ -10,6 +10,7 @@
 #include <optional>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
@@ -336,6 +337,12 @@ void run_subset(const Config& config, const TileStore& store, const TileDigests&
 
 void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cluster) {
   Stopwatch clock;
+  // Every rank computes the digests its results are filed under: they must agree.
+  if (!cluster.same_everywhere(executable_identity())) {
+    throw ConfigError(
+        "the ranks of this MPI job run different builds of citymesh: every rank must run the same executable, "
+        "byte for byte");
+  }
   check_seam_pass(config);
   const auto keys = result_keys(config);
   std::optional<WorkFolderLock> lock;

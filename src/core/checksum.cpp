@@ -3,25 +3,27 @@
 
 #include <xxhash.h>
 
-#include <filesystem>
+#include <fstream>
 #include <new>
-#include <system_error>
+#include <vector>
 
 namespace citymesh {
 
 std::uint64_t bulk_checksum(const void* data, std::size_t size) { return XXH3_64bits(data, size); }
 
 std::uint64_t executable_identity() {
+  // The executable's bytes, not its size and time: the same build installed on every node of
+  // a cluster (or copied, or reinstalled) is the same build.
   static const std::uint64_t identity = [] {
-    std::error_code ec;
-    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-    if (ec) return std::uint64_t{0};
-    const std::uintmax_t size = std::filesystem::file_size(exe, ec);
-    if (ec) return std::uint64_t{0};
-    const auto time = std::filesystem::last_write_time(exe, ec).time_since_epoch().count();
-    if (ec) return std::uint64_t{0};
-    const std::uint64_t parts[2] = {static_cast<std::uint64_t>(size), static_cast<std::uint64_t>(time)};
-    return bulk_checksum(parts, sizeof(parts));
+    std::ifstream in("/proc/self/exe", std::ios::binary);
+    if (!in) return std::uint64_t{0};
+    BulkChecksum sum;
+    std::vector<char> buffer(std::size_t{1} << 20);
+    while (in) {
+      in.read(buffer.data(), static_cast<std::streamsize>(buffer.size()));
+      sum.add(buffer.data(), static_cast<std::size_t>(in.gcount()));
+    }
+    return in.eof() ? sum.value() : std::uint64_t{0};
   }();
   return identity;
 }

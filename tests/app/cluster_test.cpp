@@ -193,6 +193,22 @@ TEST_F(ClusterRun, AnAppendedPassUnderMpiKeepsWhatOneProcessKeepsToTheSameBytes)
   EXPECT_EQ(reports["append-mpi"]["reused_tiles"], reports["append-one"]["reused_tiles"]);
 }
 
+TEST_F(ClusterRun, RanksRunningDifferentBuildsAreRefused) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  // Each rank files its results under digests that hold its build: with two builds in one job
+  // they would not find each other's work. mpirun's "A : B" starts one rank of each.
+  const std::filesystem::path other = *dir_ / "other-citymesh";  // another build: one byte more
+  std::filesystem::copy_file(CITYMESH_BINARY, other, std::filesystem::copy_options::overwrite_existing);
+  test::write_text(other, test::read_text(other) + "x");
+  std::filesystem::permissions(other, std::filesystem::perms::owner_all);
+  const std::filesystem::path log = *dir_ / "two-builds.log";
+  const std::string cmd = fmt::format("{} run {} : -n 1 {} run {} > {} 2>&1", mpirun(1), args(sim_, "two-builds"),
+                                      other.string(), args(sim_, "two-builds"), log.string());
+  EXPECT_NE(std::system(cmd.c_str()), 0);
+  EXPECT_NE(test::read_text(log).find("different builds of citymesh"), std::string::npos) << test::read_text(log);
+  EXPECT_FALSE(std::filesystem::exists(output("two-builds") / "run.json"));
+}
+
 TEST_F(ClusterRun, BadSubsetsAreUsageErrors) {
   for (const char* bad : {"0/3", "4/3", "x"}) {
     const auto r = test::run_citymesh(fmt::format("run {} --subset {}", args(sim_, "bad"), bad));

@@ -321,6 +321,31 @@ TEST(TiledRun, ChangedConfigIsRefusedWithoutForceAndDamagedTilesAreRedone) {
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], 0);
 }
 
+TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
+  // An upgraded citymesh may decide otherwise: a work folder another build filled is done
+  // again (its tiling kept), never mixed into this build's output.
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const std::filesystem::path other = dir / "other-citymesh";  // another build: one byte more
+  std::filesystem::copy_file(CITYMESH_BINARY, other);
+  test::write_text(other, test::read_text(other) + "x");
+  std::filesystem::permissions(other, std::filesystem::perms::owner_all);
+  const auto by_other = test::run_program(other, run_args(sim, "c", "--set tiling.tile_size=10"));
+  ASSERT_EQ(by_other.exit_code, 0) << by_other.err;
+  const auto made_again = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
+  ASSERT_EQ(made_again.exit_code, 0) << made_again.err;
+  EXPECT_NE(made_again.err.find("made by another build of citymesh"), std::string::npos) << made_again.err;
+  const nlohmann::json report = read_json(dir / "sim/c/run.json");
+  EXPECT_EQ(report["reused_tiles"], 0);
+  EXPECT_GT(report["tiles"].get<int>(), 1);
+  EXPECT_NE(made_again.err.find("reusing the tile store"), std::string::npos) << made_again.err;
+  const auto reused = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
+  ASSERT_EQ(reused.exit_code, 0) << reused.err;
+  EXPECT_EQ(reused.err.find("another build"), std::string::npos) << reused.err;
+  EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], report["tiles"]);
+}
+
 TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFreshRun) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();

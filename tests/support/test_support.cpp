@@ -40,10 +40,12 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
   out << text;
 }
 
-CommandResult run_citymesh(const std::string& args) {
+CommandResult run_citymesh(const std::string& args) { return run_program(CITYMESH_BINARY, args); }
+
+CommandResult run_program(const std::filesystem::path& program, const std::string& args) {
   TempDir dir;
   const auto err_file = dir / "stderr.txt";
-  const std::string command = std::string(CITYMESH_BINARY) + " " + args + " 2>" + err_file.string();
+  const std::string command = program.string() + " " + args + " 2>" + err_file.string();
   CommandResult result;
   FILE* pipe = ::popen(command.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("popen failed");

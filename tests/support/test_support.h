@@ -30,6 +30,8 @@ struct CommandResult {
 
 /// Runs the built citymesh binary with `args` (shell words, already quoted as needed).
 CommandResult run_citymesh(const std::string& args);
+/// The same with another executable (a copy of citymesh, say).
+CommandResult run_program(const std::filesystem::path& program, const std::string& args);
 
 /// The project's source folder (for tests/data, configs, docs).
 std::filesystem::path source_dir();

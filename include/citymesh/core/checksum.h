@@ -24,9 +24,10 @@ inline std::uint64_t fnv1a(const void* data, std::size_t size, std::uint64_t has
 /// XXH3 (64 bit) of `data`: tens of GB/s, so checksumming costs nothing next to writing.
 std::uint64_t bulk_checksum(const void* data, std::size_t size);
 
-/// A digest of this program's executable (its size and modification time; 0 when unknown):
-/// work kept for later runs (stitched parts, encoded tiles) mixes it in, so that a rebuilt
-/// or upgraded citymesh, whose code may give other results, never takes an older build's.
+/// A digest of this program's executable file, its bytes (0 when it cannot be read): work
+/// kept for later runs (tile results, stitched parts, encoded tiles) mixes it in, so that a
+/// rebuilt or upgraded citymesh, whose code may give other results, never takes an older
+/// build's. The same build copied or installed on every node of a cluster has one identity.
 std::uint64_t executable_identity();
 
 /// bulk_checksum of bytes given in parts: the parts' concatenation gives the same value.
