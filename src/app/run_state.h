@@ -13,7 +13,9 @@
 namespace citymesh::app {
 
 inline constexpr const char* kRunConfigFile = "run-config.json";
-/// Bumped whenever what the tiler stores or what a tile result means changes.
+/// Bumped whenever what the tiler stores or what a tile result means changes. The tile
+/// results also depend on the build (run_fingerprints holds it), the tile store does not:
+/// a change to which triangles the tiler puts where must bump kTileStoreVersion.
 inline constexpr int kTileStoreVersion = 4;   // 2: one folder per acquisition; 3: XXH3 checksums;
                                               // 4: zero-area triangles dropped as whole-mesh reading drops them
 inline constexpr int kTileResultVersion = 4;  // 3: XXH3 checksum; 4: keyed on each tile's own inputs
