@@ -400,7 +400,8 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
     const std::size_t shown = std::min<std::size_t>(missing.size(), 8);
     throw InputError(
         fmt::format("{}: {} of {} tiles have no finished result ({}{}); run the subsets that own them "
-                    "again, or citymesh run CONFIG to finish them here",
+                    "again, or citymesh run CONFIG to finish them here (results made by another build of "
+                    "citymesh do not count)",
                     (config.project.work / "results").string(), missing.size(), store->tiles.size(),
                     fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
                     shown < missing.size() ? ", ..." : ""));
