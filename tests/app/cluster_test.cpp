@@ -197,10 +197,7 @@ TEST_F(ClusterRun, RanksRunningDifferentBuildsAreRefused) {
   if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
   // Each rank files its results under digests that hold its build: with two builds in one job
   // they would not find each other's work. mpirun's "A : B" starts one rank of each.
-  const std::filesystem::path other = *dir_ / "other-citymesh";  // another build: one byte more
-  std::filesystem::copy_file(CITYMESH_BINARY, other, std::filesystem::copy_options::overwrite_existing);
-  test::write_text(other, test::read_text(other) + "x");
-  std::filesystem::permissions(other, std::filesystem::perms::owner_all);
+  const std::filesystem::path other = test::copy_as_another_build(dir_->path());
   const std::filesystem::path log = *dir_ / "two-builds.log";
   const std::string cmd = fmt::format("{} run {} : -n 1 {} run {} > {} 2>&1", mpirun(1), args(sim_, "two-builds"),
                                       other.string(), args(sim_, "two-builds"), log.string());

@@ -327,10 +327,7 @@ TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
-  const std::filesystem::path other = dir / "other-citymesh";  // another build: one byte more
-  std::filesystem::copy_file(CITYMESH_BINARY, other);
-  test::write_text(other, test::read_text(other) + "x");
-  std::filesystem::permissions(other, std::filesystem::perms::owner_all);
+  const std::filesystem::path other = test::copy_as_another_build(dir.path());
   const auto by_other = test::run_program(other, run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(by_other.exit_code, 0) << by_other.err;
   const auto made_again = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));

@@ -58,6 +58,14 @@ CommandResult run_program(const std::filesystem::path& program, const std::strin
   return result;
 }
 
+std::filesystem::path copy_as_another_build(const std::filesystem::path& dir) {
+  const std::filesystem::path other = dir / "other-citymesh";
+  std::filesystem::copy_file(CITYMESH_BINARY, other, std::filesystem::copy_options::overwrite_existing);
+  write_text(other, read_text(other) + "x");
+  std::filesystem::permissions(other, std::filesystem::perms::owner_all);
+  return other;
+}
+
 std::filesystem::path source_dir() { return CITYMESH_SOURCE_DIR; }
 
 std::filesystem::path real_data_dir() {
