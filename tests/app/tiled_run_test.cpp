@@ -330,6 +330,7 @@ TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
   const std::filesystem::path other = test::copy_as_another_build(dir.path());
   const auto by_other = test::run_program(other, run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(by_other.exit_code, 0) << by_other.err;
+  const nlohmann::json other_build = read_json(dir / "sim/c/run.json")["citymesh"];
   const auto made_again = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(made_again.exit_code, 0) << made_again.err;
   EXPECT_NE(made_again.err.find("made by another build of citymesh"), std::string::npos) << made_again.err;
@@ -337,6 +338,10 @@ TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
   EXPECT_EQ(report["reused_tiles"], 0);
   EXPECT_GT(report["tiles"].get<int>(), 1);
   EXPECT_NE(made_again.err.find("reusing the tile store"), std::string::npos) << made_again.err;
+  // run.json names the build that made the whole output.
+  EXPECT_EQ(report["citymesh"]["version"], other_build["version"]);
+  EXPECT_EQ(report["citymesh"]["build"].get<std::string>().size(), 16u);
+  EXPECT_NE(report["citymesh"]["build"], other_build["build"]);
   const auto reused = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(reused.exit_code, 0) << reused.err;
   EXPECT_EQ(reused.err.find("another build"), std::string::npos) << reused.err;
