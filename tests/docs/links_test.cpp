@@ -7,7 +7,6 @@
 
 #include <cctype>
 #include <filesystem>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -54,13 +53,21 @@ std::vector<std::filesystem::path> pages() {
   return out;
 }
 
+/// The targets of the Markdown links "[text](target)" of `text`. (Not std::regex: GCC 12
+/// warns inside it under -O2 with the sanitizers.)
+std::vector<std::string> link_targets(const std::string& text) {
+  std::vector<std::string> targets;
+  for (std::size_t at = text.find("]("); at != std::string::npos; at = text.find("](", at + 2)) {
+    const std::size_t begin = at + 2, end = text.find_first_of(") \t\n", begin);
+    if (end != std::string::npos && text[end] == ')' && end > begin) targets.push_back(text.substr(begin, end - begin));
+  }
+  return targets;
+}
+
 TEST(DocsLinks, EveryRelativeLinkFindsItsFileAndHeading) {
-  const std::regex link(R"(\]\(([^)\s]+)\))");
   std::size_t checked = 0;
   for (const std::filesystem::path& page : pages()) {
-    const std::string text = test::read_text(page);
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), link); it != std::sregex_iterator(); ++it) {
-      const std::string target = (*it)[1];
+    for (const std::string& target : link_targets(test::read_text(page))) {
       if (target.find("://") != std::string::npos || target.starts_with("mailto:")) continue;
       const std::size_t hash = target.find('#');
       const std::string file = target.substr(0, hash);
@@ -73,6 +80,11 @@ TEST(DocsLinks, EveryRelativeLinkFindsItsFileAndHeading) {
     }
   }
   EXPECT_GT(checked, 20u);  // the pages do link to each other
+}
+
+TEST(DocsLinks, LinksAreFoundAsMarkdownWritesThem) {
+  EXPECT_EQ(link_targets("see [a](b.md#c), [d](e) and [not a link] (f) or [g](h i)"),
+            (std::vector<std::string>{"b.md#c", "e"}));
 }
 
 TEST(DocsLinks, HeadingsGiveGithubsAnchors) {
