@@ -9,9 +9,11 @@
 #include <set>
 
 #include "citymesh/core/atomic_file.h"
+#include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "tileset_json.h"
 
@@ -233,6 +235,23 @@ class TileWriter {
   std::filesystem::path staged_;
 };
 
+/// A digest of every tile's glb (its name and bytes, in the tree's order): the tileset's
+/// version, which changes exactly when a tile does. Viewers that honour it add it to their
+/// requests, so that an updated map is not hidden behind their caches. Read back from
+/// `staged`: under MPI other ranks write some of the tiles.
+std::string content_version(const TileTree& tree, const std::filesystem::path& staged) {
+  BulkChecksum sum;
+  for (const TileNode& node : tree.nodes) {
+    if (node.triangle_count == 0) continue;
+    const std::string name = node.name() + ".glb";
+    const std::optional<std::string> bytes = read_file_bytes(staged / name);
+    if (!bytes) throw OutputError(fmt::format("{}: the tile written is missing", (staged / name).string()));
+    sum.add(name.data(), name.size());
+    sum.add(bytes->data(), bytes->size());
+  }
+  return fmt::format("{:016x}", sum.value());
+}
+
 /// Builds the tree with `build` (given the sink that writes each tile) and writes the tileset:
 /// the glb of every tile as the tree hands it over, then the JSON files.
 TilesetExportStats write_tileset(const TilesetFrame& frame, const TilesetExportParams& params,
@@ -256,7 +275,8 @@ TilesetExportStats write_tileset(const TilesetFrame& frame, const TilesetExportP
   const auto files = tileset_json_files(tree, {.transform = enu.to_ecef_matrix(),
                                                .max_tiles_per_file = params.max_tiles_per_file,
                                                .box_margin = step,
-                                               .min_half_extent = 0.01});
+                                               .min_half_extent = 0.01,
+                                               .tileset_version = content_version(tree, staged)});
   for (const auto& [name, text] : files) write_file_atomically(staged / name, text);
   replace_directory_atomically(staged, params.dir);
 

@@ -40,7 +40,9 @@ class Writer {
     nlohmann::json tile = tile_json(root, room);
     if (main) tile["transform"] = params_.transform;
     const double diagonal = norm(node.box.max - node.box.min);
-    nlohmann::json tileset{{"asset", {{"version", "1.1"}, {"generator", "citymesh"}}},
+    nlohmann::json asset{{"version", "1.1"}, {"generator", "citymesh"}};
+    if (!params_.tileset_version.empty()) asset["tilesetVersion"] = params_.tileset_version;
+    nlohmann::json tileset{{"asset", std::move(asset)},
                            {"geometricError", main ? std::max(2 * node.geometric_error, diagonal) : node.geometric_error},
                            {"root", std::move(tile)}};
     files_[slot].second = tileset.dump(1) + "\n";

@@ -17,6 +17,7 @@ struct TilesetJsonParams {
   std::size_t max_tiles_per_file = 341;  ///< >= 5
   double box_margin = 0.0;               ///< metres added around every bounding box
   double min_half_extent = 0.01;         ///< metres: boxes are never flat
+  std::string tileset_version;           ///< asset.tilesetVersion of every file (empty: none)
 };
 
 /// (file name, JSON text) of "tileset.json" (first) and every external tileset. Content of

@@ -381,6 +381,22 @@ TEST(TilesetExport, KeptPrimitivesGiveTheBytesOfEncodingAndOnlyChangedTilesAreEn
   EXPECT_GE(found, changed.leaves - 1) << "the other leaves";
 }
 
+TEST(TilesetExport, TheTilesetVersionChangesExactlyWhenATileDoes) {
+  // asset.tilesetVersion: viewers that honour it add it to their requests, so an updated
+  // map is fetched again instead of shown from their caches; an unchanged one is not.
+  test::TempDir tmp;
+  Scene s = scene();
+  const auto version = [&](const std::string& name) {
+    (void)export_tileset({s.mesh, s.source, lambert93()}, params(tmp / name));
+    return read_json(tmp / name / "tileset.json")["asset"].value("tilesetVersion", std::string());
+  };
+  const std::string first = version("first");
+  EXPECT_EQ(first.size(), 16u);
+  EXPECT_EQ(version("again"), first);
+  s.mesh.positions[0].z += 0.5f;  // one corner leaf (and its parents) change
+  EXPECT_NE(version("moved"), first);
+}
+
 TEST(TilesetExport, KeptSimplificationsGiveTheSameTilesAndOnlyParentsOfChangedLeavesAreSimplifiedAgain) {
   test::TempDir tmp;
   Scene s = scene();
