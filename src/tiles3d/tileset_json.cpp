@@ -12,7 +12,9 @@ namespace {
 
 nlohmann::json box_json(const Box3d& box, const TilesetJsonParams& params) {
   const Vec3d c = (box.min + box.max) * 0.5;
-  auto half = [&](double lo, double hi) { return std::max((hi - lo) * 0.5 + params.box_margin, params.min_half_extent); };
+  auto half = [&](double lo, double hi) {
+    return std::max((hi - lo) * 0.5 + params.box_margin, params.min_half_extent);
+  };
   return {{"box",
            {c.x, c.y, c.z, half(box.min.x, box.max.x), 0, 0, 0, half(box.min.y, box.max.y), 0, 0, 0,
             half(box.min.z, box.max.z)}}};
@@ -42,9 +44,10 @@ class Writer {
     const double diagonal = norm(node.box.max - node.box.min);
     nlohmann::json asset{{"version", "1.1"}, {"generator", "citymesh"}};
     if (!params_.tileset_version.empty()) asset["tilesetVersion"] = params_.tileset_version;
-    nlohmann::json tileset{{"asset", std::move(asset)},
-                           {"geometricError", main ? std::max(2 * node.geometric_error, diagonal) : node.geometric_error},
-                           {"root", std::move(tile)}};
+    nlohmann::json tileset{
+        {"asset", std::move(asset)},
+        {"geometricError", main ? std::max(2 * node.geometric_error, diagonal) : node.geometric_error},
+        {"root", std::move(tile)}};
     files_[slot].second = tileset.dump(1) + "\n";
   }
 

@@ -13,7 +13,7 @@
 namespace citymesh {
 
 struct TilesetJsonParams {
-  std::array<double, 16> transform{};  ///< root: local frame -> ECEF, column-major
+  std::array<double, 16> transform{};    ///< root: local frame -> ECEF, column-major
   std::size_t max_tiles_per_file = 341;  ///< >= 5
   double box_margin = 0.0;               ///< metres added around every bounding box
   double min_half_extent = 0.01;         ///< metres: boxes are never flat
