@@ -235,15 +235,19 @@ class TileWriter {
   std::filesystem::path staged_;
 };
 
-/// A digest of every tile's glb (its name and bytes, in the tree's order): the tileset's
-/// version, which changes exactly when a tile does. Viewers that honour it add it to their
-/// requests, so that an updated map is not hidden behind their caches. Read back from
-/// `staged`: under MPI other ranks write some of the tiles.
+/// A digest of every tile's glb (its name and bytes, in the order of the names: the tree's
+/// order of nodes depends on how the work was split): the tileset's version, which changes
+/// exactly when a tile does. Viewers that honour it add it to their requests, so that an
+/// updated map is not hidden behind their caches. Read back from `staged`: under MPI other
+/// ranks write some of the tiles.
 std::string content_version(const TileTree& tree, const std::filesystem::path& staged) {
-  BulkChecksum sum;
+  std::vector<std::string> names;
   for (const TileNode& node : tree.nodes) {
-    if (node.triangle_count == 0) continue;
-    const std::string name = node.name() + ".glb";
+    if (node.triangle_count > 0) names.push_back(node.name() + ".glb");
+  }
+  std::sort(names.begin(), names.end());
+  BulkChecksum sum;
+  for (const std::string& name : names) {
     const std::optional<std::string> bytes = read_file_bytes(staged / name);
     if (!bytes) throw OutputError(fmt::format("{}: the tile written is missing", (staged / name).string()));
     sum.add(name.data(), name.size());
