@@ -117,13 +117,15 @@ std::map<std::string, std::string> result_keys(const Config& config) {
   return keys;
 }
 
+std::string build_name() { return fmt::format("{:016x}", executable_identity()); }
+
 RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys, std::size_t acquisitions) {
   // The formats' versions are part of each: work made by an older build is redone, not misread.
   // The tile results also depend on the build itself (its code decides what they hold): another
   // build's are made again, never mixed with this one's. The tile store's layout is all its
   // version says, so it is kept across builds.
   const std::string versions = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
-  std::string settings = versions + fmt::format("build {:016x}\n", executable_identity()), tiling = versions;
+  std::string settings = versions + "build " + build_name() + "\n", tiling = versions;
   std::vector<std::string> own(acquisitions);
   for (const auto& [k, v] : keys) {
     const std::string line = k + "=" + v + "\n";
@@ -149,7 +151,7 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
   const std::filesystem::path file = work / kRunConfigFile;
   std::ifstream in(file);
-  const std::string build = fmt::format("{:016x}", executable_identity());
+  const std::string build = build_name();
   if (in) {
     std::map<std::string, std::string> before;
     try {

@@ -32,6 +32,10 @@ struct RunFingerprints {
   /// The tile store as a whole (its manifest): the tiling keys and every acquisition's.
   std::uint64_t store = 0;
 };
+/// This build of citymesh as run-config.json and run.json name it, and as the result
+/// fingerprint holds it: executable_identity() in hex.
+std::string build_name();
+
 RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys, std::size_t acquisitions);
 
 /// Compares `keys` with <work>/run-config.json. When they differ: throws ConfigError naming

@@ -71,8 +71,9 @@ SeamPartCache::SeamPartCache(std::filesystem::path dir, std::uint64_t settings)
     : dir_(std::move(dir)), settings_(settings) {}
 
 std::filesystem::path SeamPartCache::file(const BlockPartKey& key, std::uint64_t digest) const {
-  // The build too: another build's stitching may give other parts.
-  const std::uint64_t mixed[3] = {settings_, executable_identity(), digest};
+  // The build is in `settings` (the run's result fingerprint holds it): another build's
+  // stitching may give other parts.
+  const std::uint64_t mixed[2] = {settings_, digest};
   return dir_ / fmt::format("{}.{:016x}{}", key.name(), bulk_checksum(mixed, sizeof(mixed)), kCacheSuffix);
 }
 

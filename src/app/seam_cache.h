@@ -23,8 +23,8 @@ PartOutcome outcome_from(const nlohmann::json& j);
 
 /// A PartCache in one folder, one file per part: "<part>.<digest>.part" (magic, the outcome
 /// as JSON, the stitched piece, an XXH3 of both). The digest mixes in `settings` (the run's
-/// result-affecting keys). Files go in under a temporary name and are renamed (no fsync: a
-/// torn file fails its checksum and is stitched again, like a missing one). Any process of
+/// result fingerprint: its result-affecting keys and the build, run_fingerprints). Files go in under a temporary name
+/// and are renamed (no fsync: a torn file fails its checksum and is stitched again, like a missing one). Any process of
 /// the run may find and keep parts; the root prunes what the run did not use.
 class SeamPartCache final : public PartCache {
  public:

@@ -220,15 +220,15 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
   const bool several_ranks = cluster.size() > 1;
   const auto on_finish = [&](std::size_t item) {
     // Kept tiles count as reused: this process's workers say so, another rank's result does.
-    const TileKey key = store.tiles[tiles[item]].key;
-    if (kept[item].load() || (several_ranks && !mine[item].load() && kept_elsewhere(config, key))) {
+    const TileContents& tile = store.tiles[tiles[item]];
+    if (kept[item].load() || (several_ranks && !mine[item].load() && kept_elsewhere(config, tile.key))) {
       ++report.kept;
-      progress.kept(store.tiles[tiles[item]].owned());
+      progress.kept(tile.owned());
       return;
     }
     report.processed[tiles[item]] = 1;
     ++report.count;
-    progress.done(store.tiles[tiles[item]].owned());
+    progress.done(tile.owned());
   };
   // The channel ends (every rank's workers stopped) before the report is returned.
   auto channel = cluster.share(schedule ? &*schedule : nullptr, on_finish);

@@ -275,7 +275,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   const std::size_t reused = store.tiles.size() - tiles.count;
   nlohmann::json report;
   // Which citymesh made the output: all of it, since another build's work is never reused.
-  report["citymesh"] = {{"version", CITYMESH_VERSION}, {"build", fmt::format("{:016x}", executable_identity())}};
+  report["citymesh"] = {{"version", CITYMESH_VERSION}, {"build", build_name()}};
   report["tiles"] = store.tiles.size();
   report["reused_tiles"] = reused;
   report["kept_tiles"] = tiles.kept;  // of the reused: kept when a neighbour was redone
