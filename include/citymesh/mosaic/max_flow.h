@@ -48,15 +48,18 @@ class MaxFlow {
 
   enum class Tree : std::uint8_t { free, source, sink };
 
-  struct NodeData {
-    Arc first = 0, end = 0;  ///< outgoing arcs: [first, end) once solve() has laid them out
-    Arc parent = kNone;      ///< arc from the node to its parent (towards the terminal)
+  /// 32 bytes, aligned: two nodes to a cache line, none across two (the search waits on
+  /// memory: 40 bytes, with the end of the arcs stored, took ~10 % longer).
+  struct alignas(32) NodeData {
+    Arc first = 0;       ///< outgoing arcs: [first, arcs_end(i)) once solve() has laid them out
+    Arc parent = kNone;  ///< arc from the node to its parent (towards the terminal)
     Node next_active = 0;
+    std::uint32_t stamp = 0, distance = 0;  ///< distance-to-terminal heuristic, valid at `stamp`
     bool active = false;
     Tree tree = Tree::free;
     double terminal = 0;  ///< residual: > 0 from the source, < 0 to the sink
-    std::uint32_t stamp = 0, distance = 0;  ///< distance-to-terminal heuristic, valid at `stamp`
   };
+  static_assert(sizeof(NodeData) == 32);
   /// An arc as added: arcs come in pairs, the reverse of arc a is a ^ 1.
   struct StagedArc {
     Node head = 0;
@@ -71,6 +74,10 @@ class MaxFlow {
   };
 
   void lay_out_arcs();
+  /// One past node i's last outgoing arc (the arcs are laid out node after node).
+  [[nodiscard]] Arc arcs_end(Node i) const {
+    return i + 1 < nodes_.size() ? nodes_[i + 1].first : static_cast<Arc>(arcs_.size());
+  }
   void push_two_arc_paths();
   void set_active(Node i);
   Node next_active();
