@@ -119,6 +119,15 @@ void print_mosaic_summary(const nlohmann::json& m, std::ostream& out) {
                      m["triangles"].get<std::uint64_t>(), m["area"].get<double>());
   out << fmt::format("  static completeness   {:.2f} % of the static input area lies within the distance threshold\n",
                      100 * m["static_completeness"].get<double>());
+  if (m.contains("static_uncovered")) {
+    const nlohmann::json& u = m["static_uncovered"];
+    const double dropped = u["dropped_by_change_step"].get<double>(), absent = u["kept_not_in_output"].get<double>(),
+                 cut = u["in_output_cut_back"].get<double>();
+    out << fmt::format(
+        "    the rest            {:.1f} m2: {:.1f} dropped by the change step, {:.1f} kept but not in the "
+        "output, {:.1f} in the output but cut back\n",
+        dropped + absent + cut, dropped, absent, cut);
+  }
   out << fmt::format("  dynamic residue       {:.3f} % of the output area belongs to objects that must go\n",
                      100 * m["dynamic_residue"].get<double>());
   out << fmt::format("  overlap ratio         {:.3f} % of the output area doubles output of another source\n",
@@ -127,8 +136,8 @@ void print_mosaic_summary(const nlohmann::json& m, std::ostream& out) {
                      100 * m["hole_ratio"].get<double>());
   out << fmt::format("  seams                 {:.1f} m open between sources ({:.1f} m of open boundary in all)\n",
                      m["seam_length"].get<double>(), m["open_boundary_length"].get<double>());
-  out << fmt::format("  mean edge length      {:.3f} m, {:.2f} x the finest input's\n", m["mean_edge_length"].get<double>(),
-                     m["edge_length_ratio"].get<double>());
+  out << fmt::format("  mean edge length      {:.3f} m, {:.2f} x the finest input's\n",
+                     m["mean_edge_length"].get<double>(), m["edge_length_ratio"].get<double>());
 }
 
 class EvalCommand final : public Command {

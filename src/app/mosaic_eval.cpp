@@ -46,7 +46,8 @@ auto& find_object(Map& objects, const std::vector<std::uint32_t>& truth, double 
   }
   const std::uint32_t id = truth[static_cast<std::size_t>(source_face)];
   const auto it = objects.find(id);
-  if (it == objects.end()) throw InputError(fmt::format("{}: object {} is not in objects.json", origin.truth.string(), id));
+  if (it == objects.end())
+    throw InputError(fmt::format("{}: object {} is not in objects.json", origin.truth.string(), id));
   return it->second;
 }
 
@@ -131,6 +132,26 @@ std::pair<double, double> boundary_and_seam_length(const OutputMesh& o, const Me
   return {total, seam};
 }
 
+/// Where the static input area the output does not cover went (m²): faces the change step
+/// dropped, faces it kept that are not in the output (the mosaic did not select them, or
+/// clipping removed them whole: the output cannot tell which), and faces in the output whose
+/// centroid it no longer covers (clipping or snapping cut them back).
+struct UncoveredStatic {
+  double dropped = 0, not_in_output = 0, cut_back = 0;
+};
+
+/// Per face of acquisition `acquisition` (by source_face, `faces` of them: the output's faces
+/// were checked against its truth file), 1 when some output face comes from it.
+std::vector<std::uint8_t> faces_in_output(const OutputMesh& out, std::int32_t acquisition, std::size_t faces) {
+  std::vector<std::uint8_t> in_output(faces, 0);
+  for (std::size_t t = 0; t < out.source.size(); ++t) {
+    const double face = out.table.extras[1][t];
+    if (out.source[t] == acquisition && face >= 0 && face < double(faces))
+      in_output[static_cast<std::size_t>(face)] = 1;
+  }
+  return in_output;
+}
+
 }  // namespace
 
 nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::filesystem::path& truth_dir,
@@ -162,7 +183,8 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
     }
     const TriangleCorners c = out.table.corners(t);
     const auto k = static_cast<std::size_t>(a);
-    const ObjectInfo& o = object_of(objects, truths[k], out.table.extras[1][t], {output_ply, truth_paths[k], out.table.faces[t]});
+    const ObjectInfo& o =
+        object_of(objects, truths[k], out.table.extras[1][t], {output_ply, truth_paths[k], out.table.faces[t]});
     out_area += area(c);
     out_dynamic += o.fate == "remove" ? area(c) : 0.0;
     out_edges += norm(c[1] - c[0]) + norm(c[2] - c[1]) + norm(c[0] - c[2]);
@@ -174,7 +196,8 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
     const TriangleCorners c = out.table.corners(t);
     const Vec3d p = centroid(c) - out.local.origin;
     const bool covered = near.any_over(p, kOverlapDistance, [&](std::uint32_t u) {
-      return out.source[u] >= 0 && out.source[u] != out.source[t] && std::abs(dot(out.normal[u], out.normal[t])) >= cos_parallel;
+      return out.source[u] >= 0 && out.source[u] != out.source[t] &&
+             std::abs(dot(out.normal[u], out.normal[t])) >= cos_parallel;
     });
     return covered ? area(c) : 0.0;
   });
@@ -182,9 +205,11 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   // The inputs: how much of the static structure and of what the change step kept the
   // output still covers, and the finest input resolution.
   double static_area = 0, static_covered = 0, static_open = 0, finest_edge = 0;
+  UncoveredStatic uncovered;
   for (std::size_t k = 0; k < acquisitions.size(); ++k) {
     const std::filesystem::path ply = output / "detect" / acquisitions[k].at("ply").get<std::string>();
     const FaceTable in = read_face_table(ply, {kSourceFaceProperty, kKeptProperty});
+    const std::vector<std::uint8_t> in_output = faces_in_output(out, static_cast<std::int32_t>(k), truths[k].size());
     std::vector<double> face_area(in.triangles.size()), covered(in.triangles.size()), under(in.triangles.size());
     double edges = 0;
     std::uint64_t edge_count = 0;
@@ -202,6 +227,11 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
         static_area += face_area[t];
         static_covered += covered[t] * face_area[t];
         static_open += (1.0 - under[t]) * face_area[t];
+        if (covered[t] == 0) {
+          const double face = in.extras[0][t];  // checked against the truth file by object_of
+          const bool kept = in.extras[1][t] != 0, selected = in_output[static_cast<std::size_t>(face)] != 0;
+          (kept ? (selected ? uncovered.cut_back : uncovered.not_in_output) : uncovered.dropped) += face_area[t];
+        }
       }
       if (in.extras[1][t] != 0) {
         const TriangleCorners c = in.corners(t);
@@ -224,6 +254,11 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
           {"open_boundary_length", boundary},
           {"hole_ratio", static_area > 0 ? static_open / static_area : 0.0},
           {"static_completeness", static_area > 0 ? static_covered / static_area : 1.0},
+          {"static_area", static_area},
+          {"static_uncovered",
+           {{"dropped_by_change_step", uncovered.dropped},
+            {"kept_not_in_output", uncovered.not_in_output},
+            {"in_output_cut_back", uncovered.cut_back}}},
           {"dynamic_residue", out_area > 0 ? out_dynamic / out_area : 0.0},
           {"mean_edge_length", mean_edge},
           {"finest_mean_edge_length", finest_edge},
