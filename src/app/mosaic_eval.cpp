@@ -140,18 +140,6 @@ struct UncoveredStatic {
   double dropped = 0, not_in_output = 0, cut_back = 0;
 };
 
-/// Per face of acquisition `acquisition` (by source_face, `faces` of them: the output's faces
-/// were checked against its truth file), 1 when some output face comes from it.
-std::vector<std::uint8_t> faces_in_output(const OutputMesh& out, std::int32_t acquisition, std::size_t faces) {
-  std::vector<std::uint8_t> in_output(faces, 0);
-  for (std::size_t t = 0; t < out.source.size(); ++t) {
-    const double face = out.table.extras[1][t];
-    if (out.source[t] == acquisition && face >= 0 && face < double(faces))
-      in_output[static_cast<std::size_t>(face)] = 1;
-  }
-  return in_output;
-}
-
 }  // namespace
 
 nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::filesystem::path& truth_dir,
@@ -174,6 +162,9 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   }
   double out_area = 0, out_dynamic = 0, out_edges = 0;
   std::uint64_t out_edge_count = 0;
+  // Per acquisition and source face, 1 when an output face comes from it.
+  std::vector<std::vector<std::uint8_t>> in_output(truths.size());
+  for (std::size_t k = 0; k < truths.size(); ++k) in_output[k].assign(truths[k].size(), 0);
   for (std::size_t t = 0; t < out.source.size(); ++t) {
     const std::int32_t a = out.source[t];
     if (a < 0) continue;
@@ -185,6 +176,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
     const auto k = static_cast<std::size_t>(a);
     const ObjectInfo& o =
         object_of(objects, truths[k], out.table.extras[1][t], {output_ply, truth_paths[k], out.table.faces[t]});
+    in_output[k][static_cast<std::size_t>(out.table.extras[1][t])] = 1;  // checked by object_of
     out_area += area(c);
     out_dynamic += o.fate == "remove" ? area(c) : 0.0;
     out_edges += norm(c[1] - c[0]) + norm(c[2] - c[1]) + norm(c[0] - c[2]);
@@ -209,7 +201,6 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   for (std::size_t k = 0; k < acquisitions.size(); ++k) {
     const std::filesystem::path ply = output / "detect" / acquisitions[k].at("ply").get<std::string>();
     const FaceTable in = read_face_table(ply, {kSourceFaceProperty, kKeptProperty});
-    const std::vector<std::uint8_t> in_output = faces_in_output(out, static_cast<std::int32_t>(k), truths[k].size());
     std::vector<double> face_area(in.triangles.size()), covered(in.triangles.size()), under(in.triangles.size());
     double edges = 0;
     std::uint64_t edge_count = 0;
@@ -229,7 +220,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
         static_open += (1.0 - under[t]) * face_area[t];
         if (covered[t] == 0) {
           const double face = in.extras[0][t];  // checked against the truth file by object_of
-          const bool kept = in.extras[1][t] != 0, selected = in_output[static_cast<std::size_t>(face)] != 0;
+          const bool kept = in.extras[1][t] != 0, selected = in_output[k][static_cast<std::size_t>(face)] != 0;
           (kept ? (selected ? uncovered.cut_back : uncovered.not_in_output) : uncovered.dropped) += face_area[t];
         }
       }
