@@ -2,11 +2,20 @@
 // Shared inside the mosaic module.
 #pragma once
 
+#include <cstddef>
+#include <vector>
+
 #include "citymesh/mosaic/mosaic.h"
 
 namespace citymesh::mosaic_detail {
 
 /// Throws ProcessingError when the change result does not describe the meshes.
 void check_mosaic_input(const MosaicInput& input);
+
+/// Acquisition indices by date (config order on equal dates). Wherever the order of the
+/// acquisitions matters (the update model, the hole fill, the group moves), it is this one, so
+/// that where a pass is listed in the config (a late delivery appended after newer passes)
+/// does not change what is selected.
+std::vector<std::size_t> date_order(const MosaicInput& input);
 
 }  // namespace citymesh::mosaic_detail

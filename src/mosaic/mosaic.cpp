@@ -5,6 +5,7 @@
 #include <cfloat>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
@@ -43,6 +44,14 @@ void mosaic_detail::check_mosaic_input(const MosaicInput& input) {
   if (!input.forced.empty() && input.forced.size() != total) {
     throw ProcessingError("mosaic: the forced flags do not match the meshes");
   }
+}
+
+std::vector<std::size_t> mosaic_detail::date_order(const MosaicInput& input) {
+  std::vector<std::size_t> order(input.meshes.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
+  return order;
 }
 
 namespace {
@@ -237,10 +246,16 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
     x = minimise_by_flipped_cut(e.energy, *flips);
     out.stats.solver.exact = true;
   } else {
-    // Start from nothing kept and let each mesh in turn take the places where it does better
-    // than what is kept: every move is an exact cut, none raises the energy.
+    // Start from nothing kept and let each mesh in turn, oldest first, take the places where
+    // it does better than what is kept: every move is an exact cut, none raises the energy.
+    // The groups are numbered by date, as the moves visit them.
+    std::vector<std::uint32_t> group_of_acquisition(input.meshes.size());
+    const std::vector<std::size_t> by_date = mosaic_detail::date_order(input);
+    for (std::size_t r = 0; r < by_date.size(); ++r) group_of_acquisition[by_date[r]] = static_cast<std::uint32_t>(r);
     std::vector<std::uint32_t> group(e.triangle_of.size());
-    for (std::size_t v = 0; v < group.size(); ++v) group[v] = input.change->index.acquisition_of(e.triangle_of[v]);
+    for (std::size_t v = 0; v < group.size(); ++v) {
+      group[v] = group_of_acquisition[input.change->index.acquisition_of(e.triangle_of[v])];
+    }
     x.assign(e.triangle_of.size(), 0);
     GroupMoveParams moves;
     moves.max_sweeps = std::max(1, params.sweeps);

@@ -3,7 +3,6 @@
 // fill after the energy mosaic (the same rule, newest first, from the mosaic's selection).
 #include <algorithm>
 #include <atomic>
-#include <numeric>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/geometry.h"
@@ -152,15 +151,6 @@ HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size
   return counts;
 }
 
-/// Acquisition indices by date (config order on equal dates).
-std::vector<std::size_t> date_order(const MosaicInput& input) {
-  std::vector<std::size_t> order(input.meshes.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return input.dates[a] < input.dates[b]; });
-  return order;
-}
-
 }  // namespace
 
 MosaicSelection select_update_model(const MosaicInput& input) {
@@ -169,7 +159,7 @@ MosaicSelection select_update_model(const MosaicInput& input) {
   const ChangeResult& change = *input.change;
   MosaicSelection out;
   out.selected.assign(change.index.size(), 0);
-  (void)add_uncovered(input, date_order(input), out.selected, nullptr);
+  (void)add_uncovered(input, mosaic_detail::date_order(input), out.selected, nullptr);
   out.stats.candidates = static_cast<std::uint64_t>(std::count(change.kept.begin(), change.kept.end(), 1));
   out.stats.selected = static_cast<std::uint64_t>(std::count(out.selected.begin(), out.selected.end(), 1));
   out.stats.seconds_solve = clock.seconds();
@@ -179,7 +169,7 @@ MosaicSelection select_update_model(const MosaicInput& input) {
 HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,
                           std::span<const std::uint8_t> seen_through, std::vector<std::uint8_t>* notes) {
   mosaic_detail::check_mosaic_input(input);
-  std::vector<std::size_t> order = date_order(input);
+  std::vector<std::size_t> order = mosaic_detail::date_order(input);
   std::reverse(order.begin(), order.end());
   // What another pass saw through is not put back: mostly facets one pass strung across a
   // window recess that another pass saw into (they lie on no surface), which the fill would
