@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <mutex>
 #include <optional>
 #include <stdexcept>
 #include <tuple>
@@ -58,6 +59,18 @@ const Box3d& box_for_level(const BlockPart& part, int level) {
 }  // namespace
 
 namespace stitch_detail {
+
+/// An edge of a part used by one of its triangles only, by its corners' keys, and its length.
+struct OnceEdge {
+  std::pair<std::uint64_t, std::uint64_t> keys;
+  double length = 0;
+};
+
+/// What the open boundary measure keeps of a part after reading it once.
+struct PartEdges {
+  std::vector<OnceEdge> once;                                    ///< in key order
+  std::vector<std::pair<std::uint64_t, std::uint64_t>> meeting;  ///< edges that may meet a part around
+};
 
 /// Finds the parts whose boxes (as a level sees them) meet a box: the boxes are filed under
 /// every block cell they cover.
@@ -334,50 +347,45 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   stats.parts[static_cast<std::size_t>(level)] = stitcher.size();
 }
 
-/// The length of the edges of `own`'s triangles used by exactly one triangle of `own` and
-/// `around` (every triangle sharing an edge with `own` is in one of them). Own's edges are
-/// sorted (by their corners' indices, which ascend with their keys) and those it uses once
-/// kept; the triangles around then only strike off the ones they use too. Sorting the edges
-/// around with own's, by key, made up most of the measure. The lengths are summed in the
-/// order of the edges' keys.
-double own_open_boundary(const KeyedPiece& own, std::span<const std::shared_ptr<const KeyedPiece>> around) {
-  using Edge = std::pair<std::uint32_t, std::uint32_t>;  // own's vertices, smaller first
+using KeyPair = std::pair<std::uint64_t, std::uint64_t>;  ///< an edge by its corners' keys, smaller first
+
+/// The edges of `piece` used by exactly one of its triangles, in key order (its corners'
+/// indices, sorted, ascend with their keys), with their lengths.
+std::vector<stitch_detail::OnceEdge> edges_used_once(const KeyedPiece& piece) {
+  using Edge = std::pair<std::uint32_t, std::uint32_t>;  // the piece's vertices, smaller first
   std::vector<Edge> edges;
-  edges.reserve(3 * own.triangle_count());
-  for (const Triangle& tri : own.triangles) {
+  edges.reserve(3 * piece.triangle_count());
+  for (const Triangle& tri : piece.triangles) {
     for (int k = 0; k < 3; ++k) edges.push_back(std::minmax(tri[k], tri[(k + 1) % 3]));
   }
   radix_sort_pairs(edges);
-  std::vector<Edge> once;  // used once by own
+  std::vector<stitch_detail::OnceEdge> once;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t end = i + 1;
     while (end < edges.size() && edges[end] == edges[i]) ++end;
-    if (end == i + 1) once.push_back(edges[i]);
+    if (end == i + 1) {
+      const auto [a, b] = edges[i];
+      once.push_back({{piece.keys[a], piece.keys[b]}, norm(piece.positions[a] - piece.positions[b])});
+    }
     i = end;
   }
-  const auto by_keys = [&](const Edge& e, const std::pair<std::uint64_t, std::uint64_t>& key) {
-    return std::pair(own.keys[e.first], own.keys[e.second]) < key;
-  };
-  std::vector<std::uint8_t> shared(once.size(), 0);
-  const Box3d own_box = own.box();
-  for (const auto& piece : around) {
-    for (std::size_t t = 0; t < piece->triangle_count(); ++t) {
-      if (!piece->box(t).intersects(own_box)) continue;  // it shares no edge
-      const Triangle& tri = piece->triangles[t];
-      for (int k = 0; k < 3; ++k) {
-        const auto key = std::minmax(piece->keys[tri[k]], piece->keys[tri[(k + 1) % 3]]);
-        const auto it = std::lower_bound(once.begin(), once.end(), key, by_keys);
-        if (it != once.end() && own.keys[it->first] == key.first && own.keys[it->second] == key.second) {
-          shared[static_cast<std::size_t>(it - once.begin())] = 1;
-        }
-      }
-    }
+  return once;
+}
+
+/// The edges (sorted, each once) of the triangles of `piece` whose box meets one of `boxes`:
+/// the only ones another part whose box that is can share. A triangle sharing an edge with
+/// another part's triangle holds two of its corners, so its box meets that part's box.
+std::vector<KeyPair> edges_meeting(const KeyedPiece& piece, std::span<const Box3d> boxes) {
+  std::vector<KeyPair> out;
+  for (std::size_t t = 0; t < piece.triangle_count(); ++t) {
+    const Box3d box = piece.box(t);
+    if (std::none_of(boxes.begin(), boxes.end(), [&](const Box3d& b) { return b.intersects(box); })) continue;
+    const Triangle& tri = piece.triangles[t];
+    for (int k = 0; k < 3; ++k) out.push_back(std::minmax(piece.keys[tri[k]], piece.keys[tri[(k + 1) % 3]]));
   }
-  double length = 0;
-  for (std::size_t i = 0; i < once.size(); ++i) {
-    if (shared[i] == 0) length += norm(own.positions[once[i].first] - own.positions[once[i].second]);
-  }
-  return length;
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
 }
 
 }  // namespace
@@ -389,16 +397,44 @@ BoundaryMeasurer::BoundaryMeasurer(std::span<const BlockPart> parts, const PartS
       stitched_(stitched),
       // As the last level sees them (all stitched) or as the first does (none).
       view_(stitched ? kLevels : -1),
-      finder_(std::make_unique<PartFinder>(parts, blocks, view_)) {}
+      finder_(std::make_unique<PartFinder>(parts, blocks, view_)),
+      kept_(std::make_unique<Kept>(parts.size())) {}
 
 BoundaryMeasurer::~BoundaryMeasurer() = default;
 
+struct BoundaryMeasurer::Kept {
+  explicit Kept(std::size_t parts) : read(parts), edges(parts) {}
+  std::vector<std::once_flag> read;
+  std::vector<stitch_detail::PartEdges> edges;
+};
+
+const stitch_detail::PartEdges& BoundaryMeasurer::edges_of(std::size_t q) const {
+  std::call_once(kept_->read[q], [&] {
+    const std::shared_ptr<const KeyedPiece> piece = store_.load(q, stitched_);
+    std::vector<Box3d> around;
+    for (const std::uint32_t r : finder_->meeting(box_for_level(parts_[q], view_), q)) {
+      around.push_back(box_for_level(parts_[r], view_));
+    }
+    kept_->edges[q] = {edges_used_once(*piece), edges_meeting(*piece, around)};
+  });
+  return kept_->edges[q];
+}
+
+/// Part p's edges used once by its own triangles and by none of the parts around it (every
+/// triangle sharing an edge with p's is in one of them), summed in key order.
 double BoundaryMeasurer::measure(std::size_t p) const {
   const Box3d& box = box_for_level(parts_[p], view_);
   if (box.empty()) return 0.0;
-  std::vector<std::shared_ptr<const KeyedPiece>> around;
-  for (const std::uint32_t q : finder_->meeting(box, p)) around.push_back(store_.load(q, stitched_));
-  return own_open_boundary(*store_.load(p, stitched_), around);
+  std::vector<const stitch_detail::PartEdges*> around;
+  for (const std::uint32_t q : finder_->meeting(box, p)) around.push_back(&edges_of(q));
+  double length = 0;
+  for (const stitch_detail::OnceEdge& e : edges_of(p).once) {
+    const bool shared = std::any_of(around.begin(), around.end(), [&](const stitch_detail::PartEdges* q) {
+      return std::binary_search(q->meeting.begin(), q->meeting.end(), e.keys);
+    });
+    if (!shared) length += e.length;
+  }
+  return length;
 }
 
 double parts_open_boundary(std::span<const BlockPart> parts, const PartStore& store, bool stitched,

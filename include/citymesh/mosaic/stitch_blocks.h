@@ -113,6 +113,7 @@ class LevelStitcher;
 
 namespace stitch_detail {
 class PartFinder;  ///< which parts' boxes (as a level sees them) meet a box
+struct PartEdges;  ///< what the open boundary measure keeps of a part
 }  // namespace stitch_detail
 
 /// What stitching one part gives back.
@@ -213,8 +214,10 @@ std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level);
 BlockStitchStats stitch_parts(std::vector<BlockPart>& parts, PartStore& store, const PartStitchRun& run);
 
 /// The open boundary of each part of an output, before stitching or once stitched: the length
-/// of its triangles' edges used by exactly one triangle, counted with the parts around it
-/// loaded. Any number at once, on any process whose store reads the same parts.
+/// of its triangles' edges used by exactly one triangle, counted with the parts around it.
+/// Any number at once, on any process whose store reads the same parts. Each part is read
+/// once: what the measures need of it (its edges used once, and the edges of its triangles
+/// that meet the box of a part around it) is kept until the measurer goes.
 class BoundaryMeasurer {
  public:
   /// `parts`, `store` and `blocks` (the grid of the parts) must outlive this.
@@ -236,6 +239,11 @@ class BoundaryMeasurer {
   bool stitched_;
   int view_;  ///< the level whose view of the parts' boxes is measured
   std::unique_ptr<stitch_detail::PartFinder> finder_;
+  struct Kept;
+  std::unique_ptr<Kept> kept_;  ///< per part, read at its first use
+
+  /// Part q's edges, read at the first call (thread-safe).
+  [[nodiscard]] const stitch_detail::PartEdges& edges_of(std::size_t q) const;
 };
 
 /// Measures every part (measurer.measure(p) for each p, anywhere) and returns the lengths in
