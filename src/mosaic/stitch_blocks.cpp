@@ -60,16 +60,18 @@ const Box3d& box_for_level(const BlockPart& part, int level) {
 
 namespace stitch_detail {
 
-/// An edge of a part used by one of its triangles only, by its corners' keys, and its length.
+using KeyPair = std::pair<std::uint64_t, std::uint64_t>;  ///< an edge by its corners' keys, smaller first
+
+/// An edge of a part used by one of its triangles only, and its length.
 struct OnceEdge {
-  std::pair<std::uint64_t, std::uint64_t> keys;
+  KeyPair keys;
   double length = 0;
 };
 
 /// What the open boundary measure keeps of a part after reading it once.
 struct PartEdges {
-  std::vector<OnceEdge> once;                                    ///< in key order
-  std::vector<std::pair<std::uint64_t, std::uint64_t>> meeting;  ///< edges that may meet a part around
+  std::vector<OnceEdge> once;    ///< in key order
+  std::vector<KeyPair> meeting;  ///< sorted: the edges that may meet a part around
 };
 
 /// Finds the parts whose boxes (as a level sees them) meet a box: the boxes are filed under
@@ -347,7 +349,7 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   stats.parts[static_cast<std::size_t>(level)] = stitcher.size();
 }
 
-using KeyPair = std::pair<std::uint64_t, std::uint64_t>;  ///< an edge by its corners' keys, smaller first
+using stitch_detail::KeyPair;
 
 /// The edges of `piece` used by exactly one of its triangles, in key order (its corners'
 /// indices, sorted, ascend with their keys), with their lengths.

@@ -33,11 +33,11 @@ struct MosaicStats {
   double length_unit = 0;  ///< metres: the mean edge length of the candidates
   /// Weighted energy terms of the selection (the quality term is negative).
   double quality = 0, boundary = 0, overlap = 0, seam = 0, energy = 0;
-  std::uint64_t seen_through = 0;  ///< candidates another pass saw through (quality scaled down)
-  std::uint64_t filled = 0;  ///< triangles added by the hole fill
+  std::uint64_t seen_through = 0;       ///< candidates another pass saw through (quality scaled down)
+  std::uint64_t filled = 0;             ///< triangles added by the hole fill
   std::uint64_t fill_seen_through = 0;  ///< triangles the hole fill left out: another pass saw through them
-  MinimiseStats solver;  ///< solver.exact: the whole energy was solved by one flipped cut
-  GroupMoveStats moves;  ///< otherwise: the group moves (one group per acquisition)
+  MinimiseStats solver;                 ///< solver.exact: the whole energy was solved by one flipped cut
+  GroupMoveStats moves;                 ///< otherwise: the group moves (one group per acquisition)
   double seconds_build = 0, seconds_solve = 0, seconds_fill = 0;
 };
 
@@ -60,7 +60,7 @@ struct MosaicSelection {
 /// The energy of the candidates (variables in global-id order of the kept triangles) and the
 /// global id of each variable.
 struct MosaicEnergy {
-  BinaryEnergy energy;  ///< pairs: the seam terms first, then the overlap terms
+  BinaryEnergy energy;                     ///< pairs: the seam terms first, then the overlap terms
   std::vector<std::uint32_t> triangle_of;  ///< variable -> global triangle
   std::vector<double> quality, boundary;   ///< per variable: its weighted unary parts
   /// Per variable: its centroid along the scene's longer horizontal extent (where the group
@@ -74,8 +74,9 @@ struct MosaicEnergy {
 MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& params);
 
 /// Minimises the mosaic energy: one exact cut when it can be flipped submodular (two meshes),
-/// else group moves per acquisition from an empty selection (sweeps sweeps at
-/// most); then fills holes (fill_holes) when params.fill_holes. Deterministic.
+/// else group moves per acquisition, oldest first whatever the config's listing, from an
+/// empty selection (sweeps sweeps at most); then fills holes (fill_holes) when
+/// params.fill_holes. Deterministic.
 MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& params);
 
 /// The baseline: acquisitions in date order (config order on equal dates); a kept triangle is
