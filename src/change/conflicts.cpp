@@ -76,10 +76,25 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, const VoxelMask& a
 
 }  // namespace
 
+namespace {
+
+/// The dates of the acquisitions holding triangles, so that a pass absent from a tile makes
+/// no work there (and the figures do not depend on passes elsewhere); empty when none does.
+std::vector<TimePoint> held_dates(const TriangleFrames& f) {
+  std::vector<TimePoint> out;
+  for (std::size_t a = 0; a < f.acquisitions(); ++a) {
+    if (f.holds(a)) out.push_back(f.dates[a]);
+  }
+  return out;
+}
+
+}  // namespace
+
 VoxelMask asked_voxels(const TriangleFrames& f, double voxel_size) {
-  // Every question is about the box of a triangle older than some acquisition.
-  if (f.dates.empty()) return VoxelMask(std::span<const VoxelBox>{});
-  const TimePoint newest = *std::max_element(f.dates.begin(), f.dates.end());
+  // Every question is about the box of a triangle older than some acquisition's empty space.
+  const std::vector<TimePoint> held = held_dates(f);
+  if (held.empty()) return VoxelMask(std::span<const VoxelBox>{});
+  const TimePoint newest = *std::max_element(held.begin(), held.end());
   const double inverse = OccupancyGrid::inverse_of(voxel_size);
   std::vector<VoxelBox> boxes;
   for (std::size_t a = 0; a < f.acquisitions(); ++a) {
@@ -97,7 +112,8 @@ std::vector<OccupancyGrid> build_empty_space_grids(const TriangleFrames& f, cons
   // grids stay empty. The others are marked in chunks of triangles, one grid each for an even
   // load whatever the acquisition sizes, then merged (a union: the order does not matter).
   if (f.dates.empty()) return {};
-  const TimePoint oldest = *std::min_element(f.dates.begin(), f.dates.end());
+  const std::vector<TimePoint> held = held_dates(f);  // none: no triangle, no chunk below
+  const TimePoint oldest = held.empty() ? f.dates.front() : *std::min_element(held.begin(), held.end());
   struct Chunk {
     std::size_t acquisition, begin, end;
   };
@@ -402,6 +418,7 @@ ConflictFlags find_conflicts(const TriangleFrames& f, const PartnerBits& partner
   flags.refutes.assign(f.size(), 0);
   std::atomic<std::uint64_t> tests{0};
   for (std::size_t j = 0; j < f.acquisitions(); ++j) {
+    if (!f.holds(j)) continue;  // no empty space: nothing to ask
     const BoxedTriangles older = conflict_candidates(f, partners, grids, j, params, stats);
     if (older.ids.empty()) continue;
     EmptySpaces spaces = whole_empty_spaces(f, j);

@@ -38,6 +38,9 @@ struct TriangleFrames {
   /// Whether g's conflicts raise the refutes of the triangles whose empty space it meets.
   [[nodiscard]] bool raises_refutes(std::size_t g) const { return use.empty() || use[g] == TriangleUse::labelled; }
   [[nodiscard]] std::size_t acquisitions() const { return dates.size(); }
+  /// Whether acquisition a has any triangle here (a tile may hold none of a pass that
+  /// covers only part of the city: such a pass has no empty space to ask about).
+  [[nodiscard]] bool holds(std::size_t a) const { return index.offsets[a] < index.offsets[a + 1]; }
   [[nodiscard]] TriangleCorners corners(std::size_t g) const;
   [[nodiscard]] TetrahedronCorners empty_space(std::size_t g) const;
   /// The corners' box, padded by a hair so that rounding to float never loses a touching pair.
