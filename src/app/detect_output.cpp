@@ -3,9 +3,11 @@
 
 #include <fmt/format.h>
 
-#include <nlohmann/json.hpp>
-
 #include <algorithm>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <set>
+#include <string>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
@@ -13,6 +15,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
+#include "citymesh/core/read_file.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/render/render.h"
@@ -89,6 +92,39 @@ AcquisitionOutputs write_acquisition_outputs(const Config& config, const LoadedA
   return done;
 }
 
+/// The labelled PLYs and pictures a summary lists (plain names only: nothing outside its
+/// folder).
+std::set<std::string> listed_outputs(const nlohmann::json& summary) {
+  std::set<std::string> names;
+  if (!summary.is_object() || !summary.contains("acquisitions") || !summary["acquisitions"].is_array()) return names;
+  for (const nlohmann::json& entry : summary["acquisitions"]) {
+    for (const char* key : {"ply", "png"}) {
+      if (!entry.is_object() || !entry.contains(key) || !entry[key].is_string()) continue;
+      const std::filesystem::path name = entry[key].get<std::string>();
+      if (!name.empty() && name == name.filename() && name != "." && name != "..") names.insert(name.string());
+    }
+  }
+  return names;
+}
+
+/// What the summary.json already in `dir` lists; none when there is no readable one.
+std::set<std::string> listed_outputs(const std::filesystem::path& dir) {
+  const std::optional<std::string> text = read_file_bytes(dir / "summary.json");
+  return text ? listed_outputs(nlohmann::json::parse(*text, nullptr, false)) : std::set<std::string>{};
+}
+
+/// Removes the files of `before` that the run did not write again: a withdrawn or renamed
+/// pass's labelled PLY would otherwise stay beside the others as if it were current.
+void remove_unlisted(const std::filesystem::path& dir, const std::set<std::string>& before,
+                     const std::set<std::string>& now) {
+  for (const std::string& name : before) {
+    if (now.contains(name)) continue;
+    std::error_code ec;
+    if (std::filesystem::remove(dir / name, ec))
+      log::info("{}: removed (no longer an output of this config)", (dir / name).string());
+  }
+}
+
 }  // namespace
 
 std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_per_vertex, bool pictures) {
@@ -105,7 +141,8 @@ unsigned labelled_output_workers(std::uint64_t largest, std::uint64_t memory) {
 unsigned labelled_outputs_at_once(std::span<const std::uint64_t> vertex_counts, std::uint64_t bytes_per_vertex,
                                   bool pictures, std::uint64_t budget) {
   std::uint64_t largest = 0;
-  for (const std::uint64_t v : vertex_counts) largest = std::max(largest, labelled_output_bytes(v, bytes_per_vertex, pictures));
+  for (const std::uint64_t v : vertex_counts)
+    largest = std::max(largest, labelled_output_bytes(v, bytes_per_vertex, pictures));
   return labelled_output_workers(largest, memory_left(budget));
 }
 
@@ -113,6 +150,7 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
                           const DetectOutputParams& params) {
   Stopwatch clock;
   std::filesystem::create_directories(params.dir);
+  const std::set<std::string> before = listed_outputs(params.dir);
   nlohmann::json summary;
   summary["config"] = config.file.string();
   summary["policy"] = unconfirmed_policy_name(config.change.unconfirmed);
@@ -155,6 +193,8 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
                         {"consistency", s.seconds_consistency}, {"grids", s.seconds_grids},
                         {"conflicts", s.seconds_conflicts},     {"time_series", s.seconds_time_series},
                         {"detect_total", s.seconds_total()},    {"write", clock.seconds()}};
+  // Before the summary that no longer lists them: a run killed in between removes them next time.
+  remove_unlisted(params.dir, before, listed_outputs(summary));
   write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
 }
 

@@ -199,8 +199,18 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
         changed.push_back(what);
       }
     }
+    const std::size_t listed = acquisition_count(keys);
     for (const auto& [k, v] : before) {
-      if (!keys.contains(k)) changed.push_back(fmt::format("{} (gone)", k));
+      if (keys.contains(k)) continue;
+      // The last acquisitions withdrawn (a pass found faulty, an update undone) are input too:
+      // no other pass is renumbered, so only the tiles they reached are redone.
+      if (const std::optional<std::size_t> a = acquisition_of_key(k); a && *a >= listed) {
+        if (k.ends_with(".path"))
+          log::info("{} ({}) was withdrawn since the last run: the tiles it reached are redone",
+                    k.substr(0, k.size() - 5), v);
+        continue;
+      }
+      changed.push_back(fmt::format("{} (gone)", k));
     }
     if (!changed.empty() && !force) {
       throw ConfigError(

@@ -1,11 +1,15 @@
 // SPDX-License-Identifier: MIT
 // Tile result files: the labels, consistent pairs and selected triangles of one finished tile.
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstddef>
 #include <cstring>
 #include <fstream>
+#include <span>
+#include <string_view>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
@@ -229,6 +233,21 @@ std::nullopt_t stale(const std::filesystem::path& file, std::string_view why) {
   return std::nullopt;
 }
 
+/// Whether the `acquisitions` pieces from byte `at` (each an 8-byte size and its bytes) end
+/// before the checksum, those from `listed` on (acquisitions withdrawn since) empty.
+bool pieces_fit(std::string_view bytes, std::size_t at, std::uint64_t acquisitions, std::size_t listed) {
+  const std::size_t end = bytes.size() - sizeof(std::uint64_t);
+  for (std::uint64_t a = 0; a < acquisitions; ++a) {
+    std::uint64_t size = 0;
+    if (end - at < sizeof size) return false;
+    std::memcpy(&size, bytes.data() + at, sizeof size);
+    at += sizeof size;
+    if (size > end - at || (a >= listed && size > 0)) return false;
+    at += size;
+  }
+  return true;
+}
+
 /// The result in `file` when it is whole and was made under `digest` (any digest: nothing).
 std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::optional<std::uint64_t> digest,
                                             const TileStore& store) {
@@ -252,13 +271,18 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   // acquisition in this tile, or a dependency redone.
   if (digest && h.fingerprint != *digest) return std::nullopt;
   const std::size_t body = bytes.size() - sizeof sum - header_bytes;
-  // Counts are checked against the section sizes (a varint takes a byte at least) before
-  // anything is allocated. A result made before acquisitions were appended holds fewer
-  // pieces: the digest says the tile has none of the new ones.
-  if (h.acquisitions > store.triangles.size() || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
+  // Counts are checked against the section sizes (a varint takes a byte at least, a piece
+  // its 8-byte size) before anything is allocated. A result made before acquisitions were
+  // appended holds fewer pieces, one made before the last ones were withdrawn more (empty):
+  // the digest says the tile has none of the others.
+  if (h.acquisitions > body / sizeof(std::uint64_t) || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
       h.refuted_bytes > body - h.label_bytes - h.pair_bytes || h.labels > h.label_bytes / kVarintsPerLabel ||
       h.pairs > h.pair_bytes / kPairFields.size() || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
+  }
+  if (!pieces_fit(bytes, header_bytes + h.label_bytes + h.pair_bytes + h.refuted_bytes, h.acquisitions,
+                  store.triangles.size())) {
+    return stale(file, "its pieces do not fit, or hold triangles of an acquisition the config no longer lists");
   }
   return CheckedResult{h, header_bytes, std::move(*read)};
 }
@@ -298,6 +322,7 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
     std::memcpy(&size, bytes.data() + at, sizeof size);
     at += sizeof size;
     if (size > end - at) return stale(file, "truncated");
+    if (a >= store.triangles.size()) continue;  // withdrawn since: empty (checked_result)
     TilePiece piece;
     piece.mesh.origin = origin;
     if (size > 0) piece = decode_tile_blocks(bytes.substr(at, size), origin, a, file.string());

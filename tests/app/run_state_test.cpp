@@ -28,12 +28,26 @@ Keys keys_of(std::size_t n) {
   return keys;
 }
 
-TEST(RunState, AnAcquisitionAppendedResumesAndOneChangedRemovedOrInsertedIsRefused) {
+TEST(RunState, TheLastAcquisitionsAppendedOrWithdrawnResumeAndOneChangedRemovedOrInsertedIsRefused) {
   test::TempDir work;
   check_run_config(work.path(), keys_of(3), false);
   EXPECT_NO_THROW(check_run_config(work.path(), keys_of(3), false));
-  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(5), false)) << "two passes appended";
-  EXPECT_THROW(check_run_config(work.path(), keys_of(4), false), ConfigError) << "the last pass removed";
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(6), false)) << "three passes appended";
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(4), false)) << "the last two withdrawn: none renumbered";
+  // A pass withdrawn before the last one renumbers those after it: their keys change.
+  Keys middle = keys_of(3);
+  middle["acquisition[1].path"] = "/data/pass2.ply";
+  middle["acquisition[1].file"] = keys_of(3)["acquisition[2].file"];
+  middle["acquisition[1].time"] = keys_of(3)["acquisition[2].time"];
+  middle["acquisition[2].path"] = "/data/pass3.ply";
+  middle["acquisition[2].file"] = keys_of(4)["acquisition[3].file"];
+  middle["acquisition[2].time"] = keys_of(4)["acquisition[3].time"];
+  try {
+    check_run_config(work.path(), middle, false);
+    ADD_FAILURE() << "a pass withdrawn in the middle";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("acquisition[1].path"), std::string::npos) << e.what();
+  }
   Keys changed = keys_of(6);
   changed["acquisition[1].time"] = "2026-02-02T10:00:00Z";
   try {
@@ -44,6 +58,7 @@ TEST(RunState, AnAcquisitionAppendedResumesAndOneChangedRemovedOrInsertedIsRefus
     EXPECT_EQ(std::string(e.what()).find("acquisition[5]"), std::string::npos) << e.what();
   }
   // A pass inserted before the last one renumbers it: its keys change.
+  check_run_config(work.path(), keys_of(5), false);
   Keys inserted = keys_of(5);
   inserted["acquisition[4].path"] = "/data/inserted.ply";
   inserted["acquisition[5].path"] = "/data/pass4.ply";

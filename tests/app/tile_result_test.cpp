@@ -150,11 +150,47 @@ TEST(TileResult, AResultMadeBeforeAnAcquisitionWasAddedReadsWithAnEmptyPieceForI
   EXPECT_EQ(back->selected[2].triangle_count(), 0u);
   EXPECT_EQ(back->selected[2].mesh.origin, back->selected[0].mesh.origin);
   expect_same_labels(back->labels, r.labels);
-  // A result holding more acquisitions than the store is another store's.
-  TileStore one = two_acquisitions();
-  one.triangles.pop_back();
-  EXPECT_FALSE(read_tile_result(tmp / "t.bin", kFingerprint, one).has_value());
-  EXPECT_FALSE(read_tile_labels(tmp / "t.bin", kFingerprint, one).has_value());
+  // (A result holding more acquisitions than the store: the test below.)
+}
+
+/// A piece of one triangle of acquisition `a`, in the tile's frame.
+TilePiece one_triangle(std::uint32_t a) {
+  TilePiece p;
+  p.mesh.origin = {651000 + 50 * 13020.0, 6860000 - 50 * 7.0, 0};
+  for (const Vec3f v : {Vec3f{1, 1, 0}, Vec3f{2, 1, 0}, Vec3f{1, 2, 0}}) {
+    p.mesh.positions.push_back(v);
+    p.mesh.sensor_positions.push_back({0, 0, 2});
+  }
+  p.vertex_ids = {7, 8, 9};
+  p.mesh.triangles.push_back({0, 1, 2});
+  p.mesh.triangle_ids.push_back({a, 0, 12});
+  p.triangle_index.push_back(12);
+  p.roles.push_back(TileRole::owned);
+  return p;
+}
+
+TEST(TileResult, AResultMadeBeforeTheLastAcquisitionWasWithdrawnReadsWhenItHoldsNoneOfIt) {
+  // Three acquisitions when it was written; the store now lists two (the third withdrawn).
+  test::TempDir tmp;
+  TileResult r = random_result(4, true);  // labels of acquisitions 0 and 1
+  r.selected = {one_triangle(0), one_triangle(1), TilePiece{}};
+  r.selected[2].mesh.origin = r.selected[0].mesh.origin;
+  write_tile_result(tmp / "t.bin", r, kDigests);
+  const TileStore two = two_acquisitions();
+  const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint, two);
+  ASSERT_TRUE(back.has_value());
+  ASSERT_EQ(back->selected.size(), 2u);
+  EXPECT_EQ(back->selected[1].triangle_count(), 1u);
+  expect_same_labels(back->labels, r.labels);
+  EXPECT_TRUE(read_tile_labels(tmp / "t.bin", kFingerprint, two).has_value());
+  EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint, two));
+  // One that holds a triangle of the withdrawn acquisition is not used (the digest, which
+  // counts the tile's triangles of each acquisition, says so first).
+  r.selected[2] = one_triangle(2);
+  write_tile_result(tmp / "piece.bin", r, kDigests);
+  EXPECT_FALSE(read_tile_result(tmp / "piece.bin", kFingerprint, two).has_value());
+  EXPECT_FALSE(read_tile_labels(tmp / "piece.bin", kFingerprint, two).has_value());
+  EXPECT_FALSE(tile_result_is_finished(tmp / "piece.bin", kFingerprint, two));
 }
 
 TEST(TileResult, ScanOrderedLabelsTakeUnderAQuarterOfTheFixedLayout) {

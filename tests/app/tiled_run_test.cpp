@@ -411,10 +411,21 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   EXPECT_EQ(read_json(dir / "sim/u/detect/summary.json")["prefilter"],
             read_json(dir / "sim/f/detect/summary.json")["prefilter"]);
 
-  // Dropping an acquisition is a change of config: refused without --force.
-  const auto dropped = run("five.toml", "u");
-  EXPECT_EQ(dropped.exit_code, 1);
-  EXPECT_NE(dropped.err.find("acquisition[5].path (gone)"), std::string::npos) << dropped.err;
+  // Withdrawing the appended pass again (found faulty, say) renumbers no other: like
+  // appending it, it redoes only the tiles it reached, to the bytes of a fresh run (its
+  // labelled PLY removed from the outputs).
+  const auto withdrawn = run("five.toml", "u");
+  ASSERT_EQ(withdrawn.exit_code, 0) << withdrawn.err;
+  EXPECT_NE(withdrawn.err.find("acquisition[5] (acq_5_part.ply) was withdrawn"), std::string::npos) << withdrawn.err;
+  EXPECT_EQ(withdrawn.err.find("do not fit"), std::string::npos) << withdrawn.err;
+  const nlohmann::json after = read_json(dir / "sim/u/run.json");
+  EXPECT_GT(after["reused_tiles"].get<int>(), 0) << "tiles the pass did not reach";
+  EXPECT_LT(after["reused_tiles"].get<int>(), after["tiles"].get<int>()) << "tiles the pass reached";
+  const auto five_fresh = run("five.toml", "g");
+  ASSERT_EQ(five_fresh.exit_code, 0) << five_fresh.err;
+  EXPECT_TRUE(test::result_bytes(dir / "sim/u") == test::result_bytes(dir / "sim/g")) << "withdrawing differs";
+  EXPECT_EQ(read_json(dir / "sim/u/detect/summary.json")["prefilter"],
+            read_json(dir / "sim/g/detect/summary.json")["prefilter"]);
 }
 
 /// The face count a PLY header declares.
