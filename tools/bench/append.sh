@@ -2,8 +2,9 @@
 # SPDX-License-Identifier: MIT
 # Appending a pass over one district to a run (a monthly update): the run of every
 # acquisition but the last, then the last one's triangles within a box appended to the same
-# work folder, against a fresh run of the same config. Prints both wall times, the tiles
-# reused and whether the outputs are the same bytes.
+# work folder, against a fresh run of the same config; then that pass withdrawn again
+# (session 65), against the first run's outputs. Prints the wall times, the tiles reused and
+# whether the outputs are the same bytes.
 # Usage: tools/bench/append.sh FOLDER XMIN YMIN XMAX YMAX [threads (default 2)]
 #   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
 set -euo pipefail
@@ -27,17 +28,31 @@ run() {  # config, work/output name
     tail -1
   tail -1 "$dir/append-$2.log"
 }
-rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh"
+same_as() {  # output folder against another: mosaic.ply and 3D Tiles
+  cmp -s "$dir/$1/mosaic/mosaic.ply" "$dir/$2/mosaic/mosaic.ply" && diff -rq "$dir/$1/tiles" "$dir/$2/tiles" >/dev/null
+}
+reused() {  # what the last run into out-append reused
+  python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} kept when a neighbour was redone)\")"
+}
+rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh" "$dir/out-before"
 echo "every acquisition but the last:"
 run append-before.toml append
+cp -r "$dir/out-append" "$dir/out-before"
 echo "the district appended to that work folder:"
 run append-after.toml append
-python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} kept when a neighbour was redone)\")"
+reused
 echo "a fresh run of the same config:"
 run append-after.toml fresh
-if cmp -s "$dir/out-append/mosaic/mosaic.ply" "$dir/out-fresh/mosaic/mosaic.ply" &&
-  diff -rq "$dir/out-append/tiles" "$dir/out-fresh/tiles" >/dev/null; then
+if same_as out-append out-fresh; then
   echo "appended and fresh: identical mosaic.ply and 3D Tiles"
 else
   echo "appended and fresh: outputs DIFFER"
+fi
+echo "the district withdrawn again from the appended work folder:"
+run append-before.toml append
+reused
+if same_as out-append out-before; then
+  echo "withdrawn and the first run: identical mosaic.ply and 3D Tiles"
+else
+  echo "withdrawn and the first run: outputs DIFFER"
 fi
