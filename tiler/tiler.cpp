@@ -113,12 +113,18 @@ class AcquisitionTiler {
         if (batch_bytes() > buffer_bytes_ || batch_.size() >= kMaxBatchTriangles) flush();
       }
     }
-    flush();
-    blocks_file_.close();
+    finish();
     if (zero_area_dropped_ > 0) log::info("{}: dropped {} zero-area triangles", file.string(), zero_area_dropped_);
     out_.triangles = next_index_;
     out_.stats.input_bytes += reader.stats().bytes;
     out_.stats.largest_radius = std::sqrt(largest_radius_squared_);
+  }
+
+  /// Writes what is buffered and closes the blocks file: after run(), or alone for a
+  /// withdrawn acquisition (no triangle).
+  void finish() {
+    flush();
+    blocks_file_.close();
   }
 
  private:
@@ -317,12 +323,18 @@ AcquisitionTiling tile_acquisition(const Acquisition& acquisition, const TilerPa
   if (ec) throw OutputError(fmt::format("{}: cannot create a tiling folder: {}", staged.string(), ec.message()));
   AcquisitionTiling out;
   out.fingerprint = fingerprint;
-  AcquisitionTiler(grid, staged / kBlocksFile, out, params.buffer_bytes).run(acquisition.path, params.ply);
+  AcquisitionTiler tiler(grid, staged / kBlocksFile, out, params.buffer_bytes);
+  if (acquisition.withdrawn) {
+    tiler.finish();  // an empty tiling: the tiles it was in are redone without it
+  } else {
+    tiler.run(acquisition.path, params.ply);
+  }
   out.stats.seconds = clock.seconds();
   write_acquisition_tiling(staged, out);
   sync_tile_files(staged);
   if (std::optional<AcquisitionTiling> first = publish_acquisition_tiling(staged, target, fingerprint)) return *first;
-  log::info("tiled {}: {} triangles in {:.2f} s", acquisition.path.string(), out.triangles, out.stats.seconds);
+  log::info("tiled {}: {} triangles in {:.2f} s{}", acquisition.path.string(), out.triangles, out.stats.seconds,
+            acquisition.withdrawn ? " (withdrawn)" : "");
   return out;
 }
 
@@ -371,6 +383,7 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
   for (std::size_t k = 0; k < order.size(); ++k) {
     order[k] = k;
     sizes[k] = std::filesystem::file_size(acquisitions[k].path, ec);  // 0 when unreadable: the tiler says why
+    if (ec || acquisitions[k].withdrawn) sizes[k] = 0;
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
   std::vector<AcquisitionTiling> parts(acquisitions.size());

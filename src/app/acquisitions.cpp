@@ -22,6 +22,12 @@ void check_provenance_ids(const std::filesystem::path& file, std::uint64_t faces
 }
 
 Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin) {
+  if (a.withdrawn) {
+    log::info("{}: withdrawn, read as an empty mesh", a.path.string());
+    Mesh empty;
+    empty.origin = origin.value_or(Vec3d{});
+    return empty;
+  }
   MeshReadParams params;
   params.ply = config.ply_read_params();
   params.acquisition = a.index;
@@ -36,10 +42,16 @@ LoadedAcquisitions load_acquisitions(const Config& config) {
   LoadedAcquisitions out;
   out.acquisitions = config.acquisition_list();
   if (out.acquisitions.empty()) throw ConfigError(fmt::format("{}: no [[acquisition]]", config.file.string()));
+  // Every mesh in the frame of the first one with a vertex: an empty one (withdrawn, say) has
+  // none of its own, and later steps take the first mesh's frame as everyone's.
+  std::optional<Vec3d> frame;
   for (const Acquisition& a : out.acquisitions) {
-    out.meshes.push_back(read_acquisition(config, a, out.meshes.empty() ? std::nullopt
-                                                                         : std::optional(out.meshes.front().origin)));
+    out.meshes.push_back(read_acquisition(config, a, frame));
+    if (!frame && out.meshes.back().vertex_count() > 0) frame = out.meshes.back().origin;
     out.dates.push_back(a.date);
+  }
+  for (Mesh& m : out.meshes) {
+    if (m.vertex_count() == 0 && frame) m.origin = *frame;
   }
   return out;
 }

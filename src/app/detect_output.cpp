@@ -77,6 +77,15 @@ struct AcquisitionOutputs {
 AcquisitionOutputs write_acquisition_outputs(const Config& config, const LoadedAcquisitions& described,
                                              DetectOutputSource& source, const DetectOutputParams& params,
                                              std::size_t k) {
+  if (described.acquisitions[k].withdrawn) {  // no labels: no file (an earlier run's is removed)
+    AcquisitionOutputs none{acquisition_json(config, described, k), {}};
+    none.entry["withdrawn"] = true;
+    none.entry["ply"] = "";
+    none.entry["png"] = "";
+    none.entry["triangles"] = 0;
+    none.entry["counts"] = counts_json(none.counts);
+    return none;
+  }
   const std::string stem = file_stem(config, k);
   LabelledOutputParams files = source.layout(k);
   files.ply = params.dir / (stem + ".ply");

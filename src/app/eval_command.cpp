@@ -164,6 +164,7 @@ class EvalCommand final : public Command {
     std::map<std::uint32_t, ObjectInfo> objects = catalogue;  // areas added up per object
     try {
       for (const auto& a : summary.at("acquisitions")) {
+        if (a.value("withdrawn", false)) continue;  // no labels to score
         score_acquisition(detect / a.at("ply").get<std::string>(), truth_file(truth_, a), objects);
       }
     } catch (const nlohmann::json::exception& e) {

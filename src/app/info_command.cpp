@@ -9,6 +9,7 @@
 
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/geo/crs.h"
 #include "citymesh/io/ply_inspect.h"
 #include "command.h"
@@ -139,7 +140,13 @@ class InfoCommand final : public Command {
       params = config.ply_read_params();
       crs = config.crs();
       if (files_.empty()) {
-        for (const auto& a : config.acquisitions) files_.push_back(a.path.string());
+        for (const auto& a : config.acquisitions) {
+          if (a.withdrawn) {
+            log::info("{}: withdrawn, not described", a.path.string());
+          } else {
+            files_.push_back(a.path.string());
+          }
+        }
       }
     }
     if (!crs_.empty()) crs = Crs::parse(crs_);

@@ -199,6 +199,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   double static_area = 0, static_covered = 0, static_open = 0, finest_edge = 0;
   UncoveredStatic uncovered;
   for (std::size_t k = 0; k < acquisitions.size(); ++k) {
+    if (acquisitions[k].value("withdrawn", false)) continue;  // not an input of the run
     const std::filesystem::path ply = output / "detect" / acquisitions[k].at("ply").get<std::string>();
     const FaceTable in = read_face_table(ply, {kSourceFaceProperty, kKeptProperty});
     std::vector<double> face_area(in.triangles.size()), covered(in.triangles.size()), under(in.triangles.size());

@@ -203,6 +203,7 @@ ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAc
                                    (dir / "summary.json").string(), acquisitions.size(), input.meshes.size()));
     }
     for (std::size_t k = 0; k < input.meshes.size(); ++k) {
+      if (input.acquisitions[k].withdrawn) continue;  // an empty mesh: no labels written
       const std::filesystem::path ply = dir / acquisitions[k].at("ply").get<std::string>();
       const FaceTable t = read_face_table(ply, {kKeptProperty});
       if (t.triangles.size() != input.meshes[k].triangle_count()) {

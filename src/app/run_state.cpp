@@ -42,6 +42,16 @@ std::string describe_rewrite(const std::map<std::string, std::string>& keys, con
   return fmt::format("{} was rewritten since the last run ({})", where, how);
 }
 
+/// The `.file` key of a withdrawn acquisition, whose file is not looked at.
+constexpr std::string_view kWithdrawnFile = "withdrawn";
+
+/// "acquisition[k] (its path)" for any key of acquisition k.
+std::string acquisition_named(const std::map<std::string, std::string>& keys, const std::string& key) {
+  const std::string acquisition = key.substr(0, key.find(']') + 1);
+  const auto path = keys.find(acquisition + ".path");
+  return path == keys.end() ? acquisition : fmt::format("{} ({})", acquisition, path->second);
+}
+
 /// k of an "acquisition[k]..." key; nothing for other keys.
 std::optional<std::size_t> acquisition_of_key(std::string_view key) {
   constexpr std::string_view prefix = "acquisition[";
@@ -109,6 +119,10 @@ std::map<std::string, std::string> result_keys(const Config& config) {
   for (std::size_t k = 0; k < config.acquisitions.size(); ++k) {
     const auto& path = config.acquisitions[k].path;
     keys[fmt::format("acquisition[{}].path", k)] = path_key(path, config.base_dir);
+    if (config.acquisitions[k].withdrawn) {
+      keys[fmt::format("acquisition[{}].file", k)] = std::string(kWithdrawnFile);  // not read: may be gone
+      continue;
+    }
     std::error_code ec;
     const auto size = std::filesystem::file_size(path, ec);
     const auto time = std::filesystem::last_write_time(path, ec).time_since_epoch().count();
@@ -190,6 +204,12 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
                                : it->second != v  ? fmt::format("{} ({} -> {})", k, it->second, v)
                                                   : std::string();
       if (what.empty()) continue;
+      // A pass withdrawn in place, or put back, is input too: no pass is renumbered.
+      if (k.ends_with(".withdrawn")) {
+        log::info("{} was withdrawn since the last run: the tiles it reached are redone", acquisition_named(keys, k));
+        continue;
+      }
+      if (k.ends_with(".file") && it != before.end() && (it->second == kWithdrawnFile || v == kWithdrawnFile)) continue;
       // A rewritten input file is not a config change: its tiles are simply redone.
       if (k.ends_with(".file")) {
         log::warn("{}: its work is redone", it == before.end()
@@ -202,6 +222,10 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     const std::size_t listed = acquisition_count(keys);
     for (const auto& [k, v] : before) {
       if (keys.contains(k)) continue;
+      if (const std::optional<std::size_t> a = acquisition_of_key(k); k.ends_with(".withdrawn") && a && *a < listed) {
+        log::info("{} is no longer withdrawn: the tiles it reaches are redone", acquisition_named(keys, k));
+        continue;
+      }
       // The last acquisitions withdrawn (a pass found faulty, an update undone) are input too:
       // no other pass is renumbered, so only the tiles they reached are redone.
       if (const std::optional<std::size_t> a = acquisition_of_key(k); a && *a >= listed) {

@@ -90,6 +90,7 @@ Vec3d shared_frame(const Config& config, const LoadedAcquisitions& described) {
   PlyVertexChunk vertices;
   PlyFaceChunk faces;
   for (const Acquisition& a : described.acquisitions) {
+    if (a.withdrawn) continue;
     PlyReader reader(a.path, config.ply_read_params());
     for (auto kind = reader.next(vertices, faces); kind == PlyReader::ChunkKind::vertices;
          kind = reader.next(vertices, faces)) {

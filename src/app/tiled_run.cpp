@@ -50,7 +50,7 @@ LoadedAcquisitions describe_acquisitions(const Config& config) {
 unsigned labels_at_once(const Config& config, const LoadedAcquisitions& described, bool pictures) {
   std::vector<std::uint64_t> vertices;
   for (const Acquisition& a : described.acquisitions) {
-    vertices.push_back(PlyReader(a.path, config.ply_read_params()).vertex_count());
+    vertices.push_back(a.withdrawn ? 0 : PlyReader(a.path, config.ply_read_params()).vertex_count());
   }
   return labelled_outputs_at_once(vertices, TiledDetectOutput::kBytesPerVertex, pictures, config.run.memory);
 }

@@ -166,6 +166,9 @@ class Parser {
       } else if (k == "name") {
         if (!value.is_string()) ctx.fail("expected a string");
         a.name = *value.value<std::string>();
+      } else if (k == "withdrawn") {
+        if (!value.is_boolean()) ctx.fail("expected true or false");
+        a.withdrawn = *value.value<bool>();
       } else {
         std::vector<std::string> valid(acquisition_keys().begin(), acquisition_keys().end());
         ctx.fail(fmt::format("unknown key; did you mean '{}'?", nearest(k, valid)));
@@ -217,15 +220,21 @@ class Parser {
                        config_.tiling.halo, config_.tiling.tile_size));
     }
     if (config_.acquisitions.empty()) fail("no [[acquisition]] tables: a run needs at least one acquisition");
+    if (std::all_of(config_.acquisitions.begin(), config_.acquisitions.end(),
+                    [](const AcquisitionEntry& a) { return a.withdrawn; })) {
+      fail("every [[acquisition]] is withdrawn: a run needs at least one acquisition");
+    }
     for (std::size_t i = 0; i < config_.acquisitions.size(); ++i) check_acquisition(i);
   }
 
   void check_acquisition(std::size_t i) const {
     const AcquisitionEntry& a = config_.acquisitions[i];
+    if (a.withdrawn) return;  // not read: its file may be gone, or listed again as a new pass
     if (params_.check_files && !std::filesystem::is_regular_file(a.path)) {
       fail(fmt::format("acquisition[{}].path: no such file: {}", i, a.path.string()));
     }
     for (std::size_t j = 0; j < i; ++j) {
+      if (config_.acquisitions[j].withdrawn) continue;
       if (config_.acquisitions[j].path == a.path) {
         fail(fmt::format("acquisition[{}] and acquisition[{}] name the same file {}", j, i, a.path.string()));
       }
@@ -269,11 +278,13 @@ std::string render(const Config& c, bool defaults) {
            "# [[acquisition]]\n"
            "# path = \"acq_0.ply\"              # (required) PLY mesh with per-vertex sensor position\n"
            "# time = \"2026-01-05T10:00:00Z\"   # (required) ISO 8601 date-time with zone, or a date\n"
-           "# name = \"january\"                # label in reports (default: the file name)\n";
+           "# name = \"january\"                # label in reports (default: the file name)\n"
+           "# withdrawn = true                # a faulty pass: read as empty, no later pass renumbered\n";
   }
   for (const AcquisitionEntry& a : c.acquisitions) {
     out += fmt::format("\n[[acquisition]]\npath = {}\ntime = {}\nname = {}\n", toml_string(a.path.string()),
                        toml_string(format_iso8601(a.time)), toml_string(a.name));
+    if (a.withdrawn) out += "withdrawn = true\n";
   }
   return out;
 }
@@ -287,7 +298,8 @@ Crs Config::crs() const {
 std::vector<Acquisition> Config::acquisition_list() const {
   std::vector<Acquisition> list;
   for (std::size_t i = 0; i < acquisitions.size(); ++i) {
-    list.push_back({static_cast<std::uint32_t>(i), acquisitions[i].time, acquisitions[i].path});
+    list.push_back(
+        {static_cast<std::uint32_t>(i), acquisitions[i].time, acquisitions[i].path, acquisitions[i].withdrawn});
   }
   return list;
 }

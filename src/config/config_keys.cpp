@@ -321,7 +321,7 @@ const std::vector<std::string_view>& config_sections() {
 }
 
 const std::vector<std::string_view>& acquisition_keys() {
-  static const std::vector<std::string_view> keys{"path", "time", "name"};
+  static const std::vector<std::string_view> keys{"path", "time", "name", "withdrawn"};
   return keys;
 }
 

@@ -72,6 +72,24 @@ TEST(RunState, TheLastAcquisitionsAppendedOrWithdrawnResumeAndOneChangedRemovedO
   EXPECT_NO_THROW(check_run_config(work.path(), keys_of(2), true));
 }
 
+TEST(RunState, APassWithdrawnInPlaceOrPutBackResumesAndChangesOnlyItsOwnFingerprint) {
+  test::TempDir work;
+  check_run_config(work.path(), keys_of(3), false);
+  Keys withdrawn = keys_of(3);  // as result_keys gives them for `withdrawn = true`
+  withdrawn["acquisition[1].withdrawn"] = "true";
+  withdrawn["acquisition[1].file"] = "withdrawn";
+  EXPECT_NO_THROW(check_run_config(work.path(), withdrawn, false));
+  EXPECT_NO_THROW(check_run_config(work.path(), keys_of(3), false)) << "put back";
+  const RunFingerprints before = run_fingerprints(keys_of(3), 3), after = run_fingerprints(withdrawn, 3);
+  EXPECT_EQ(before.settings, after.settings);
+  EXPECT_EQ(before.acquisitions[0], after.acquisitions[0]);
+  EXPECT_NE(before.acquisitions[1], after.acquisitions[1]) << "its tiling is made again (empty)";
+  EXPECT_EQ(before.acquisitions[2], after.acquisitions[2]);
+  // Its date or path changed at the same time is still a change of config.
+  withdrawn["acquisition[1].time"] = "2026-02-03T10:00:00Z";
+  EXPECT_THROW(check_run_config(work.path(), withdrawn, false), ConfigError);
+}
+
 TEST(RunState, AFileNamedByItsAbsolutePathBeforeAndRelativeNowIsTheSameFile) {
   test::TempDir work;
   Keys before = keys_of(2);

@@ -428,6 +428,62 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
             read_json(dir / "sim/g/detect/summary.json")["prefilter"]);
 }
 
+/// `files` without the change step's labelled outputs (detect/...).
+std::map<std::string, std::string> without_labels(std::map<std::string, std::string> files) {
+  std::erase_if(files, [](const auto& f) { return f.first.starts_with("detect/"); });
+  return files;
+}
+
+TEST(TiledRun, APassWithdrawnInPlaceIsReadAsEmptyAndPutBackGivesTheFirstBytes) {
+  test::TempDir dir;
+  const std::filesystem::path sim = dir / "sim";
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim.string())).exit_code, 0);
+  const auto run = [&](const std::string& config, const std::string& name) {
+    return test::run_citymesh(fmt::format("run {} --no-pictures --set tiling.tile_size=10 --set project.output={} "
+                                          "--set project.work=work-{}",
+                                          (sim / config).string(), name, name));
+  };
+  ASSERT_EQ(run("config.toml", "w").exit_code, 0);
+  const auto first = test::result_bytes(sim / "w");
+  ASSERT_TRUE(first.contains("detect/1_epoch 1.ply"));
+
+  // Acquisition 1 found faulty: withdrawn in place, its file moved away (it is not read).
+  const std::string config = test::read_text(sim / "config.toml");
+  std::string withdrawn = config;
+  withdrawn.replace(withdrawn.find("path = \"acq_1.ply\"\n") + 19, 0, "withdrawn = true\n");
+  test::write_text(sim / "withdrawn.toml", withdrawn);
+  std::filesystem::rename(sim / "acq_1.ply", sim / "acq_1.moved");
+  const auto without = run("withdrawn.toml", "w");
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  EXPECT_NE(without.err.find("acquisition[1] (acq_1.ply) was withdrawn"), std::string::npos) << without.err;
+  const auto after = test::result_bytes(sim / "w");
+  EXPECT_FALSE(after.contains("detect/1_epoch 1.ply")) << "its labelled PLY removed";
+  EXPECT_TRUE(after.contains("detect/2_epoch 2.ply")) << "no pass renumbered";
+  EXPECT_TRUE(read_json(sim / "w/detect/summary.json")["acquisitions"][1]["withdrawn"].get<bool>());
+  EXPECT_EQ(test::run_citymesh(fmt::format("eval {}/w --truth {}", sim.string(), sim.string())).exit_code, 0);
+
+  // The output is that of a fresh run in which the pass's file holds no triangle.
+  test::write_text(sim / "empty.ply",
+                   "ply\nformat ascii 1.0\nelement vertex 0\nproperty double x\nproperty double y\n"
+                   "property double z\nproperty double x_origin\nproperty double y_origin\nproperty double z_origin\n"
+                   "element face 0\nproperty list uchar uint vertex_indices\nend_header\n");
+  std::string emptied = config;
+  emptied.replace(emptied.find("acq_1.ply"), 9, "empty.ply");
+  test::write_text(sim / "emptied.toml", emptied);
+  ASSERT_EQ(run("emptied.toml", "e").exit_code, 0);
+  const auto reference = without_labels(test::result_bytes(sim / "e"));
+  ASSERT_TRUE(reference.contains("mosaic/mosaic.ply"));
+  EXPECT_TRUE(without_labels(after) == reference) << "withdrawn differs from an empty file";
+  EXPECT_NE(without_labels(after), without_labels(first));
+
+  // Put back: the bytes of the first run, its labelled PLY again.
+  std::filesystem::rename(sim / "acq_1.moved", sim / "acq_1.ply");
+  const auto back = run("config.toml", "w");
+  ASSERT_EQ(back.exit_code, 0) << back.err;
+  EXPECT_NE(back.err.find("acquisition[1] (acq_1.ply) is no longer withdrawn"), std::string::npos) << back.err;
+  EXPECT_TRUE(test::result_bytes(sim / "w") == first);
+}
+
 /// The face count a PLY header declares.
 std::size_t ply_faces(const std::filesystem::path& ply) {
   const std::string text = test::read_text(ply);

@@ -142,6 +142,35 @@ TEST_F(ConfigTest, EffectiveConfigIsItselfAValidConfig) {
             effective_config_toml(c).substr(effective_config_toml(c).find('\n')));
 }
 
+TEST_F(ConfigTest, AWithdrawnAcquisitionKeepsItsPlaceAndNeedsNoFile) {
+  std::filesystem::remove(dir_ / "b.ply");
+  const std::string withdrawn = std::string(kMinimal).replace(std::string(kMinimal).find("time = \"2026-03"), 0,
+                                                              "withdrawn = true\n");
+  const Config c = parse(withdrawn);  // b.ply is gone: it is not read
+  ASSERT_EQ(c.acquisitions.size(), 2u);
+  EXPECT_TRUE(c.acquisitions[0].withdrawn);
+  EXPECT_FALSE(c.acquisitions[1].withdrawn);
+  EXPECT_TRUE(c.acquisition_list()[0].withdrawn);
+  EXPECT_EQ(c.acquisition_list()[1].index, 1u) << "no later pass renumbered";
+  // The effective config says so, and parses back to it.
+  EXPECT_NE(effective_config_toml(c).find("withdrawn = true"), std::string::npos);
+  EXPECT_TRUE(parse(effective_config_toml(c)).acquisitions[0].withdrawn);
+  // A pass listed again (corrected) may name the withdrawn one's file.
+  test::write_text(dir_ / "b.ply", "");
+  EXPECT_NO_THROW(parse(withdrawn + "\n[[acquisition]]\npath = \"b.ply\"\ntime = 2026-04-01\n"));
+  EXPECT_THROW(parse(std::string(kMinimal) + "\n[[acquisition]]\npath = \"b.ply\"\ntime = 2026-04-01\n"), ConfigError);
+  // Not a boolean, or every pass withdrawn: refused, naming the key.
+  try {
+    parse(std::string(kMinimal).replace(std::string(kMinimal).find("time = \"2026-03"), 0, "withdrawn = \"yes\"\n"));
+    ADD_FAILURE() << "a string accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("acquisition[0].withdrawn"), std::string::npos) << e.what();
+  }
+  std::string both = withdrawn;
+  both.replace(both.find("name = \"january\""), 0, "withdrawn = true\n");
+  EXPECT_THROW(parse(both), ConfigError);
+}
+
 TEST(ConfigExamples, CommentedExampleAndDemoParse) {
   const Config example = load_config(test::source_dir() / "configs/example.toml", {.overrides = {}, .check_files = false});
   EXPECT_GE(example.acquisitions.size(), 2u);

@@ -38,6 +38,9 @@ struct AcquisitionEntry {
   std::filesystem::path path;  ///< absolute (resolved against the config file's folder)
   TimePoint time{};
   std::string name;  ///< defaults to the file stem
+  /// Withdrawn (a pass found faulty): kept in the list so that no later pass is renumbered,
+  /// read as an empty mesh; its file need not exist.
+  bool withdrawn = false;
 };
 
 struct TilingParams {

@@ -21,6 +21,7 @@ struct Acquisition {
   std::uint32_t index = 0;
   TimePoint date{};
   std::filesystem::path path;
+  bool withdrawn = false;  ///< read as an empty mesh (its file is not opened)
 };
 
 /// Global identity of a triangle, kept by every stage and written to every output.
