@@ -136,6 +136,17 @@ void remove_unlisted(const std::filesystem::path& dir, const std::set<std::strin
 
 }  // namespace
 
+void remove_detect_outputs(const std::filesystem::path& dir) {
+  const std::set<std::string> listed = listed_outputs(dir);
+  std::error_code ec;
+  if (listed.empty() && !std::filesystem::exists(dir / kPairsFile, ec)) return;
+  for (const std::string& name : listed) std::filesystem::remove(dir / name, ec);
+  std::filesystem::remove(dir / kPairsFile, ec);
+  std::filesystem::remove(dir / "summary.json", ec);  // last: what it lists is gone
+  log::info("{}: an earlier run's labelled outputs removed (this run writes none: [output] labels = false)",
+            dir.string());
+}
+
 std::uint64_t labelled_output_bytes(std::uint64_t vertices, std::uint64_t bytes_per_vertex, bool pictures) {
   const std::uint64_t side = ViewParams{}.max_side;
   constexpr std::uint64_t kPixelBytes = sizeof(Rgb8) + sizeof(float);  // the picture and its depth

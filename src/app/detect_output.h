@@ -71,6 +71,11 @@ unsigned labelled_outputs_at_once(std::span<const std::uint64_t> vertex_counts, 
 void write_detect_outputs(const Config& config, const LoadedAcquisitions& described, DetectOutputSource& source,
                           const DetectOutputParams& params);
 
+/// Removes what write_detect_outputs wrote in `dir` before (the files its summary.json lists,
+/// pairs.bin, then summary.json): a run that writes no labels (`[output] labels = false`)
+/// leaves no earlier run's labels beside its mosaic, which they no longer describe.
+void remove_detect_outputs(const std::filesystem::path& dir);
+
 /// `citymesh detect`'s source: the meshes and the result it has in memory.
 class InMemoryDetectOutput final : public DetectOutputSource {
  public:

@@ -245,7 +245,11 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   read_tile_results(config, store, digests, tiles, assembly, output, per_tile);
   const std::uint64_t selected = output.assemble(assembly);
   stage_done("assembly");
-  if (config.output.labels) write_labels(config, assembly, pictures);
+  if (config.output.labels) {
+    write_labels(config, assembly, pictures);
+  } else if (cluster == nullptr || cluster->root()) {
+    remove_detect_outputs(config.project.output / "detect");
+  }
   stage_done("labels");
   const nlohmann::json stitched = output.stitch();
   stage_done("stitch");

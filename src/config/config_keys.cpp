@@ -300,7 +300,7 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(bool_key(output, "ply", "also write one PLY per tile with provenance (source_acq, source_face)",
       [](auto& c) -> auto& { return c.output.ply; }));
   keys.push_back(bool_key(output, "labels",
-      "citymesh run: also write the change step's labelled PLY per acquisition (what eval scores; as large as the inputs on disk; written acquisition by acquisition, several at once when the memory budget holds them, with the pairs waiting on disk)",
+      "citymesh run: also write the change step's labelled PLY per acquisition (what eval scores; as large as the inputs on disk; written acquisition by acquisition, several at once when the memory budget holds them, with the pairs waiting on disk; false also removes an earlier run's)",
       [](auto& c) -> auto& { return c.output.labels; }));
   keys.push_back(real_key(output, "draco_tolerance", "largest position error of Draco quantization (metres)",
       [](auto& c) -> auto& { return c.output.draco_tolerance; }, 1e-5, 1));

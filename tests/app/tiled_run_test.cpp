@@ -482,6 +482,20 @@ TEST(TiledRun, APassWithdrawnInPlaceIsReadAsEmptyAndPutBackGivesTheFirstBytes) {
   ASSERT_EQ(back.exit_code, 0) << back.err;
   EXPECT_NE(back.err.find("acquisition[1] (acq_1.ply) is no longer withdrawn"), std::string::npos) << back.err;
   EXPECT_TRUE(test::result_bytes(sim / "w") == first);
+
+  // A run that writes no labels leaves none of an earlier run's beside its mosaic.
+  const auto unlabelled = test::run_citymesh(
+      fmt::format("run {}/config.toml --no-pictures --set tiling.tile_size=10 --set project.output=w "
+                  "--set project.work=work-w --set output.labels=false",
+                  sim.string()));
+  ASSERT_EQ(unlabelled.exit_code, 0) << unlabelled.err;
+  EXPECT_FALSE(std::filesystem::exists(sim / "w/detect/summary.json"));
+  EXPECT_FALSE(std::filesystem::exists(sim / "w/detect/0_epoch 0.ply"));
+  EXPECT_FALSE(std::filesystem::exists(sim / "w/detect/pairs.bin"));
+  EXPECT_TRUE(std::filesystem::exists(sim / "w/mosaic/mosaic.ply"));
+  const auto no_labels = test::run_citymesh(fmt::format("eval {}/w --truth {}", sim.string(), sim.string()));
+  EXPECT_EQ(no_labels.exit_code, 2);
+  EXPECT_NE(no_labels.err.find("labels = true"), std::string::npos) << no_labels.err;
 }
 
 /// The face count a PLY header declares.
