@@ -159,7 +159,8 @@ class EvalCommand final : public Command {
 
   void run() override {
     const std::filesystem::path detect = std::filesystem::path(output_) / "detect";
-    const nlohmann::json summary = read_json(detect / "summary.json", "run citymesh detect first, or citymesh run with [output] labels = true");
+    const nlohmann::json summary =
+        read_json(detect / "summary.json", "run citymesh detect first, or citymesh run with [output] labels = true");
     const std::map<std::uint32_t, ObjectInfo> catalogue = objects_by_id(truth_);
     std::map<std::uint32_t, ObjectInfo> objects = catalogue;  // areas added up per object
     try {

@@ -1,7 +1,5 @@
 // SPDX-License-Identifier: MIT
 // Tile result files: the labels, consistent pairs and selected triangles of one finished tile.
-#include <fmt/format.h>
-
 #include <algorithm>
 #include <array>
 #include <atomic>
