@@ -295,9 +295,9 @@ std::vector<KeyDef> make_keys() {
       [](auto& c) -> auto& { return c.run.seam_pass; }, {SeamPass::automatic, SeamPass::whole, SeamPass::blocks},
       seam_pass_name));
 
-  keys.push_back(bool_key(output, "tiles_3d", "write a 3D Tiles tileset with Draco-compressed glb tiles",
+  keys.push_back(bool_key(output, "tiles_3d", "write a 3D Tiles tileset with Draco-compressed glb tiles (false also removes an earlier run's)",
       [](auto& c) -> auto& { return c.output.tiles_3d; }));
-  keys.push_back(bool_key(output, "ply", "also write one PLY per tile with provenance (source_acq, source_face)",
+  keys.push_back(bool_key(output, "ply", "also write one PLY per tile with provenance (source_acq, source_face; false also removes an earlier run's)",
       [](auto& c) -> auto& { return c.output.ply; }));
   keys.push_back(bool_key(output, "labels",
       "citymesh run: also write the change step's labelled PLY per acquisition (what eval scores; as large as the inputs on disk; written acquisition by acquisition, several at once when the memory budget holds them, with the pairs waiting on disk; false also removes an earlier run's)",

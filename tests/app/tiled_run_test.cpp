@@ -538,6 +538,15 @@ TEST(TiledRun, ProvenancePlyPerTileAndTilesetCheck) {
   const auto no_tileset = test::run_citymesh(fmt::format("view {}/nothing --port 0", sim));
   EXPECT_EQ(no_tileset.exit_code, 2);
   EXPECT_NE(no_tileset.err.find("no tileset.json"), std::string::npos) << no_tileset.err;
+
+  // A run that writes neither leaves none of the earlier run's beside its mosaic.
+  const auto neither =
+      test::run_citymesh(run_args(sim, "p", "--set tiling.tile_size=10 --set output.ply=false --set output.tiles_3d=false"));
+  ASSERT_EQ(neither.exit_code, 0) << neither.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/p/ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/p/tiles"));
+  EXPECT_TRUE(std::filesystem::exists(dir / "sim/p/mosaic/mosaic.ply"));
+  EXPECT_EQ(test::run_citymesh(fmt::format("check {}/p", sim)).exit_code, 2) << "no tileset to check";
 }
 
 }  // namespace
