@@ -371,6 +371,13 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
   return store;
 }
 
+std::uint64_t acquisition_bytes(const Acquisition& acquisition) {
+  if (acquisition.withdrawn) return 0;
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(acquisition.path, ec);
+  return ec ? 0 : size;
+}
+
 TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params, unsigned at_once) {
   std::error_code ec;
   std::filesystem::remove_all(params.dir, ec);
@@ -382,8 +389,7 @@ TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const Til
   std::vector<std::uintmax_t> sizes(acquisitions.size(), 0);
   for (std::size_t k = 0; k < order.size(); ++k) {
     order[k] = k;
-    sizes[k] = std::filesystem::file_size(acquisitions[k].path, ec);  // 0 when unreadable: the tiler says why
-    if (ec || acquisitions[k].withdrawn) sizes[k] = 0;
+    sizes[k] = acquisition_bytes(acquisitions[k]);
   }
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return sizes[a] > sizes[b]; });
   std::vector<AcquisitionTiling> parts(acquisitions.size());

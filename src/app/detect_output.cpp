@@ -140,7 +140,7 @@ void remove_detect_outputs(const std::filesystem::path& dir) {
   const std::set<std::string> listed = listed_outputs(dir);
   std::error_code ec;
   if (listed.empty() && !std::filesystem::exists(dir / kPairsFile, ec)) return;
-  for (const std::string& name : listed) std::filesystem::remove(dir / name, ec);
+  remove_unlisted(dir, listed, {});  // this run lists nothing
   std::filesystem::remove(dir / kPairsFile, ec);
   std::filesystem::remove(dir / "summary.json", ec);  // last: what it lists is gone
   log::info("{}: an earlier run's labelled outputs removed (this run writes none: [output] labels = false)",

@@ -28,13 +28,18 @@ bool affects_results(const std::string& section) {
          section.starts_with("acquisition[");
 }
 
+/// "acquisition[k] (its path)" for any key of acquisition k.
+std::string acquisition_named(const std::map<std::string, std::string>& keys, const std::string& key) {
+  const std::string acquisition = key.substr(0, key.find(']') + 1);
+  const auto path = keys.find(acquisition + ".path");
+  return path == keys.end() ? acquisition : fmt::format("{} ({})", acquisition, path->second);
+}
+
 /// "acquisition[1] (/data/b.ply) was rewritten (17500 -> 17547 bytes)" from the `.file`
 /// key's two values ("<size> bytes, modified <ticks>"): the ticks mean nothing to a reader.
 std::string describe_rewrite(const std::map<std::string, std::string>& keys, const std::string& file_key,
                              const std::string& before, const std::string& after) {
-  const std::string acquisition = file_key.substr(0, file_key.size() - std::string_view(".file").size());
-  const auto path = keys.find(acquisition + ".path");
-  const std::string where = path == keys.end() ? acquisition : fmt::format("{} ({})", acquisition, path->second);
+  const std::string where = acquisition_named(keys, file_key);
   const auto size_of = [](const std::string& value) { return std::strtoull(value.c_str(), nullptr, 10); };
   const std::string how = size_of(before) == size_of(after)
                               ? fmt::format("same size, {} bytes, new modification time", size_of(after))
@@ -44,13 +49,6 @@ std::string describe_rewrite(const std::map<std::string, std::string>& keys, con
 
 /// The `.file` key of a withdrawn acquisition, whose file is not looked at.
 constexpr std::string_view kWithdrawnFile = "withdrawn";
-
-/// "acquisition[k] (its path)" for any key of acquisition k.
-std::string acquisition_named(const std::map<std::string, std::string>& keys, const std::string& key) {
-  const std::string acquisition = key.substr(0, key.find(']') + 1);
-  const auto path = keys.find(acquisition + ".path");
-  return path == keys.end() ? acquisition : fmt::format("{} ({})", acquisition, path->second);
-}
 
 /// k of an "acquisition[k]..." key; nothing for other keys.
 std::optional<std::size_t> acquisition_of_key(std::string_view key) {

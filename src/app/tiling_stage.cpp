@@ -16,15 +16,10 @@ namespace citymesh::app {
 
 namespace {
 
-/// Each acquisition's file size in bytes (0 when it cannot be read: the tiler says why; 0
-/// when withdrawn: it is not read).
+/// Each acquisition's bytes to tile (acquisition_bytes).
 std::vector<std::uint64_t> file_sizes(std::span<const Acquisition> acquisitions) {
   std::vector<std::uint64_t> sizes;
-  for (const Acquisition& a : acquisitions) {
-    std::error_code ec;
-    const std::uintmax_t size = std::filesystem::file_size(a.path, ec);
-    sizes.push_back(ec || a.withdrawn ? 0 : size);
-  }
+  for (const Acquisition& a : acquisitions) sizes.push_back(acquisition_bytes(a));
   return sizes;
 }
 

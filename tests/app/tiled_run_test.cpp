@@ -22,9 +22,21 @@ namespace {
 
 nlohmann::json read_json(const std::filesystem::path& path) { return nlohmann::json::parse(test::read_text(path)); }
 
-std::string run_args(const std::string& sim, const std::string& name, const std::string& extra) {
-  return fmt::format("run {}/config.toml --no-pictures --set project.output={} --set project.work=work-{} {}", sim,
+/// `run <sim>/<config>` into output `name` and work folder `work-<name>`, without pictures.
+std::string run_file_args(const std::string& sim, const std::string& config, const std::string& name,
+                          const std::string& extra) {
+  return fmt::format("run {}/{} --no-pictures --set project.output={} --set project.work=work-{} {}", sim, config,
                      name, name, extra);
+}
+
+std::string run_args(const std::string& sim, const std::string& name, const std::string& extra) {
+  return run_file_args(sim, "config.toml", name, extra);
+}
+
+/// A run that redid some tiles and reused others.
+void expect_some_tiles_reused(const nlohmann::json& report, const char* reused, const char* redone) {
+  EXPECT_GT(report["reused_tiles"].get<int>(), 0) << reused;
+  EXPECT_LT(report["reused_tiles"].get<int>(), report["tiles"].get<int>()) << redone;
 }
 
 TEST(TiledRun, NineTilesOrMoreScoreLikeOneTile) {
@@ -358,11 +370,8 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   // end on the first side (decisions there unchanged: those tiles are kept) and 2.2 m on the
   // other (a decision on their halo changed: redone).
   ASSERT_TRUE(test::write_append_configs(dir / "sim", 0.35, 27.8 / 60));
-  const auto run = [&](const std::string& file, const std::string& name, const std::string& extra = "") {
-    return test::run_citymesh(
-        fmt::format("run {}/{} --no-pictures --set tiling.tile_size=10 --set project.output={} "
-                    "--set project.work=work-{} {}",
-                    sim, file, name, name, extra));
+  const auto run = [&](const std::string& file, const std::string& name) {
+    return test::run_citymesh(run_file_args(sim, file, name, "--set tiling.tile_size=10"));
   };
   const auto five = run("five.toml", "u");
   ASSERT_EQ(five.exit_code, 0) << five.err;
@@ -372,8 +381,7 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   EXPECT_NE(appended.err.find("acquisition[5] (acq_5_part.ply) was added"), std::string::npos) << appended.err;
   EXPECT_NE(appended.err.find("reusing the tiling of 5 of 6 acquisitions"), std::string::npos) << appended.err;
   const nlohmann::json report = read_json(dir / "sim/u/run.json");
-  EXPECT_GT(report["reused_tiles"].get<int>(), 0) << "tiles far from the new pass";
-  EXPECT_LT(report["reused_tiles"].get<int>(), report["tiles"].get<int>()) << "tiles the new pass reaches";
+  expect_some_tiles_reused(report, "tiles far from the new pass", "tiles the new pass reaches");
   // Progress counts the tiles to process, not the reused ones (nor do they enter the ETA).
   const int redone = report["tiles"].get<int>() - report["reused_tiles"].get<int>();
   EXPECT_NE(
@@ -419,8 +427,7 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   EXPECT_NE(withdrawn.err.find("acquisition[5] (acq_5_part.ply) was withdrawn"), std::string::npos) << withdrawn.err;
   EXPECT_EQ(withdrawn.err.find("do not fit"), std::string::npos) << withdrawn.err;
   const nlohmann::json after = read_json(dir / "sim/u/run.json");
-  EXPECT_GT(after["reused_tiles"].get<int>(), 0) << "tiles the pass did not reach";
-  EXPECT_LT(after["reused_tiles"].get<int>(), after["tiles"].get<int>()) << "tiles the pass reached";
+  expect_some_tiles_reused(after, "tiles the pass did not reach", "tiles the pass reached");
   const auto five_fresh = run("five.toml", "g");
   ASSERT_EQ(five_fresh.exit_code, 0) << five_fresh.err;
   EXPECT_TRUE(test::result_bytes(dir / "sim/u") == test::result_bytes(dir / "sim/g")) << "withdrawing differs";
@@ -439,9 +446,7 @@ TEST(TiledRun, APassWithdrawnInPlaceIsReadAsEmptyAndPutBackGivesTheFirstBytes) {
   const std::filesystem::path sim = dir / "sim";
   ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim.string())).exit_code, 0);
   const auto run = [&](const std::string& config, const std::string& name) {
-    return test::run_citymesh(fmt::format("run {} --no-pictures --set tiling.tile_size=10 --set project.output={} "
-                                          "--set project.work=work-{}",
-                                          (sim / config).string(), name, name));
+    return test::run_citymesh(run_file_args(sim.string(), config, name, "--set tiling.tile_size=10"));
   };
   ASSERT_EQ(run("config.toml", "w").exit_code, 0);
   const auto first = test::result_bytes(sim / "w");
@@ -484,10 +489,8 @@ TEST(TiledRun, APassWithdrawnInPlaceIsReadAsEmptyAndPutBackGivesTheFirstBytes) {
   EXPECT_TRUE(test::result_bytes(sim / "w") == first);
 
   // A run that writes no labels leaves none of an earlier run's beside its mosaic.
-  const auto unlabelled = test::run_citymesh(
-      fmt::format("run {}/config.toml --no-pictures --set tiling.tile_size=10 --set project.output=w "
-                  "--set project.work=work-w --set output.labels=false",
-                  sim.string()));
+  const auto unlabelled =
+      test::run_citymesh(run_args(sim.string(), "w", "--set tiling.tile_size=10 --set output.labels=false"));
   ASSERT_EQ(unlabelled.exit_code, 0) << unlabelled.err;
   EXPECT_FALSE(std::filesystem::exists(sim / "w/detect/summary.json"));
   EXPECT_FALSE(std::filesystem::exists(sim / "w/detect/0_epoch 0.ply"));
