@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// `citymesh view OUTPUT`: serves a run's tileset and the three.js viewer page on localhost.
+// `citymesh view OUTPUT`: serves a run's tileset and the viewer pages (three.js, CesiumJS) on localhost.
 // The only source that includes cpp-httplib.
 #include <fmt/format.h>
 #include <httplib.h>
@@ -43,7 +43,8 @@ class ViewCommand final : public Command {
     app.add_option("--port", port_, "TCP port on 127.0.0.1 (0: any free port)")->check(CLI::Range(0, 65535));
     app.add_option("--viewer", viewer_, "folder of the viewer page and its node_modules");
     app.footer(
-        "Listens on 127.0.0.1 only, prints the address to open, and serves until Ctrl-C. Example:\n"
+        "Listens on 127.0.0.1 only, prints the address to open, and serves until Ctrl-C. The three.js\n"
+        "viewer is at /, the same tileset in CesiumJS at /cesium.html. Example:\n"
         "  citymesh run sim/config.toml && citymesh view sim/out   # then open http://127.0.0.1:8080/");
   }
 
@@ -62,6 +63,9 @@ class ViewCommand final : public Command {
     const int port = port_ == 0 ? server.bind_to_any_port("127.0.0.1") : (server.bind_to_port("127.0.0.1", port_) ? port_ : -1);
     if (port < 0) throw UsageError(fmt::format("cannot listen on 127.0.0.1:{} (in use?)", port_));
     std::cout << fmt::format("serving {} on http://127.0.0.1:{}/ (Ctrl-C stops)", tiles.string(), port) << std::endl;
+    if (std::filesystem::is_regular_file(viewer / "node_modules/cesium/Build/Cesium/Cesium.js")) {
+      std::cout << fmt::format("the same tileset in CesiumJS: http://127.0.0.1:{}/cesium.html", port) << std::endl;
+    }
     std::atomic<bool> listening = true;
     std::thread listener([&] {
       server.listen_after_bind();

@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
-// The web side against real tools: the Khronos glTF validator on every glb of a run, and the
-// viewer page in headless Chromium (the screenshot must show the street). Skips when the npm
-// packages (tools/setup) or Debian's chromium are missing.
+// The web side against real tools: the Khronos glTF validator on every glb of a run, and both
+// viewer pages in headless Chromium: three.js (the screenshot must show the street) and
+// CesiumJS (every tile loads, none fails, and the tileset stands where the input lies on
+// Earth). Skips when the npm packages (tools/setup) or Debian's chromium are missing.
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
 #include <chrono>
 #include <csignal>
 #include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <sstream>
 #include <thread>
 
 #include "citymesh/render/render.h"
@@ -84,24 +87,17 @@ class Viewer {
   int pid_ = -1;
 };
 
-TEST(Web, ViewerDrawsTheStreetInHeadlessChromium) {
-  if (!have_npm_packages()) GTEST_SKIP() << "npm packages missing: run tools/setup";
-  if (!std::filesystem::exists("/usr/bin/chromium")) GTEST_SKIP() << "Debian's chromium is not installed";
-  test::TempDir tmp;
-  const auto out = run_short_street(tmp);
-  const Viewer viewer(out, tmp);
-  const std::string url = viewer.url();
-  ASSERT_FALSE(url.empty()) << "citymesh view printed no address";
-  const auto png = tmp / "viewer.png";
-  const Shell shot = shell(fmt::format("node {} {} {} --timeout 90", (web_dir() / "screenshot.mjs").string(), url,
-                                       png.string()), tmp);
-  ASSERT_EQ(shot.exit_code, 0) << shot.out;
-  EXPECT_NE(shot.out.find("tiles loaded"), std::string::npos) << shot.out;
-  // The background is #1b2330; the street must cover a good part of the picture, across it.
-  const Image image = read_png(png);
+/// How much of a screenshot the street covers, and how wide it spans, away from the status
+/// and legend lines: every pixel not of the page's background colour (#1b2330) counts.
+struct StreetInPicture {
+  double covered = 0;        ///< share of the pixels
+  std::uint32_t spread = 0;  ///< pixels from the leftmost to the rightmost
+};
+
+StreetInPicture street_in(const Image& image) {
   std::size_t drawn = 0;
   std::uint32_t left = image.width, right = 0;
-  for (std::uint32_t y = 40; y + 40 < image.height; ++y) {  // skip the status and legend lines
+  for (std::uint32_t y = 40; y + 40 < image.height; ++y) {
     for (std::uint32_t x = 0; x < image.width; ++x) {
       const Rgb8 p = image.pixels[std::size_t(y) * image.width + x];
       if (std::abs(p.r - 0x1b) + std::abs(p.g - 0x23) + std::abs(p.b - 0x30) < 30) continue;
@@ -110,9 +106,103 @@ TEST(Web, ViewerDrawsTheStreetInHeadlessChromium) {
       right = std::max(right, x);
     }
   }
-  const double covered = double(drawn) / double(image.width * (image.height - 80));
-  EXPECT_GT(covered, 0.15) << "the street covers " << covered * 100 << " % of the view";
-  EXPECT_GT(right - left, image.width / 2) << "the street spans " << right - left << " pixels";
+  return {double(drawn) / double(image.width * (image.height - 80)), right >= left ? right - left : 0};
+}
+
+bool have_browser() { return have_npm_packages() && std::filesystem::exists("/usr/bin/chromium"); }
+
+/// A viewer page's screenshot: the page's status line (or the error) and the picture.
+struct PageShot {
+  Shell shot;
+  Image image;
+};
+
+/// Serves `out` with `citymesh view`, opens `page` (path and query under its address) in
+/// headless Chromium, waits until the page has settled and takes the screenshot.
+PageShot screenshot(const std::filesystem::path& out, const std::string& page, const test::TempDir& tmp) {
+  const Viewer viewer(out, tmp);
+  const std::string url = viewer.url();
+  EXPECT_FALSE(url.empty()) << "citymesh view printed no address";
+  const auto png = tmp / "page.png";
+  PageShot s{shell(fmt::format("node {} '{}{}' {} --timeout 120", (web_dir() / "screenshot.mjs").string(), url, page,
+                               png.string()),
+                   tmp),
+             {}};
+  if (s.shot.exit_code == 0) s.image = read_png(png);
+  return s;
+}
+
+void expect_street_drawn(const Image& image) {
+  const StreetInPicture street = street_in(image);
+  EXPECT_GT(street.covered, 0.15) << "the street covers " << street.covered * 100 << " % of the view";
+  EXPECT_GT(street.spread, image.width / 2) << "the street spans " << street.spread << " pixels";
+}
+
+TEST(Web, ViewerDrawsTheStreetInHeadlessChromium) {
+  if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
+  test::TempDir tmp;
+  const PageShot page = screenshot(run_short_street(tmp), "", tmp);
+  ASSERT_EQ(page.shot.exit_code, 0) << page.shot.out;
+  EXPECT_NE(page.shot.out.find("tiles loaded"), std::string::npos) << page.shot.out;
+  expect_street_drawn(page.image);
+}
+
+/// Where the input lies: latitude, longitude and ellipsoidal height bounds over every
+/// acquisition, as `citymesh info --config --json` gives them (GeographicLib, not the tileset).
+struct Place {
+  double lat[2] = {90, -90}, lon[2] = {180, -180}, height[2] = {1e9, -1e9};
+};
+
+Place input_place(const std::filesystem::path& config, double geoid_undulation) {
+  const test::CommandResult info = test::run_citymesh(fmt::format("info --config {} --json", config.string()));
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  Place p;
+  std::istringstream lines(info.out);
+  for (std::string line; std::getline(lines, line);) {
+    const auto j = nlohmann::json::parse(line);
+    const auto& ll = j.at("lat_lon_bounds");
+    p.lat[0] = std::min(p.lat[0], ll.at("lat")[0].get<double>());
+    p.lat[1] = std::max(p.lat[1], ll.at("lat")[1].get<double>());
+    p.lon[0] = std::min(p.lon[0], ll.at("lon")[0].get<double>());
+    p.lon[1] = std::max(p.lon[1], ll.at("lon")[1].get<double>());
+    p.height[0] = std::min(p.height[0], j.at("bounds").at("min")[2].get<double>() + geoid_undulation);
+    p.height[1] = std::max(p.height[1], j.at("bounds").at("max")[2].get<double>() + geoid_undulation);
+  }
+  return p;
+}
+
+TEST(Web, CesiumJsLoadsEveryTileWhereTheInputLies) {
+  if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
+  test::TempDir tmp;
+  const auto out = run_short_street(tmp);
+  // A screen-space error of 0 asks for the finest tiles: every tile of the tree is loaded.
+  const PageShot page = screenshot(out, "cesium.html?error=0", tmp);
+  const Shell& shot = page.shot;
+  ASSERT_EQ(shot.exit_code, 0) << shot.out;
+  const std::string tileset = test::read_text(out / "tiles" / "tileset.json");
+  std::size_t tiles = 0;
+  for (auto at = tileset.find("\"uri\""); at != std::string::npos; at = tileset.find("\"uri\"", at + 1)) ++tiles;
+  ASSERT_GT(tiles, 1u);
+  EXPECT_NE(shot.out.find(fmt::format(" {} tiles loaded, 0 failed", tiles)), std::string::npos) << shot.out;
+
+  // The simulator writes Lambert-93 with orthometric heights: ellipsoidal = z + undulation.
+  const auto config = out.parent_path() / "config.toml";
+  const std::string text = test::read_text(config);
+  const auto undulation_at = text.find("geoid_undulation = ");
+  ASSERT_NE(undulation_at, std::string::npos) << text;
+  const Place input = input_place(config, std::stod(text.substr(undulation_at + 19)));
+  double lat = 0, lon = 0, height = 0;
+  const auto at = shot.out.find("centre lat ");
+  ASSERT_NE(at, std::string::npos) << shot.out;
+  ASSERT_EQ(std::sscanf(shot.out.c_str() + at, "centre lat %lf lon %lf h %lf", &lat, &lon, &height), 3) << shot.out;
+  EXPECT_GE(lat, input.lat[0]);
+  EXPECT_LE(lat, input.lat[1]);
+  EXPECT_GE(lon, input.lon[0]);
+  EXPECT_LE(lon, input.lon[1]);
+  EXPECT_GE(height, input.height[0]);
+  EXPECT_LE(height, input.height[1]);
+
+  expect_street_drawn(page.image);
 }
 
 }  // namespace

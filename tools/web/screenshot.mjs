@@ -22,7 +22,7 @@ let failed = false;
 try {
   const page = await browser.newPage({ viewport: { width: 1024, height: 640 } });
   page.on('pageerror', (e) => { console.error(`page error: ${e.message}`); failed = true; });
-  await page.goto(url);
+  await page.goto(url, { timeout });
   // The viewer sets data-settled once the tile queue is empty and something is drawn.
   await page.waitForSelector('body[data-settled="true"]', { timeout });
   await page.screenshot({ path: out });

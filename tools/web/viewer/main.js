@@ -8,12 +8,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
-
-// The palette of citymesh's pictures (src/app/mosaic_output.cpp source_color).
-const PALETTE = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [140, 86, 75],
-  [23, 190, 207], [188, 189, 34], [127, 127, 127], [148, 103, 189], [0, 80, 40]];
-const STITCH = [230, 0, 230];
-const NULL_FEATURE = 65535;
+import { PALETTE, STITCH, NULL_FEATURE, legendHtml } from './palette.js';
 
 const params = new URLSearchParams(location.search);
 const status = document.getElementById('status');
@@ -84,9 +79,7 @@ function colourByAcquisition(mesh) {
 tiles.addEventListener('load-model', ({ scene: model }) => {
   models++;
   model.traverse((o) => { if (o.isMesh) colourByAcquisition(o); });
-  legend.innerHTML = [...seen].sort((a, b) => a - b)
-    .map((id) => `<span style="background: rgb(${PALETTE[id % PALETTE.length].join(',')})"></span>acquisition ${id}`)
-    .join('') + `<span style="background: rgb(${STITCH.join(',')})"></span>stitch`;
+  legend.innerHTML = legendHtml(seen);
 });
 tiles.addEventListener('load-error', ({ url, error }) => {
   status.textContent = `cannot load ${url}: ${error}`;
