@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
@@ -62,6 +64,7 @@ TEST(Web, GltfValidatorFindsNoErrorInARunsTiles) {
 class Viewer {
  public:
   Viewer(const std::filesystem::path& output, const test::TempDir& tmp) : log_(tmp / "view.log") {
+    std::filesystem::remove(log_);  // an earlier viewer's address is not this one's
     const std::string command = fmt::format("{} view {} --port 0 > {} 2>&1 & echo $!", CITYMESH_BINARY, output.string(),
                                             log_.string());
     FILE* pipe = ::popen(command.c_str(), "r");
@@ -138,13 +141,60 @@ void expect_street_drawn(const Image& image) {
   EXPECT_GT(street.spread, image.width / 2) << "the street spans " << street.spread << " pixels";
 }
 
+/// The legend both pages show for the run of `config`: each acquisition's name and day, in
+/// the order of the tables (the swatches hold no text), then the stitch entry.
+std::string expected_legend(const std::filesystem::path& config) {
+  const std::string text = test::read_text(config);
+  std::vector<std::string> names, days;
+  std::istringstream lines(text);
+  for (std::string line; std::getline(lines, line);) {
+    const auto quoted = [&] { return line.substr(line.find('"') + 1, line.rfind('"') - line.find('"') - 1); };
+    if (line.starts_with("name = ")) names.push_back(quoted());
+    if (line.starts_with("time = ")) days.push_back(quoted().substr(0, 10));
+  }
+  EXPECT_EQ(names.size(), days.size());
+  std::string legend = "legend: ";
+  for (std::size_t k = 0; k < std::min(names.size(), days.size()); ++k) legend += names[k] + " (" + days[k] + ")";
+  return legend + "stitch";
+}
+
+/// The share of the picture whose pixels `is` accepts (the status and legend lines left out).
+template <class Predicate>
+double share_of(const Image& image, Predicate is) {
+  std::size_t n = 0;
+  for (std::uint32_t y = 40; y + 40 < image.height; ++y) {
+    for (std::uint32_t x = 0; x < image.width; ++x) n += is(image.pixels[std::size_t(y) * image.width + x]) ? 1 : 0;
+  }
+  return double(n) / double(image.width * (image.height - 80));
+}
+
+/// A pixel's hue in degrees [0, 360) when it is saturated and bright enough to have one
+/// (saturation above 0.45, value above 0.3), else -1.
+double hue_of(Rgb8 p) {
+  const int hi = std::max({p.r, p.g, p.b}), lo = std::min({p.r, p.g, p.b}), range = hi - lo;
+  if (hi < 77 || range <= 0.45 * hi) return -1;
+  double h = hi == p.r ? double(p.g - p.b) / range : hi == p.g ? 2.0 + double(p.b - p.r) / range
+                                                                : 4.0 + double(p.r - p.g) / range;
+  return std::fmod(h * 60.0 + 360.0, 360.0);
+}
+
+// Hues that survive the pages' lighting (measured on both pages: shading and CesiumJS's sRGB
+// output move them by ten degrees at most): the palette's orange (acquisition 1, 255 127 14,
+// 28 degrees) shows at 30-39 degrees; the date ramp has no colour there, and its newest end
+// (253 231 37, 54 degrees) shows at 50-59.
+bool orange(Rgb8 p) { return hue_of(p) >= 20 && hue_of(p) < 45; }
+bool yellow(Rgb8 p) { return hue_of(p) >= 48 && hue_of(p) < 66; }
+
 TEST(Web, ViewerDrawsTheStreetInHeadlessChromium) {
   if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
   test::TempDir tmp;
-  const PageShot page = screenshot(run_short_street(tmp), "", tmp);
+  const auto out = run_short_street(tmp);
+  const PageShot page = screenshot(out, "", tmp);
   ASSERT_EQ(page.shot.exit_code, 0) << page.shot.out;
   EXPECT_NE(page.shot.out.find("tiles loaded"), std::string::npos) << page.shot.out;
+  EXPECT_NE(page.shot.out.find(expected_legend(out.parent_path() / "config.toml")), std::string::npos) << page.shot.out;
   expect_street_drawn(page.image);
+  EXPECT_GT(share_of(page.image, orange), 0.01) << "acquisition 1's orange";
 }
 
 /// Where the input lies: latitude, longitude and ellipsoidal height bounds over every
@@ -202,7 +252,25 @@ TEST(Web, CesiumJsLoadsEveryTileWhereTheInputLies) {
   EXPECT_GE(height, input.height[0]);
   EXPECT_LE(height, input.height[1]);
 
+  EXPECT_NE(shot.out.find(expected_legend(config)), std::string::npos) << shot.out;
   expect_street_drawn(page.image);
+  EXPECT_GT(share_of(page.image, orange), 0.01) << "acquisition 1's orange";
+}
+
+TEST(Web, BothPagesColourByDateFromTheTilesMetadata) {
+  if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
+  test::TempDir tmp;
+  const auto out = run_short_street(tmp);
+  for (const std::string page_url : {"?color=date", "cesium.html?color=date"}) {
+    const PageShot page = screenshot(out, page_url, tmp);
+    ASSERT_EQ(page.shot.exit_code, 0) << page_url << ": " << page.shot.out;
+    EXPECT_NE(page.shot.out.find(expected_legend(out.parent_path() / "config.toml")), std::string::npos)
+        << page.shot.out;
+    expect_street_drawn(page.image);
+    // The palette's orange is gone (its pages show it above), the newest passes' yellow is there.
+    EXPECT_LT(share_of(page.image, orange), 0.001) << page_url;
+    EXPECT_GT(share_of(page.image, yellow), 0.002) << page_url;
+  }
 }
 
 }  // namespace

@@ -1,8 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Opens the citymesh viewer in headless Chromium (Debian's /usr/bin/chromium, driven by
 // playwright-core), waits until every tile the view needs is loaded and drawn, and saves a
-// screenshot. Prints the page's status line; exits 1 when the page reports an error or the
-// tiles do not load in time. Usage:
+// screenshot. Prints the page's status line and its legend's text; exits 1 when the page
+// reports an error or the tiles do not load in time. Usage:
 //   node tools/web/screenshot.mjs http://127.0.0.1:8080/ viewer.png [--timeout 60]
 import { chromium } from 'playwright-core';
 
@@ -22,11 +22,14 @@ let failed = false;
 try {
   const page = await browser.newPage({ viewport: { width: 1024, height: 640 } });
   page.on('pageerror', (e) => { console.error(`page error: ${e.message}`); failed = true; });
+  page.on('console', (m) => { if (m.type() === 'error') console.error(`console error: ${m.text()}`); });
   await page.goto(url, { timeout });
   // The viewer sets data-settled once the tile queue is empty and something is drawn.
   await page.waitForSelector('body[data-settled="true"]', { timeout });
   await page.screenshot({ path: out });
   console.log(await page.textContent('#status'));
+  const legend = await page.$('#legend');
+  if (legend) console.log(`legend: ${await legend.textContent()}`);
 } catch (e) {
   console.error(`screenshot: ${e.message}`);
   failed = true;

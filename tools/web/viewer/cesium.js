@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
 // citymesh in CesiumJS: streams /tiles/tileset.json in CesiumJS's Earth-centred frame (no
-// globe, imagery or terrain: nothing is fetched from the internet), looks at it obliquely and colours every
-// triangle by its source acquisition (feature id _FEATURE_ID_0; stitch triangles magenta).
+// globe, imagery or terrain: nothing is fetched from the internet), looks at it obliquely,
+// colours every triangle by its source acquisition (feature id _FEATURE_ID_0; stitch
+// triangles magenta) and names each in the legend from the tiles' property table.
 // The status line gives the tiles loaded and failed and where CesiumJS placed the tileset's
 // centre (latitude, longitude, ellipsoidal height): tests compare it with the input's place.
 // Triangles are single-sided, as glTF says by default: each is wound to face the sensor that
 // saw it, so a facade seen from behind (from inside its building) is not drawn.
-// URL parameters: ?error=16 (maximum screen-space error, pixels), ?color=none (plain grey),
-// ?cull=0 (draw both sides, as the three.js page does).
-import { PALETTE, STITCH, NULL_FEATURE, legendHtml } from './palette.js';
+// URL parameters: ?error=16 (maximum screen-space error, pixels), ?color=date (oldest pass
+// blue to newest yellow), ?color=none (plain grey), ?cull=0 (draw both sides, as the
+// three.js page does).
+import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, legendHtml } from './palette.js';
 
 const Cesium = window.Cesium;
 const params = new URLSearchParams(location.search);
@@ -29,26 +31,31 @@ scene.sun.show = false;
 scene.moon.show = false;
 
 const vec3 = (rgb) => `vec3(${rgb.map((c) => (c / 255).toFixed(4)).join(', ')})`;
-// Flat shading from the screen-space derivatives of the eye position: the tiles carry no
-// normals, and a light fixed to the camera keeps the picture independent of the date.
-const colourByAcquisition = new Cesium.CustomShader({
-  lightingModel: Cesium.LightingModel.UNLIT,
-  fragmentShaderText: `
-    const vec3 palette[${PALETTE.length}] = vec3[${PALETTE.length}](${PALETTE.map(vec3).join(', ')});
-    void fragmentMain(FragmentInput fsInput, inout czm_modelMaterial material) {
-      vec3 p = fsInput.attributes.positionEC;
-      vec3 n = normalize(cross(dFdx(p), dFdy(p)));
-      float shade = 0.35 + 0.65 * abs(dot(n, normalize(vec3(0.3, 0.5, 1.0))));
-      vec3 colour = vec3(0.72, 0.74, 0.77);
-      ${params.get('color') === 'none' ? '' : `
-      int id = fsInput.featureIds.featureId_0;
-      colour = id == ${NULL_FEATURE} ? ${vec3(STITCH)} : palette[id % ${PALETTE.length}];`}
-      material.diffuse = colour * shade;
-    }`,
-});
+
+/// Colours every triangle by its feature id (`colours`, by id; stitch triangles magenta), flat
+/// shaded from the screen-space derivatives of the eye position: the tiles carry no normals,
+/// and a light fixed to the camera keeps the picture independent of the date.
+function colourShader(colours) {
+  const n = colours.length;
+  const colour = params.get('color') === 'none' || n === 0 ? 'vec3(0.72, 0.74, 0.77)' : `
+      id == ${NULL_FEATURE} ? ${vec3(STITCH)} : id < ${n} ? colours[id] : ${vec3(PALETTE[7])}`;
+  return new Cesium.CustomShader({
+    lightingModel: Cesium.LightingModel.UNLIT,
+    fragmentShaderText: `
+      ${n ? `const vec3 colours[${n}] = vec3[${n}](${colours.map(vec3).join(', ')});` : ''}
+      void fragmentMain(FragmentInput fsInput, inout czm_modelMaterial material) {
+        vec3 p = fsInput.attributes.positionEC;
+        vec3 normal = normalize(cross(dFdx(p), dFdy(p)));
+        float shade = 0.35 + 0.65 * abs(dot(normal, normalize(vec3(0.3, 0.5, 1.0))));
+        int id = fsInput.featureIds.featureId_0;
+        material.diffuse = (${colour}) * shade;
+      }`,
+  });
+}
 
 let loaded = 0;
 const failures = [];
+const acquisitions = [];  // [{name, date}] by feature id
 let place = '';
 
 function showStatus() {
@@ -63,11 +70,17 @@ function describePlace(tileset) {
   return ` · centre lat ${deg(c.latitude).toFixed(7)} lon ${deg(c.longitude).toFixed(7)} h ${c.height.toFixed(1)} m`;
 }
 
-/// The legend: every acquisition of the run (a tile's property table, EXT_structural_metadata,
-/// has one row per acquisition).
-function showLegend(content) {
-  const ids = Array.from({ length: content.featuresLength }, (_, i) => i);
-  if (ids.length) legend.innerHTML = legendHtml(new Set(ids));
+/// Every tile carries the run's whole acquisition table (EXT_structural_metadata): the first
+/// one with features names and dates them, for the legend and the colours.
+function readAcquisitions(tileset, content) {
+  if (acquisitions.length || !content.featuresLength) return;
+  for (let id = 0; id < content.featuresLength; id++) {
+    const feature = content.getFeature(id);
+    acquisitions.push({ name: String(feature.getProperty('name')), date: String(feature.getProperty('date')) });
+  }
+  const colours = acquisitionColours(acquisitions, params.get('color'));
+  tileset.customShader = colourShader(colours);
+  legend.innerHTML = legendHtml(acquisitions, colours);
 }
 
 try {
@@ -75,10 +88,10 @@ try {
     maximumScreenSpaceError: Number(params.get('error') ?? 16),
     backFaceCulling: params.get('cull') !== '0',
   });
-  tileset.customShader = colourByAcquisition;
+  tileset.customShader = colourShader([]);
   tileset.tileLoad.addEventListener((tile) => {
     loaded++;
-    showLegend(tile.content);
+    readAcquisitions(tileset, tile.content);
   });
   tileset.tileFailed.addEventListener((e) => failures.push(`${e.url}: ${e.message}`));
   scene.primitives.add(tileset);

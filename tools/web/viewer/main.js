@@ -1,14 +1,16 @@
 // SPDX-License-Identifier: MIT
 // citymesh viewer: streams /tiles/tileset.json (3D Tiles 1.1, Draco glb) with three.js and
 // 3d-tiles-renderer, places the street at the origin (east-north-up, y up), and colours every
-// triangle by its source acquisition (feature id _FEATURE_ID_0; stitch triangles magenta).
-// URL parameters: ?error=16 (screen-space error target, pixels), ?color=none (plain grey).
+// triangle by its source acquisition (feature id _FEATURE_ID_0; stitch triangles magenta),
+// naming each in the legend from the tiles' property table (EXT_structural_metadata).
+// URL parameters: ?error=16 (screen-space error target, pixels), ?color=date (oldest pass
+// blue to newest yellow), ?color=none (plain grey).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
-import { PALETTE, STITCH, NULL_FEATURE, legendHtml } from './palette.js';
+import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, legendHtml } from './palette.js';
 
 const params = new URLSearchParams(location.search);
 const status = document.getElementById('status');
@@ -37,8 +39,9 @@ tiles.setCamera(camera);
 tiles.setResolutionFromRenderer(camera, renderer);
 scene.add(tiles.group);
 
-const seen = new Set();
 let models = 0;
+let acquisitions = [];  // [{name, date}] by feature id, from the first tile's property table
+let colours = [];
 
 // The root transform maps the tileset's east-north-up frame to ECEF: undo it, then turn z-up
 // into three.js's y-up, so that the street sits at the origin.
@@ -62,24 +65,33 @@ function colourByAcquisition(mesh) {
   if (!geometry.getAttribute('normal')) geometry.computeVertexNormals();
   const material = new THREE.MeshLambertMaterial({ side: THREE.DoubleSide, color: 0xb8bcc4 });
   if (ids && params.get('color') !== 'none') {
-    const colours = new Float32Array(ids.count * 3);
+    const rgbs = new Float32Array(ids.count * 3);
     for (let v = 0; v < ids.count; v++) {
       const id = ids.getX(v);
-      if (id !== NULL_FEATURE) seen.add(id);
-      const rgb = id === NULL_FEATURE ? STITCH : PALETTE[id % PALETTE.length];
-      colours.set(rgb.map((c) => c / 255), v * 3);
+      const rgb = id === NULL_FEATURE ? STITCH : colours[id] ?? PALETTE[id % PALETTE.length];
+      rgbs.set(rgb.map((c) => c / 255), v * 3);
     }
-    geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+    geometry.setAttribute('color', new THREE.BufferAttribute(rgbs, 3));
     material.vertexColors = true;
     material.color.set(0xffffff);
   }
   mesh.material = material;
 }
 
+/// Every tile carries the run's whole acquisition table: read it from the first one.
+function readAcquisitions(model) {
+  const metadata = model.userData.structuralMetadata;
+  const table = metadata?.tableAccessors?.[0];
+  if (acquisitions.length || !table) return;
+  for (let id = 0; id < table.count; id++) acquisitions.push(metadata.getPropertyTableData(0, id));
+  colours = acquisitionColours(acquisitions, params.get('color'));
+  legend.innerHTML = legendHtml(acquisitions, colours);
+}
+
 tiles.addEventListener('load-model', ({ scene: model }) => {
   models++;
+  readAcquisitions(model);
   model.traverse((o) => { if (o.isMesh) colourByAcquisition(o); });
-  legend.innerHTML = legendHtml(seen);
 });
 tiles.addEventListener('load-error', ({ url, error }) => {
   status.textContent = `cannot load ${url}: ${error}`;

@@ -1,15 +1,35 @@
 // SPDX-License-Identifier: MIT
-// The colours of the source acquisitions, shared by both viewer pages: the palette of
-// citymesh's pictures (src/app/mosaic_output.cpp source_color), stitch triangles magenta.
+// The colours of the source acquisitions, shared by both viewer pages: by acquisition, the
+// palette of citymesh's pictures (src/app/mosaic_output.cpp source_color); by date, a ramp
+// from the oldest pass (blue) to the newest (yellow). Stitch triangles are magenta.
 export const PALETTE = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [140, 86, 75],
   [23, 190, 207], [188, 189, 34], [127, 127, 127], [148, 103, 189], [0, 80, 40]];
 export const STITCH = [230, 0, 230];
 /// The feature id of stitch triangles (EXT_mesh_features nullFeatureId).
 export const NULL_FEATURE = 65535;
 
-/// The legend's HTML for the acquisitions seen so far, then the stitch colour.
-export function legendHtml(seen) {
-  return [...seen].sort((a, b) => a - b)
-    .map((id) => `<span style="background: rgb(${PALETTE[id % PALETTE.length].join(',')})"></span>acquisition ${id}`)
-    .join('') + `<span style="background: rgb(${STITCH.join(',')})"></span>stitch`;
+// Viridis from its blue on (its purple end would read as the stitch magenta once shaded):
+// ordered in lightness, so the ramp reads as old to new in grey too.
+const RAMP = [[59, 82, 139], [33, 145, 140], [94, 201, 98], [253, 231, 37]];
+
+function rampAt(t) {
+  const x = Math.min(Math.max(t, 0), 1) * (RAMP.length - 1);
+  const i = Math.min(Math.floor(x), RAMP.length - 2), f = x - i;
+  return RAMP[i].map((c, k) => Math.round(c + f * (RAMP[i + 1][k] - c)));
+}
+
+/// Per acquisition (feature id), its colour: `mode` 'date' ranks the distinct dates of
+/// `acquisitions` ([{name, date}], ISO 8601, from the tiles' property table) oldest first;
+/// otherwise the palette by id.
+export function acquisitionColours(acquisitions, mode) {
+  if (mode !== 'date') return acquisitions.map((_, id) => PALETTE[id % PALETTE.length]);
+  const dates = [...new Set(acquisitions.map((a) => a.date))].sort();
+  return acquisitions.map((a) => rampAt(dates.length > 1 ? dates.indexOf(a.date) / (dates.length - 1) : 1));
+}
+
+/// The legend's HTML: each acquisition with its name and day, then the stitch colour.
+export function legendHtml(acquisitions, colours) {
+  const swatch = (rgb) => `<span style="background: rgb(${rgb.join(',')})"></span>`;
+  return acquisitions.map((a, id) => `${swatch(colours[id])}${a.name} (${a.date.slice(0, 10)})`).join('') +
+    `${swatch(STITCH)}stitch`;
 }
