@@ -18,18 +18,26 @@ function rampAt(t) {
   return RAMP[i].map((c, k) => Math.round(c + f * (RAMP[i + 1][k] - c)));
 }
 
+/// Milliseconds since 1970 of an ISO 8601 date as citymesh writes it. Not the string's order:
+/// "…00:00:00.100Z" sorts before "…00:00:00Z".
+const timeOf = (date) => Date.parse(date);
+
 /// Per acquisition (feature id), its colour: `mode` 'date' ranks the distinct dates of
 /// `acquisitions` ([{name, date}], ISO 8601, from the tiles' property table) oldest first;
 /// otherwise the palette by id.
 export function acquisitionColours(acquisitions, mode) {
   if (mode !== 'date') return acquisitions.map((_, id) => PALETTE[id % PALETTE.length]);
-  const dates = [...new Set(acquisitions.map((a) => a.date))].sort();
-  return acquisitions.map((a) => rampAt(dates.length > 1 ? dates.indexOf(a.date) / (dates.length - 1) : 1));
+  const times = [...new Set(acquisitions.map((a) => timeOf(a.date)))].sort((x, y) => x - y);
+  const rank = (a) => times.indexOf(timeOf(a.date));
+  return acquisitions.map((a) => rampAt(times.length > 1 ? rank(a) / (times.length - 1) : 1));
 }
 
-/// The legend's HTML: each acquisition with its name and day, then the stitch colour.
+/// The legend's HTML: each acquisition with its name and day (its whole date when passes
+/// share a day, as frames of one drive do), then the stitch colour.
 export function legendHtml(acquisitions, colours) {
+  const days = new Set(acquisitions.map((a) => a.date.slice(0, 10)));
+  const when = (a) => (days.size < acquisitions.length ? a.date : a.date.slice(0, 10));
   const swatch = (rgb) => `<span style="background: rgb(${rgb.join(',')})"></span>`;
-  return acquisitions.map((a, id) => `${swatch(colours[id])}${a.name} (${a.date.slice(0, 10)})`).join('') +
+  return acquisitions.map((a, id) => `${swatch(colours[id])}${a.name} (${when(a)})`).join('') +
     `${swatch(STITCH)}stitch`;
 }
