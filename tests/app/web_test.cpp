@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "citymesh/render/render.h"
+#include "mosaic_output.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -121,14 +122,16 @@ struct PageShot {
 };
 
 /// Serves `out` with `citymesh view`, opens `page` (path and query under its address) in
-/// headless Chromium, waits until the page has settled and takes the screenshot.
-PageShot screenshot(const std::filesystem::path& out, const std::string& page, const test::TempDir& tmp) {
+/// headless Chromium, waits until the page has settled and takes the screenshot; `options`
+/// go to screenshot.mjs (e.g. "--click X,Y").
+PageShot screenshot(const std::filesystem::path& out, const std::string& page, const test::TempDir& tmp,
+                    const std::string& options = "") {
   const Viewer viewer(out, tmp);
   const std::string url = viewer.url();
   EXPECT_FALSE(url.empty()) << "citymesh view printed no address";
   const auto png = tmp / "page.png";
-  PageShot s{shell(fmt::format("node {} '{}{}' {} --timeout 120", (web_dir() / "screenshot.mjs").string(), url, page,
-                               png.string()),
+  PageShot s{shell(fmt::format("node {} '{}{}' {} --timeout 120 {}", (web_dir() / "screenshot.mjs").string(), url, page,
+                               png.string(), options),
                    tmp),
              {}};
   if (s.shot.exit_code == 0) s.image = read_png(png);
@@ -185,12 +188,38 @@ double hue_of(Rgb8 p) {
 bool orange(Rgb8 p) { return hue_of(p) >= 20 && hue_of(p) < 45; }
 bool yellow(Rgb8 p) { return hue_of(p) >= 48 && hue_of(p) < 66; }
 
+/// Where the tests click: below the middle of the picture, on the street in both pages' views.
+constexpr std::uint32_t kClickX = 512, kClickY = 400;
+
+/// After a click at (kClickX, kClickY): the page named the pass of the triangle there (as the
+/// config names it) or a stitch triangle, and the pixel shows that pass's colour of citymesh's
+/// pictures (source_color; hues within 15 degrees, when the colour has one).
+void expect_click_names_the_pass(const PageShot& page) {
+  const std::string& out = page.shot.out;
+  const auto at = out.find("picked: ");
+  ASSERT_NE(at, std::string::npos) << out;
+  int acquisition = -1;
+  if (out.compare(at + 8, 18, "a stitch triangle ") != 0) {
+    ASSERT_EQ(std::sscanf(out.c_str() + out.find("(acquisition ", at), "(acquisition %d)", &acquisition), 1) << out;
+    EXPECT_EQ(out.compare(at + 8, fmt::format("epoch {},", acquisition).size(), fmt::format("epoch {},", acquisition)),
+              0)
+        << out;
+  }
+  const double expected = hue_of(app::source_color(acquisition));
+  const double seen = hue_of(page.image.pixels[std::size_t(kClickY) * page.image.width + kClickX]);
+  if (expected >= 0) {
+    const double apart = std::abs(std::fmod(seen - expected + 540.0, 360.0) - 180.0);
+    EXPECT_LE(apart, 15.0) << "hue " << seen << " at the click, " << expected << " for " << out.substr(at);
+  }
+}
+
 TEST(Web, ViewerDrawsTheStreetInHeadlessChromium) {
   if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
   test::TempDir tmp;
   const auto out = run_short_street(tmp);
-  const PageShot page = screenshot(out, "", tmp);
+  const PageShot page = screenshot(out, "", tmp, fmt::format("--click {},{}", kClickX, kClickY));
   ASSERT_EQ(page.shot.exit_code, 0) << page.shot.out;
+  expect_click_names_the_pass(page);
   EXPECT_NE(page.shot.out.find("tiles loaded"), std::string::npos) << page.shot.out;
   EXPECT_NE(page.shot.out.find(expected_legend(out.parent_path() / "config.toml")), std::string::npos) << page.shot.out;
   expect_street_drawn(page.image);
@@ -226,9 +255,10 @@ TEST(Web, CesiumJsLoadsEveryTileWhereTheInputLies) {
   test::TempDir tmp;
   const auto out = run_short_street(tmp);
   // A screen-space error of 0 asks for the finest tiles: every tile of the tree is loaded.
-  const PageShot page = screenshot(out, "cesium.html?error=0", tmp);
+  const PageShot page = screenshot(out, "cesium.html?error=0", tmp, fmt::format("--click {},{}", kClickX, kClickY));
   const Shell& shot = page.shot;
   ASSERT_EQ(shot.exit_code, 0) << shot.out;
+  expect_click_names_the_pass(page);
   const std::string tileset = test::read_text(out / "tiles" / "tileset.json");
   std::size_t tiles = 0;
   for (auto at = tileset.find("\"uri\""); at != std::string::npos; at = tileset.find("\"uri\"", at + 1)) ++tiles;

@@ -3,6 +3,7 @@
 // globe, imagery or terrain: nothing is fetched from the internet), looks at it obliquely,
 // colours every triangle by its source acquisition (feature id _FEATURE_ID_0; stitch
 // triangles magenta) and names each in the legend from the tiles' property table.
+// A click names the pass the triangle under the pointer comes from (name, date, index).
 // The status line gives the tiles loaded and failed and where CesiumJS placed the tileset's
 // centre (latitude, longitude, ellipsoidal height): tests compare it with the input's place.
 // Triangles are single-sided, as glTF says by default: each is wound to face the sensor that
@@ -10,7 +11,7 @@
 // URL parameters: ?error=16 (maximum screen-space error, pixels), ?color=date (oldest pass
 // blue to newest yellow), ?color=none (plain grey), ?cull=0 (draw both sides, as the
 // three.js page does).
-import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, legendHtml } from './palette.js';
+import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, describePick, legendHtml } from './palette.js';
 
 const Cesium = window.Cesium;
 const params = new URLSearchParams(location.search);
@@ -99,6 +100,12 @@ try {
   const radius = Math.max(tileset.boundingSphere.radius, 10);
   await viewer.zoomTo(tileset, new Cesium.HeadingPitchRange(Cesium.Math.toRadians(20), Cesium.Math.toRadians(-40),
     2.2 * radius));
+  // A click names the pass the triangle under the pointer comes from.
+  viewer.screenSpaceEventHandler.setInputAction((click) => {
+    const picked = scene.pick(click.position);
+    document.getElementById('picked').textContent = !picked ? 'nothing here'
+      : describePick(acquisitions, picked instanceof Cesium.Cesium3DTileFeature ? picked.featureId : NULL_FEATURE);
+  }, Cesium.ScreenSpaceEventType.LEFT_CLICK);
   // For tests and scripts: every tile the view needs is loaded and something is drawn.
   scene.postRender.addEventListener(() => {
     showStatus();

@@ -2,7 +2,8 @@
 // citymesh viewer: streams /tiles/tileset.json (3D Tiles 1.1, Draco glb) with three.js and
 // 3d-tiles-renderer, places the street at the origin (east-north-up, y up), and colours every
 // triangle by its source acquisition (feature id _FEATURE_ID_0; stitch triangles magenta),
-// naming each in the legend from the tiles' property table (EXT_structural_metadata).
+// naming each in the legend from the tiles' property table (EXT_structural_metadata); a
+// click names the pass of the triangle under the pointer.
 // URL parameters: ?error=16 (screen-space error target, pixels), ?color=date (oldest pass
 // blue to newest yellow), ?color=none (plain grey).
 import * as THREE from 'three';
@@ -10,7 +11,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { DRACOLoader } from 'three/addons/loaders/DRACOLoader.js';
 import { TilesRenderer } from '3d-tiles-renderer';
 import { GLTFExtensionsPlugin } from '3d-tiles-renderer/plugins';
-import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, legendHtml } from './palette.js';
+import { PALETTE, STITCH, NULL_FEATURE, acquisitionColours, describePick, legendHtml } from './palette.js';
 
 const params = new URLSearchParams(location.search);
 const status = document.getElementById('status');
@@ -95,6 +96,19 @@ tiles.addEventListener('load-model', ({ scene: model }) => {
 });
 tiles.addEventListener('load-error', ({ url, error }) => {
   status.textContent = `cannot load ${url}: ${error}`;
+});
+
+// A click names the pass the triangle under the pointer comes from (its first corner's id:
+// a triangle's corners share it, vertices being split where sources meet).
+const raycaster = new THREE.Raycaster();
+renderer.domElement.addEventListener('click', (event) => {
+  const pointer = new THREE.Vector2((event.clientX / window.innerWidth) * 2 - 1,
+    -(event.clientY / window.innerHeight) * 2 + 1);
+  raycaster.setFromCamera(pointer, camera);
+  const hit = raycaster.intersectObject(tiles.group, true)[0];
+  const ids = hit?.object.geometry.getAttribute('_feature_id_0');
+  document.getElementById('picked').textContent = !hit ? 'nothing here'
+    : describePick(acquisitions, ids ? ids.getX(hit.face.a) : NULL_FEATURE);
 });
 
 window.addEventListener('resize', () => {

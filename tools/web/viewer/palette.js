@@ -41,3 +41,11 @@ export function legendHtml(acquisitions, colours) {
   return acquisitions.map((a, id) => `${swatch(colours[id])}${a.name} (${when(a)})`).join('') +
     `${swatch(STITCH)}stitch`;
 }
+
+/// What a click on a triangle of feature `id` tells: its acquisition's name, date and index,
+/// or that citymesh's stitching made it.
+export function describePick(acquisitions, id) {
+  if (id === NULL_FEATURE) return 'a stitch triangle (made by citymesh between two passes)';
+  const a = acquisitions[id];
+  return a ? `${a.name}, ${a.date} (acquisition ${id})` : `acquisition ${id}`;
+}
