@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "citymesh/encode/glb.h"
 #include "citymesh/render/render.h"
 #include "mosaic_output.h"
 #include "test_support.h"
@@ -301,6 +302,40 @@ TEST(Web, BothPagesColourByDateFromTheTilesMetadata) {
     EXPECT_LT(share_of(page.image, orange), 0.001) << page_url;
     EXPECT_GT(share_of(page.image, yellow), 0.002) << page_url;
   }
+}
+
+/// Adds to the tileset of `tiles` a leaf as the export writes a tile whose triangles all come
+/// from stitching: every feature id null, so write_glb gives it no feature ids at all.
+void add_stitch_only_tile(const std::filesystem::path& tiles) {
+  const std::vector<Vec3f> positions{{0, 0, 0}, {8, 0, 0}, {0, 8, 0}};  // east-north-up, by the root's origin
+  const std::vector<Triangle> triangles{{0, 1, 2}};
+  const std::vector<std::uint16_t> ids(positions.size(), 65535);
+  GlbParams params;
+  params.acquisitions = {{"epoch 0", "2026-01-05T10:00:00Z"}};
+  const std::vector<std::uint8_t> glb = write_glb({positions, triangles, ids, {}, {}}, params);
+  test::write_text(tiles / "stitch_only.glb", std::string(glb.begin(), glb.end()));
+  nlohmann::json tileset = nlohmann::json::parse(test::read_text(tiles / "tileset.json"));
+  tileset["root"]["children"].push_back({{"boundingVolume", {{"box", {4, 4, 0, 4, 0, 0, 0, 4, 0, 0, 0, 1}}}},
+                                         {"content", {{"uri", "stitch_only.glb"}}},
+                                         {"geometricError", 0.0},
+                                         {"refine", "REPLACE"}});
+  test::write_text(tiles / "tileset.json", tileset.dump(1));
+}
+
+TEST(Web, CesiumJsDrawsATileOfStitchTrianglesOnly) {
+  if (!have_browser()) GTEST_SKIP() << "npm packages (tools/setup) or Debian's chromium missing";
+  test::TempDir tmp;
+  const auto out = run_short_street(tmp);
+  add_stitch_only_tile(out / "tiles");
+  // The page's colouring reads the feature ids, which such a tile lacks: before session 66's
+  // guard its shader did not compile ("no such field in structure") and nothing was drawn.
+  const PageShot page = screenshot(out, "cesium.html?error=0", tmp);
+  ASSERT_EQ(page.shot.exit_code, 0) << page.shot.out;
+  EXPECT_EQ(page.shot.out.find("console error"), std::string::npos) << page.shot.out;
+  EXPECT_NE(page.shot.out.find(" 0 failed"), std::string::npos) << page.shot.out;
+  expect_street_drawn(page.image);
+  EXPECT_GT(share_of(page.image, [](Rgb8 p) { return p.r > 150 && p.b > 150 && p.g < 60; }), 0.0005)
+      << "the stitch tile's magenta";
 }
 
 }  // namespace

@@ -48,7 +48,11 @@ function colourShader(colours) {
         vec3 p = fsInput.attributes.positionEC;
         vec3 normal = normalize(cross(dFdx(p), dFdy(p)));
         float shade = 0.35 + 0.65 * abs(dot(normal, normalize(vec3(0.3, 0.5, 1.0))));
+      #ifdef HAS_SELECTED_FEATURE_ID
         int id = fsInput.featureIds.featureId_0;
+      #else
+        int id = ${NULL_FEATURE};  // a tile without feature ids holds stitch triangles only
+      #endif
         material.diffuse = (${colour}) * shade;
       }`,
   });
