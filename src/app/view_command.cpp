@@ -44,7 +44,9 @@ class ViewCommand final : public Command {
     app.add_option("--viewer", viewer_, "folder of the viewer page and its node_modules");
     app.footer(
         "Listens on 127.0.0.1 only, prints the address to open, and serves until Ctrl-C. The three.js\n"
-        "viewer is at /, the same tileset in CesiumJS at /cesium.html. Example:\n"
+        "viewer is at /, the same tileset in CesiumJS at /cesium.html. Both colour triangles by\n"
+        "acquisition (?color=date: by date, ?color=none: grey; ?error=2 for finer tiles) and name\n"
+        "the acquisition of a clicked triangle. Example:\n"
         "  citymesh run sim/config.toml && citymesh view sim/out   # then open http://127.0.0.1:8080/");
   }
 
