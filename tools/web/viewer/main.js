@@ -41,7 +41,7 @@ tiles.setResolutionFromRenderer(camera, renderer);
 scene.add(tiles.group);
 
 let models = 0;
-let acquisitions = [];  // [{name, date}] by feature id, from the first tile's property table
+const acquisitions = [];  // [{name, date}] by feature id, from the first tile's property table
 let colours = [];
 
 // The root transform maps the tileset's east-north-up frame to ECEF: undo it, then turn z-up
