@@ -220,16 +220,17 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     const std::size_t listed = acquisition_count(keys);
     for (const auto& [k, v] : before) {
       if (keys.contains(k)) continue;
-      if (const std::optional<std::size_t> a = acquisition_of_key(k); k.ends_with(".withdrawn") && a && *a < listed) {
+      const std::optional<std::size_t> a = acquisition_of_key(k);
+      if (a && *a < listed && k.ends_with(".withdrawn")) {
         log::info("{} is no longer withdrawn: the tiles it reaches are redone", acquisition_named(keys, k));
         continue;
       }
       // The last acquisitions withdrawn (a pass found faulty, an update undone) are input too:
       // no other pass is renumbered, so only the tiles they reached are redone.
-      if (const std::optional<std::size_t> a = acquisition_of_key(k); a && *a >= listed) {
+      if (a && *a >= listed) {
         if (k.ends_with(".path"))
-          log::info("{} ({}) was withdrawn since the last run: the tiles it reached are redone",
-                    k.substr(0, k.size() - 5), v);
+          log::info("{} was withdrawn since the last run: the tiles it reached are redone",
+                    acquisition_named(before, k));
         continue;
       }
       changed.push_back(fmt::format("{} (gone)", k));

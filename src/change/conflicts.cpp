@@ -74,10 +74,6 @@ void mark_empty_space(const TriangleFrames& f, std::size_t g, const VoxelMask& a
   }
 }
 
-}  // namespace
-
-namespace {
-
 /// The dates of the acquisitions holding triangles, so that a pass absent from a tile makes
 /// no work there (and the figures do not depend on passes elsewhere); empty when none does.
 std::vector<TimePoint> held_dates(const TriangleFrames& f) {

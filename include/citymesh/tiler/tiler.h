@@ -107,13 +107,13 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
 void prune_tile_store(const std::filesystem::path& dir, std::span<const std::string> acquisition_fingerprints,
                       const std::string& store_fingerprint, bool staging);
 
-/// Empties `params.dir`, tiles every acquisition, largest file first and `at_once` at a time
-/// (each alone, with its own buffers: the store's bytes do not depend on it), and assembles
-/// the store (without a fingerprint or manifest).
 /// The bytes tiling `acquisition` reads: its file's size; 0 when it is withdrawn (not read)
 /// or cannot be read (tile_acquisition says why). Used to hand out the largest first.
 std::uint64_t acquisition_bytes(const Acquisition& acquisition);
 
+/// Empties `params.dir`, tiles every acquisition, largest file first and `at_once` at a time
+/// (each alone, with its own buffers: the store's bytes do not depend on it), and assembles
+/// the store (without a fingerprint or manifest).
 TileStore tile_acquisitions(std::span<const Acquisition> acquisitions, const TilerParams& params, unsigned at_once = 1);
 
 /// The folder of one acquisition in the store.
