@@ -59,11 +59,17 @@ void InMemoryDetectOutput::feed(std::size_t k, LabelledAcquisitionWriter& out) {
 }
 
 std::uint64_t InMemoryDetectOutput::write_pairs(const std::filesystem::path& path) {
+  // Consistent pairs and pairs of layers of one pass, in one sorted list (a reader tells them
+  // apart by their acquisitions), as a tiled run writes them.
+  std::vector<TrianglePair> pairs;
+  pairs.reserve(result_.consistent_pairs.size() + result_.layer_pairs.size());
+  std::merge(result_.consistent_pairs.begin(), result_.consistent_pairs.end(), result_.layer_pairs.begin(),
+             result_.layer_pairs.end(), std::back_inserter(pairs));
   std::vector<std::uint32_t> flat;
-  flat.reserve(2 * result_.consistent_pairs.size());
-  for (const auto& [a, b] : result_.consistent_pairs) flat.insert(flat.end(), {a, b});
+  flat.reserve(2 * pairs.size());
+  for (const auto& [a, b] : pairs) flat.insert(flat.end(), {a, b});
   write_u32_records(path, kPairsMagic, flat);
-  return result_.consistent_pairs.size();
+  return pairs.size();
 }
 
 namespace {

@@ -43,8 +43,8 @@ class DetectOutputSource {
   /// Gives acquisition k's vertices, then its triangles with their labels, to `out` (every
   /// mesh in the first one's frame, as `detect` reads them).
   virtual void feed(std::size_t k, LabelledAcquisitionWriter& out) = 0;
-  /// Writes the consistent pairs, sorted and unique, to `path` (kPairsMagic records);
-  /// returns how many.
+  /// Writes the consistent pairs and the pairs of layers of one pass (ChangeResult::layer_pairs),
+  /// in one list sorted and unique, to `path` (kPairsMagic records); returns how many.
   virtual std::uint64_t write_pairs(const std::filesystem::path& path) = 0;
   /// The change step's statistics (pre-filter, seconds); the pair count comes from write_pairs.
   [[nodiscard]] virtual ChangeStats stats() const = 0;

@@ -221,7 +221,8 @@ ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAc
         throw InputError(fmt::format("{}: pair {} ({}, {}) is not a pair of the {} triangles", pairs_file.string(),
                                      k / 2, flat[k], flat[k + 1], n));
       }
-      r.consistent_pairs.emplace_back(flat[k], flat[k + 1]);
+      const bool one_pass = r.index.acquisition_of(flat[k]) == r.index.acquisition_of(flat[k + 1]);
+      (one_pass ? r.layer_pairs : r.consistent_pairs).emplace_back(flat[k], flat[k + 1]);
     }
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: {}", (dir / "summary.json").string(), e.what()));

@@ -184,11 +184,15 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   // (from sorted global pairs) come sorted already (sorting them was 1 % of a run).
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
   sort_unless_sorted(r.refuted.begin(), r.refuted.end());
-  for (const auto& [g, h] : change.consistent_pairs) {
-    if (!owned(g) && !owned(h)) continue;
-    auto x = id(g), y = id(h);
-    if (y < x) std::swap(x, y);
-    r.pairs.push_back({x.first, x.second, y.first, y.second});
+  // The pairs of layers of one pass go with the consistent pairs: a reader tells them apart
+  // by their acquisitions, the same for both.
+  for (const auto& pairs : {std::span(change.consistent_pairs), std::span(change.layer_pairs)}) {
+    for (const auto& [g, h] : pairs) {
+      if (!owned(g) && !owned(h)) continue;
+      auto x = id(g), y = id(h);
+      if (y < x) std::swap(x, y);
+      r.pairs.push_back({x.first, x.second, y.first, y.second});
+    }
   }
   sort_unless_sorted(r.pairs.begin(), r.pairs.end(), [](const LabelPair& x, const LabelPair& y) {
     return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <

@@ -44,28 +44,55 @@ Box3f prism_box(const TriangleFrames& f, std::size_t u, double threshold) {
   return {Vec3f(Vec3d(box.min) - widen), Vec3f(Vec3d(box.max) + widen)};
 }
 
-/// The pairs (min, max) found from triangle g's side: every U of another acquisition whose
-/// prism holds g's centroid (`hits`), with compatible normals, that g overlaps. A pair that U
-/// also finds from its side (U overlaps g, and U asks) is kept by the smaller index only, so
-/// that each pair is listed once.
+/// Whether triangles t and u share a corner: the same vertex gives the same float corner, so
+/// comparing positions finds mesh neighbours without the meshes' vertex ids.
+bool share_a_corner(const TriangleFrames& f, std::uint32_t t, std::uint32_t u) {
+  for (const Vec3f& a : f.corner[t]) {
+    for (const Vec3f& b : f.corner[u]) {
+      if (a == b) return true;
+    }
+  }
+  return false;
+}
+
+/// The pairs (min, max) found from triangle g's side: every U whose prism holds g's centroid
+/// (`hits`), with compatible normals, that g overlaps. Into `out.consistent` when U is of
+/// another acquisition; into `out.layers` when it is of g's own and shares no corner with it
+/// (two layers of one pass). A pair that U also finds from its side (U overlaps g, and U
+/// asks) is kept by the smaller index only, so that each pair is listed once.
 void pairs_of(const TriangleFrames& f, std::size_t g, std::span<const std::uint32_t> hits, double threshold,
-              float cos_min, std::vector<TrianglePair>& out) {
+              float cos_min, OverlappingPairs& out) {
   const std::uint32_t acq = f.index.acquisition_of(g);
   const std::size_t own_begin = f.index.offsets[acq], own_end = f.index.offsets[acq + 1];
   const auto t = static_cast<std::uint32_t>(g);
   for (const std::uint32_t u : hits) {
-    if (u >= own_begin && u < own_end) continue;  // same acquisition
-    if (dot(f.normal[g], f.normal[u]) < cos_min) continue;
+    const bool same_acquisition = u >= own_begin && u < own_end;
+    if (u == t || dot(f.normal[g], f.normal[u]) < cos_min) continue;
     if (!overlaps(Vec3d(f.centroid[g]), f, u, threshold)) continue;
     if (t > u && f.asks(u) && overlaps(Vec3d(f.centroid[u]), f, t, threshold)) continue;  // u lists it
-    out.emplace_back(std::min(t, u), std::max(t, u));
+    if (same_acquisition && share_a_corner(f, t, u)) continue;                            // neighbours on one sheet
+    (same_acquisition ? out.layers : out.consistent).emplace_back(std::min(t, u), std::max(t, u));
   }
+}
+
+/// One block's pairs after another (emptying them as it goes), sorted.
+std::vector<TrianglePair> concatenate_sorted(std::vector<OverlappingPairs>& blocks,
+                                             std::vector<TrianglePair> OverlappingPairs::*list) {
+  std::size_t total = 0;
+  for (const OverlappingPairs& b : blocks) total += (b.*list).size();
+  std::vector<TrianglePair> pairs;
+  pairs.reserve(total);
+  for (OverlappingPairs& b : blocks) {
+    pairs.insert(pairs.end(), (b.*list).begin(), (b.*list).end());
+    std::vector<TrianglePair>().swap(b.*list);
+  }
+  radix_sort_pairs(pairs);
+  return pairs;
 }
 
 }  // namespace
 
-std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const ChangeParams& params,
-                                                ChangeStats& stats) {
+OverlappingPairs find_overlapping_pairs(const TriangleFrames& f, const ChangeParams& params, ChangeStats& stats) {
   const double threshold = params.distance_threshold;
   const auto cos_min = static_cast<float>(std::cos(params.normal_angle * std::numbers::pi / 180.0) - 1e-6);
   std::vector<Box3f> boxes(f.size());
@@ -75,7 +102,7 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
   const BoxTree prisms(std::move(boxes));
 
   constexpr std::size_t kGrain = 4096;  // a multiple of the packet: packets stay in a block
-  std::vector<std::vector<TrianglePair>> per_block((f.size() + kGrain - 1) / kGrain);
+  std::vector<OverlappingPairs> per_block((f.size() + kGrain - 1) / kGrain);
   parallel_for_blocks(f.size(), kGrain, [&](std::size_t begin, std::size_t end) {
     // In the tree's order, a triangle's candidates are near the previous one's: warm caches,
     // and packets of neighbouring centroids that share one walk down the tree.
@@ -91,16 +118,10 @@ std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& f, const C
           pairs_of(f, order[i], hits, threshold, cos_min, per_block[begin / kGrain]);
         });
   });
-  std::size_t total = 0;
-  for (const auto& b : per_block) total += b.size();
-  std::vector<TrianglePair> pairs;
-  pairs.reserve(total);
-  for (auto& b : per_block) {
-    pairs.insert(pairs.end(), b.begin(), b.end());
-    std::vector<TrianglePair>().swap(b);
-  }
-  radix_sort_pairs(pairs);
-  stats.consistent_pairs = pairs.size();
+  OverlappingPairs pairs;
+  pairs.consistent = concatenate_sorted(per_block, &OverlappingPairs::consistent);
+  pairs.layers = concatenate_sorted(per_block, &OverlappingPairs::layers);
+  stats.consistent_pairs = pairs.consistent.size();
   return pairs;
 }
 

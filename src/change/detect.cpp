@@ -116,7 +116,9 @@ ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params
   r.stats.triangles = frames.size();
   r.stats.seconds_prepare = clock.restart();
 
-  r.consistent_pairs = find_consistent_pairs(frames, params, r.stats);
+  OverlappingPairs pairs = find_overlapping_pairs(frames, params, r.stats);
+  r.consistent_pairs = std::move(pairs.consistent);
+  r.layer_pairs = std::move(pairs.layers);
   r.stats.seconds_consistency = clock.restart();
 
   const bool need_grids = params.prefilter || params.unconfirmed == UnconfirmedPolicy::keep_unobserved;
@@ -131,8 +133,9 @@ ChangeResult detect_changes(const ChangeInput& input, const ChangeParams& params
   compute_time_series(frames, partners, conflicts, grids, params, r);
   r.refutes = std::move(conflicts.refutes);
   r.stats.seconds_time_series = clock.restart();
-  log::debug("change detection: {} triangles, {} pairs, {} exact tests, {:.3f} s", r.stats.triangles,
-             r.stats.consistent_pairs, r.stats.exact_tests, r.stats.seconds_total());
+  log::debug("change detection: {} triangles, {} pairs, {} pairs of layers of one pass, {} exact tests, {:.3f} s",
+             r.stats.triangles, r.stats.consistent_pairs, r.layer_pairs.size(), r.stats.exact_tests,
+             r.stats.seconds_total());
   return r;
 }
 

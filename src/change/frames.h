@@ -81,15 +81,21 @@ class EmptySpaceSlabs {
 /// Checks the input and computes every frame (parallel, deterministic).
 TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& params);
 
-/// Consistent pairs: triangles of different acquisitions whose normals are within
-/// normal_angle and where one's centroid lies within distance_threshold of the other's plane
-/// and projects inside it (point-to-triangle distance reached inside). Candidates come from
-/// point queries in a BVH of every triangle's prism box (the triangle thickened by the
-/// threshold along its normal), which holds exactly the points that can pass the test.
-/// Only triangles that ask (TriangleFrames::asks) query: a pair of which only an
-/// empty-space triangle overlaps the other is not found. Sorted, each pair once.
-std::vector<TrianglePair> find_consistent_pairs(const TriangleFrames& frames, const ChangeParams& params,
-                                                ChangeStats& stats);
+/// Overlapping triangles: pairs whose normals are within normal_angle and where one's
+/// centroid lies within distance_threshold of the other's plane and projects inside it
+/// (point-to-triangle distance reached inside). Candidates come from point queries in a BVH
+/// of every triangle's prism box (the triangle thickened by the threshold along its normal),
+/// which holds exactly the points that can pass the test. Only triangles that ask
+/// (TriangleFrames::asks) query: a pair of which only an empty-space triangle overlaps the
+/// other is not found. Each list sorted, each pair once.
+struct OverlappingPairs {
+  /// Of different acquisitions: the consistent pairs (labels and the mosaic's overlap terms).
+  std::vector<TrianglePair> consistent;
+  /// Of one acquisition, sharing no corner: two layers of one pass (overlapping frames of a
+  /// spinning scanner, a vehicle crossing its own path). The mosaic's overlap terms only.
+  std::vector<TrianglePair> layers;
+};
+OverlappingPairs find_overlapping_pairs(const TriangleFrames& frames, const ChangeParams& params, ChangeStats& stats);
 
 /// The voxels of every box a grid is ever asked about: those of the triangles older than the
 /// newest acquisition (the pre-filter and the unconfirmed policy ask about nothing else).

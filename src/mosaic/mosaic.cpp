@@ -268,6 +268,9 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
   out.selected.assign(input.change->index.size(), 0);
   for (std::size_t v = 0; v < x.size(); ++v) out.selected[e.triangle_of[v]] = static_cast<std::uint8_t>(x[v]);
   account(e, x, out.stats);  // the energy of the solver's labelling, before the fill
+  // The energy picks passes, not layers: where a pass holds two layers (overlapping turns of
+  // a spinning scanner), one stays.
+  out.stats.layers_dropped = keep_one_layer(input, 0, out.selected);
   // The energy's answers per global triangle: noted, and given to the fill, which need not
   // ask again (empty when the energy did not ask: the fill then works them out).
   out.notes.assign(input.change->index.size(), 0);

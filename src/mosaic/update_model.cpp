@@ -113,7 +113,8 @@ std::uint64_t drop_seen_through(const MosaicInput& input, const mosaic_detail::S
 
 /// Visits the acquisitions in `order`; in each, selects the kept triangles with no selected
 /// triangle within the distance threshold of their centroid (what is selected at the start of
-/// the acquisition: its own triangles never hide each other), unless, with `visibility`,
+/// the acquisition: its own triangles do not hide each other, but of two layers of one pass
+/// only one is taken: keep_one_layer), unless, with `visibility`,
 /// another pass saw through them. The triangles selected at the start are indexed once; the
 /// ones added on the way are indexed again per acquisition (few, for the hole fill).
 HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size_t> order,
@@ -141,6 +142,7 @@ HoleFillCounts add_uncovered(const MosaicInput& input, std::span<const std::size
         add[t] = near_later.any_within((p + q + r) / 3.0, reach) ? 0 : 1;
       }
     });
+    (void)keep_one_layer(input, base, add);
     for (std::size_t t = 0; t < add.size(); ++t) {
       selected[base + t] |= add[t];
       added_so_far[base + t] |= add[t];
@@ -164,6 +166,24 @@ MosaicSelection select_update_model(const MosaicInput& input) {
   out.stats.selected = static_cast<std::uint64_t>(std::count(out.selected.begin(), out.selected.end(), 1));
   out.stats.seconds_solve = clock.seconds();
   return out;
+}
+
+std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::span<std::uint8_t> selected) {
+  const std::span<const TrianglePair> layers(input.change->layer_pairs);
+  const auto is_forced = [&](std::size_t g) { return !input.forced.empty() && input.forced[g] != 0; };
+  const auto first = std::lower_bound(layers.begin(), layers.end(), TrianglePair{static_cast<std::uint32_t>(base), 0});
+  std::uint64_t dropped = 0;
+  for (auto it = first; it != layers.end() && it->first < base + selected.size(); ++it) {
+    const auto [g, u] = *it;
+    if (selected[g - base] == 0 || selected[u - base] == 0) continue;
+    // The later one goes (in a pass's file order, a later turn), so that the earlier layer
+    // stays whole where it is; a decision taken elsewhere (forced) stays.
+    const std::uint32_t drop = is_forced(u) ? g : u;
+    if (is_forced(drop)) continue;
+    selected[drop - base] = 0;
+    ++dropped;
+  }
+  return dropped;
 }
 
 HoleFillCounts fill_holes(const MosaicInput& input, std::vector<std::uint8_t>& selected,

@@ -126,6 +126,54 @@ TEST(Consistency, PairsEqualBruteForceOnNoisyOverlappingPatches) {
   EXPECT_EQ(r.consistent_pairs, expected);
 }
 
+/// Two turns of a spinning scanner over the same ground in one acquisition: every pair of
+/// overlapping triangles of that pass sharing no corner is a layer pair, found as brute force
+/// finds it; neighbours on one turn are not; the layers touch no label (the same states as the
+/// two turns given as two passes would not be: there they are consistent).
+TEST(Consistency, LayerPairsOfOnePassEqualBruteForceAndLeaveTheLabelsAlone) {
+  std::mt19937 rng(5);
+  std::vector<Mesh> meshes(2);
+  add_patch(meshes[0], 0, 2, 0, 2, 0.0, 0.1, {1, -3, 2.5f}, &rng);               // turn 1
+  add_patch(meshes[0], 0.53, 2.53, 0.31, 2.31, 0.02, 0.12, {1, 4, 2.5f}, &rng);  // turn 2, overlapping
+  add_patch(meshes[1], 5, 6, 0, 1, 0.0, 0.1, {5.5f, -3, 2.5f});                  // elsewhere
+  for (std::uint32_t a = 0; a < 2; ++a) finish(meshes[a], a);
+  const ChangeResult r = detect(meshes, {day(0), day(40)});
+
+  const Mesh& m = meshes[0];
+  const auto corners = [&](std::size_t t) {
+    return TriangleCorners{Vec3d(m.positions[m.triangles[t][0]]), Vec3d(m.positions[m.triangles[t][1]]),
+                           Vec3d(m.positions[m.triangles[t][2]])};
+  };
+  const auto share_a_vertex = [&](std::size_t a, std::size_t b) {
+    for (const std::uint32_t v : m.triangles[a]) {
+      if (std::find(m.triangles[b].begin(), m.triangles[b].end(), v) != m.triangles[b].end()) return true;
+    }
+    return false;
+  };
+  std::vector<TrianglePair> expected;
+  std::size_t across_turns = 0;
+  const std::size_t first_of_turn_2 = 2 * 20 * 20;
+  for (std::size_t i = 0; i < m.triangle_count(); ++i) {
+    for (std::size_t j = i + 1; j < m.triangle_count(); ++j) {
+      if (share_a_vertex(i, j)) continue;
+      const TriangleCorners p = corners(i), q = corners(j);
+      const Vec3d cp = (p[0] + p[1] + p[2]) / 3.0, cq = (q[0] + q[1] + q[2]) / 3.0;
+      if (projects_inside(cp, q, 0.1) || projects_inside(cq, p, 0.1)) {
+        expected.emplace_back(static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(j));
+        across_turns += (i < first_of_turn_2) != (j < first_of_turn_2) ? 1 : 0;
+      }
+    }
+  }
+  ASSERT_GT(expected.size(), 300u);
+  EXPECT_EQ(across_turns, expected.size());  // no pair within one turn
+  EXPECT_EQ(r.layer_pairs, expected);
+  EXPECT_TRUE(r.consistent_pairs.empty());
+  for (std::size_t g = 0; g < r.state.size(); ++g) {
+    EXPECT_EQ(r.state[g], TriangleState::single) << g;
+    EXPECT_EQ(r.first_seen[g], r.last_seen[g]) << g;
+  }
+}
+
 // ---- conflicts ---------------------------------------------------------------------------
 
 /// Ground seen from x = -5 in both passes; the older pass also saw a wall at x = 2 which the

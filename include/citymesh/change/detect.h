@@ -94,6 +94,10 @@ struct ChangeResult {
                                           ///< kept by the unconfirmed policy)
   std::vector<std::uint8_t> refutes;      ///< its empty space made an older labelled triangle conflict
   std::vector<TrianglePair> consistent_pairs;
+  /// Overlapping triangles of one acquisition that share no corner (sorted, first < second):
+  /// two layers of one pass, such as the overlapping turns of a spinning scanner meshed one
+  /// by one. They take no part in the labels; the mosaic keeps at most one of each pair.
+  std::vector<TrianglePair> layer_pairs;
   ChangeStats stats;
 };
 

@@ -36,6 +36,7 @@ struct MosaicStats {
   std::uint64_t seen_through = 0;       ///< candidates another pass saw through (quality scaled down)
   std::uint64_t filled = 0;             ///< triangles added by the hole fill
   std::uint64_t fill_seen_through = 0;  ///< triangles the hole fill left out: another pass saw through them
+  std::uint64_t layers_dropped = 0;     ///< selected triangles dropped as a second layer of their pass
   MinimiseStats solver;                 ///< solver.exact: the whole energy was solved by one flipped cut
   GroupMoveStats moves;                 ///< otherwise: the group moves (one group per acquisition)
   double seconds_build = 0, seconds_solve = 0, seconds_fill = 0;
@@ -88,6 +89,13 @@ struct HoleFillCounts {
   std::uint64_t added = 0;
   std::uint64_t seen_through = 0;  ///< left out: another pass saw through them
 };
+
+/// One layer per pass: for each pair (g, u), g < u, of the change step's layer_pairs
+/// (overlapping triangles of one acquisition sharing no corner, such as two turns of a
+/// spinning scanner), in the list's order, whose both triangles are selected, u is dropped
+/// (g when u is forced in `input`; neither when both are). `selected[i]` is global triangle
+/// base + i. Returns how many were dropped.
+std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::span<std::uint8_t> selected);
 
 /// Hole fill after the energy mosaic: the acquisitions newest first; a kept triangle is added
 /// to `selected` when no selected triangle lies within the distance threshold of its centroid
