@@ -181,6 +181,19 @@ void warn_tiles_over_budget(const Config& config, const TileStore& store, const 
       tile_memory_estimate(largest) >> 20);
 }
 
+/// Says when the tiles took this process past the budget: the estimate (bytes per triangle
+/// held) is right for one sheet per pass, not for inputs whose surfaces are many layers deep,
+/// whose pairs of overlapping triangles it does not count.
+void warn_if_past_budget(const Config& config) {
+  const std::uint64_t peak = peak_resident_bytes();
+  if (peak <= config.run.memory) return;
+  log::warn(
+      "the tiles took this process to {} MiB, past the memory budget of {}: their surfaces are more layers "
+      "deep than the estimate allows for (many passes, or overlapping turns of a spinning scanner in one "
+      "pass); use a smaller [tiling] tile_size or a larger --memory",
+      peak >> 20, format_byte_size(config.run.memory));
+}
+
 }  // namespace
 
 std::filesystem::path result_path(const Config& config, TileKey key) {
@@ -268,6 +281,9 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
     gate.release(estimate);
   });
   channel.reset();
+  if (std::any_of(mine.get(), mine.get() + tiles.size(), [](const std::atomic<bool>& m) { return m.load(); })) {
+    warn_if_past_budget(config);
+  }
   for (std::size_t item = 0; item < tiles.size(); ++item) {
     if (finished_elsewhere[item] == 0) continue;
     report.processed[tiles[item]] = 0;

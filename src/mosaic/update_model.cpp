@@ -168,6 +168,32 @@ MosaicSelection select_update_model(const MosaicInput& input) {
   return out;
 }
 
+namespace {
+
+/// Whether the centroid of global triangle g lies on global triangle u: within `reach` of its
+/// plane, projecting inside it (edges included).
+bool centroid_on(const MosaicInput& input, std::uint32_t g, std::uint32_t u, double reach) {
+  const GlobalTriangles& index = input.change->index;
+  const auto corners = [&](std::uint32_t t) {
+    const std::uint32_t a = index.acquisition_of(t);
+    return input.meshes[a].corners(t - index.offsets[a]);
+  };
+  const auto [p, q, r] = corners(g);
+  const TriangleCorners on = corners(u);
+  const Vec3d n = cross(on[1] - on[0], on[2] - on[0]);
+  const double n_sq = dot(n, n);
+  if (!(n_sq > 0)) return false;
+  const Vec3d c = (p + q + r) / 3.0;
+  const double h = dot(c - on[0], n) / std::sqrt(n_sq);
+  if (std::abs(h) > reach) return false;
+  for (int k = 0; k < 3; ++k) {
+    if (dot(cross(on[(k + 1) % 3] - on[k], c - on[k]), n) < 0) return false;  // c's foot is outside
+  }
+  return true;
+}
+
+}  // namespace
+
 std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::span<std::uint8_t> selected) {
   const std::span<const TrianglePair> layers(input.change->layer_pairs);
   const auto is_forced = [&](std::size_t g) { return !input.forced.empty() && input.forced[g] != 0; };
@@ -177,9 +203,11 @@ std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::sp
     const auto [g, u] = *it;
     if (selected[g - base] == 0 || selected[u - base] == 0) continue;
     // The later one goes (in a pass's file order, a later turn), so that the earlier layer
-    // stays whole where it is; a decision taken elsewhere (forced) stays.
-    const std::uint32_t drop = is_forced(u) ? g : u;
-    if (is_forced(drop)) continue;
+    // stays whole where it is; a decision taken elsewhere (forced) stays. Only a triangle
+    // whose centre the other covers goes: one that merely reaches over the other's edge
+    // covers more beyond it, and dropping it would open a slit there.
+    const auto [drop, stays] = is_forced(u) ? std::pair{g, u} : std::pair{u, g};
+    if (is_forced(drop) || !centroid_on(input, drop, stays, input.distance_threshold)) continue;
     selected[drop - base] = 0;
     ++dropped;
   }

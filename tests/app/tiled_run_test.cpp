@@ -160,6 +160,21 @@ TEST(TiledRun, AHaloNarrowerThanTheTrianglesReachIsWarnedOf) {
   EXPECT_GE(std::stod(run.err.substr(at + 16)), radius + 0.1);
 }
 
+TEST(TiledRun, TilesThatTakeTheProcessPastTheBudgetAreWarnedOf) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  constexpr const char* kPast = "past the memory budget of";
+  const auto within = test::run_citymesh(run_args(sim, "within", ""));
+  ASSERT_EQ(within.exit_code, 0) << within.err;
+  EXPECT_EQ(within.err.find(kPast), std::string::npos) << within.err;
+  const auto past = test::run_citymesh(run_args(sim, "past", "--memory 64MiB"));
+  ASSERT_EQ(past.exit_code, 0) << past.err;
+  const auto peak = read_json(dir / "sim/past/run.json")["peak_rss_bytes"].get<std::uint64_t>();
+  ASSERT_GT(peak, std::uint64_t{64} << 20) << "the street no longer needs more than 64 MiB: take a longer one";
+  EXPECT_NE(past.err.find(fmt::format("{} 64MiB", kPast)), std::string::npos) << past.err;
+}
+
 TEST(TiledRun, AZeroAreaInputTriangleIsDroppedAlikeByTheTilerAndTheLabelledPlys) {
   // The labelled PLYs read each file again: they must leave out the triangles the tiler left
   // out, or the labels of every later triangle are shifted (the run used to stop there).

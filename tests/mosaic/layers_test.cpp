@@ -71,6 +71,33 @@ TEST(OneLayerPerPass, TheHoleFillAddsOneLayer) {
   for (std::uint32_t t = 0; t < 32; ++t) EXPECT_EQ(selected[t] + selected[32 + t], 1) << t;
 }
 
+TEST(OneLayerPerPass, ATriangleReachingPastTheOthersEdgeStaysOneItCoversGoes) {
+  // One pass, three triangles 1 cm apart in height, no shared corner: g; a larger one whose
+  // centroid lies beyond g's long edge but which covers g's centroid (dropping it would leave
+  // most of it uncovered); a small one lying on g.
+  Mesh m;
+  m.positions = {{0, 0, 0},           {1, 0, 0},           {0, 1, 0},             // g
+                 {0.2f, 0, 0.01f},    {2.2f, 0, 0.01f},    {0.2f, 2, 0.01f},      // larger, reaching past g
+                 {0.1f, 0.1f, 0.01f}, {0.5f, 0.1f, 0.01f}, {0.1f, 0.5f, 0.01f}};  // small, on g
+  m.triangles = {{0, 1, 2}, {3, 4, 5}, {6, 7, 8}};
+  m.triangle_ids.resize(3);
+  const std::vector<Mesh> meshes{m};
+  const std::vector<TimePoint> dates{TimePoint(std::chrono::days(1))};
+  ChangeResult change;
+  change.index.offsets = {0, 3};
+  change.kept.assign(3, 1);
+  change.layer_pairs = {{0, 1}, {0, 2}, {1, 2}};
+  std::vector<std::uint8_t> selected{1, 1, 1};
+  EXPECT_EQ(keep_one_layer({meshes, dates, &change, 0.1, {}}, 0, selected), 1u);
+  EXPECT_EQ(selected, (std::vector<std::uint8_t>{1, 1, 0}));
+  // 10 cm above g instead of 1 cm: beyond the distance threshold, nothing lies on g.
+  for (std::size_t v = 6; v < 9; ++v) m.positions[v].z = 0.15f;
+  const std::vector<Mesh> apart{m};
+  selected = {1, 1, 1};
+  change.layer_pairs = {{0, 1}, {0, 2}};
+  EXPECT_EQ(keep_one_layer({apart, dates, &change, 0.1, {}}, 0, selected), 0u);
+}
+
 TEST(OneLayerPerPass, WithoutLayerPairsBothTurnsStay) {
   // The same mesh with no layer pairs listed (as before they were found): both sheets are
   // kept, which is what the pairs are there to prevent.

@@ -93,8 +93,10 @@ struct HoleFillCounts {
 /// One layer per pass: for each pair (g, u), g < u, of the change step's layer_pairs
 /// (overlapping triangles of one acquisition sharing no corner, such as two turns of a
 /// spinning scanner), in the list's order, whose both triangles are selected, u is dropped
-/// (g when u is forced in `input`; neither when both are). `selected[i]` is global triangle
-/// base + i. Returns how many were dropped.
+/// (g when u is forced in `input`; neither when both are) if its centroid lies on the other
+/// (within the distance threshold of its plane, projecting inside it; otherwise it reaches
+/// past the other's edge and both stay). `selected[i]` is global triangle base + i. Returns
+/// how many were dropped.
 std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::span<std::uint8_t> selected);
 
 /// Hole fill after the energy mosaic: the acquisitions newest first; a kept triangle is added
