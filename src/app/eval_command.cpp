@@ -132,6 +132,10 @@ void print_mosaic_summary(const nlohmann::json& m, std::ostream& out) {
                      100 * m["dynamic_residue"].get<double>());
   out << fmt::format("  overlap ratio         {:.3f} % of the output area doubles output of another source\n",
                      100 * m["overlap_ratio"].get<double>());
+  if (m.contains("layered_ratio")) {
+    out << fmt::format("  layered ratio         {:.3f} % of the output area doubles output of its own source\n",
+                       100 * m["layered_ratio"].get<double>());
+  }
   out << fmt::format("  hole ratio            {:.3f} % of the static input area has no output over it\n",
                      100 * m["hole_ratio"].get<double>());
   out << fmt::format("  seams                 {:.1f} m open between sources ({:.1f} m of open boundary in all)\n",

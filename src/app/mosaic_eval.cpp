@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <numbers>
 
 #include "citymesh/core/error.h"
@@ -132,6 +133,23 @@ std::pair<double, double> boundary_and_seam_length(const OutputMesh& o, const Me
   return {total, seam};
 }
 
+/// The output area of input triangles (source >= 0) whose centroid lies on another output
+/// triangle u with doubles(t, u) (within kOverlapDistance of its plane, projecting inside it,
+/// normals within kParallelDeg): surface the output holds twice.
+double area_doubled(const OutputMesh& out, const MeshProximity& near,
+                    const std::function<bool(std::size_t, std::uint32_t)>& doubles) {
+  const double cos_parallel = std::cos(kParallelDeg * std::numbers::pi / 180.0);
+  return parallel_sum(out.source.size(), [&](std::size_t t) {
+    if (out.source[t] < 0) return 0.0;
+    const TriangleCorners c = out.table.corners(t);
+    const Vec3d p = centroid(c) - out.local.origin;
+    const bool covered = near.any_over(p, kOverlapDistance, [&](std::uint32_t u) {
+      return doubles(t, u) && std::abs(dot(out.normal[u], out.normal[t])) >= cos_parallel;
+    });
+    return covered ? area(c) : 0.0;
+  });
+}
+
 /// Where the static input area the output does not cover went (m²): faces the change step
 /// dropped, faces it kept that are not in the output (the mosaic did not select them, or
 /// clipping removed them whole: the output cannot tell which), and faces in the output whose
@@ -182,16 +200,20 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
     out_edges += norm(c[1] - c[0]) + norm(c[2] - c[1]) + norm(c[0] - c[2]);
     out_edge_count += 3;
   }
-  const double cos_parallel = std::cos(kParallelDeg * std::numbers::pi / 180.0);
-  const double overlap = parallel_sum(out.source.size(), [&](std::size_t t) {
-    if (out.source[t] < 0) return 0.0;
-    const TriangleCorners c = out.table.corners(t);
-    const Vec3d p = centroid(c) - out.local.origin;
-    const bool covered = near.any_over(p, kOverlapDistance, [&](std::uint32_t u) {
-      return out.source[u] >= 0 && out.source[u] != out.source[t] &&
-             std::abs(dot(out.normal[u], out.normal[t])) >= cos_parallel;
-    });
-    return covered ? area(c) : 0.0;
+  const double overlap = area_doubled(
+      out, near, [&](std::size_t t, std::uint32_t u) { return out.source[u] >= 0 && out.source[u] != out.source[t]; });
+  // Two layers of one source: its own triangles that are not neighbours (a pass whose turns
+  // overlap, kept whole).
+  const auto neighbours = [&](std::size_t t, std::uint32_t u) {
+    for (const std::uint32_t v : out.table.triangles[t]) {
+      for (const std::uint32_t w : out.table.triangles[u]) {
+        if (v == w) return true;
+      }
+    }
+    return false;
+  };
+  const double layered = area_doubled(out, near, [&](std::size_t t, std::uint32_t u) {
+    return u != t && out.source[u] == out.source[t] && !neighbours(t, u);
   });
 
   // The inputs: how much of the static structure and of what the change step kept the
@@ -242,6 +264,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
           {"triangles", out.table.triangles.size()},
           {"area", out_area},
           {"overlap_ratio", out_area > 0 ? overlap / out_area : 0.0},
+          {"layered_ratio", out_area > 0 ? layered / out_area : 0.0},
           {"seam_length", seam},
           {"open_boundary_length", boundary},
           {"hole_ratio", static_area > 0 ? static_open / static_area : 0.0},

@@ -150,5 +150,33 @@ TEST(RunEval, EvalRefusesAMosaicThatDoesNotMatchTheRun) {
   EXPECT_NE(bad.err.find("mosaic"), std::string::npos) << bad.err;
 }
 
+TEST(RunEval, APassOfOverlappingTurnsGivesTheOutputOneLayer) {
+  // A spinning scanner's turns are meshed one by one and overlap within each pass. Both `run`
+  // (tiles) and `detect` + `mosaic` (pairs.bin) keep one layer of each pass; keeping every
+  // layer, as before session 67, left ~90 % of the output over output of its own pass.
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(
+      test::run_citymesh(fmt::format("simulate --out {} --scanner spinning --length 30 --rings 8 --columns 256", sim))
+          .exit_code,
+      0);
+  const auto run = test::run_citymesh(fmt::format("run {}/config.toml --no-pictures", sim));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  ASSERT_EQ(
+      test::run_citymesh(fmt::format("detect {}/config.toml --no-pictures --set project.output=whole", sim)).exit_code,
+      0);
+  ASSERT_EQ(
+      test::run_citymesh(fmt::format("mosaic {}/config.toml --no-pictures --set project.output=whole", sim)).exit_code,
+      0);
+  for (const char* out : {"out", "whole"}) {
+    const auto eval = test::run_citymesh(fmt::format("eval {}/{} --truth {}", sim, out, sim));
+    ASSERT_EQ(eval.exit_code, 0) << eval.err;
+    const nlohmann::json m = read_json(dir / "sim" / out / "eval.json").at("mosaic");
+    EXPECT_LT(m["layered_ratio"].get<double>(), 0.08) << out;
+    EXPECT_GT(m["static_completeness"].get<double>(), 0.98) << out;
+    EXPECT_LT(m["hole_ratio"].get<double>(), 0.04) << out;
+  }
+}
+
 }  // namespace
 }  // namespace citymesh
