@@ -21,8 +21,11 @@ class MeshCommand final : public Command {
   std::string_view summary() const override { return "mesh real scan-ordered points (profiler lines or spinning frames)"; }
 
   void declare(CLI::App& app) override {
-    app.add_option("files", files_, "PLY point files in acquisition order (profiler: consecutive chunks of one drive)")
-        ->required()->check(CLI::ExistingFile);
+    app.add_option("files", files_,
+                   "PLY point files in acquisition order (profiler: consecutive chunks of one drive; spinning: frames "
+                   "of one drive, each meshed on its own, all in one mesh)")
+        ->required()
+        ->check(CLI::ExistingFile);
     app.add_option("--out", out_, "mesh PLY to write")->required();
     app.add_option("--layout", layout_, "auto (from the properties), profiler (angle wraps per line), spinning (ring x column)")
         ->check(CLI::IsMember({"auto", "profiler", "spinning"}));
@@ -34,33 +37,59 @@ class MeshCommand final : public Command {
         ->check(CLI::Range(0.0, 10.0));
     app.add_option("--max-incidence", meshing_.max_incidence_deg, "degrees between normal and line of sight")
         ->check(CLI::Range(1.0, 90.0));
-    app.footer("Examples:\n  citymesh mesh sample_riegl_18_0{1,2,3,4,5}.ply --out riegl_mesh.ply\n"
-               "  citymesh mesh ouster_os1_128_frame1795.ply --out frame1795_mesh.ply");
+    app.footer(
+        "Examples:\n  citymesh mesh sample_riegl_18_0{1,2,3,4,5}.ply --out riegl_mesh.ply\n"
+        "  citymesh mesh ouster_os1_128_frame1795.ply --out frame1795_mesh.ply\n"
+        "  citymesh mesh ouster_os1_128_frame179{5,6,7}.ply --out drive.ply   # one pass of three frames");
   }
 
   void run() override {
     std::vector<std::filesystem::path> paths(files_.begin(), files_.end());
     const std::string layout = layout_ == "auto" ? detect(paths.front()) : layout_;
-    SensorGrid grid;
     if (layout == "profiler") {
       ProfilerGridParams p;
       p.echo = echo_ == "last" ? ProfilerGridParams::Echo::last : ProfilerGridParams::Echo::first;
-      grid = profiler_grid(paths, p);
-    } else {
-      if (paths.size() != 1) throw UsageError("spinning layout: mesh one frame at a time");
-      grid = spinning_grid(paths.front());
+      const SensorGrid grid = profiler_grid(paths, p);
+      const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
+      write_mesh_ply(out_, r.mesh);
+      const auto cells = std::count(grid.valid.begin(), grid.valid.end(), 1);
+      std::cout << fmt::format("{}: {} layout, grid {} x {}, {} points, {} triangles\n", out_, layout, grid.rows,
+                               grid.cols, cells, r.mesh.triangle_count());
+      print_rejected(r.stats);
+      return;
     }
-    const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
-    write_mesh_ply(out_, r.mesh);
-    const auto cells = std::count(grid.valid.begin(), grid.valid.end(), 1);
-    std::cout << fmt::format("{}: {} layout, grid {} x {}, {} points, {} triangles\n", out_, layout, grid.rows, grid.cols,
-                             cells, r.mesh.triangle_count());
-    std::cout << fmt::format("  rejected: {} long edges, {} depth jumps, {} grazing (of {} candidates)\n",
-                             r.stats.rejected_long_edge, r.stats.rejected_depth_jump, r.stats.rejected_grazing,
-                             r.stats.candidates);
+    mesh_spinning_frames(paths);
   }
 
  private:
+  /// Each frame meshed on its own grid, the frames of one drive in one mesh (as the simulator
+  /// writes a spinning pass: its turns overlap, and the mosaic keeps one layer of them).
+  void mesh_spinning_frames(const std::vector<std::filesystem::path>& paths) const {
+    Mesh drive;
+    SensorMeshStats stats;
+    std::int64_t cells = 0;
+    for (const std::filesystem::path& path : paths) {
+      const SensorGrid grid = spinning_grid(path);
+      const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
+      if (drive.vertex_count() == 0) drive.origin = r.mesh.origin;
+      append_mesh(r.mesh, drive);
+      cells += std::count(grid.valid.begin(), grid.valid.end(), 1);
+      stats.candidates += r.stats.candidates;
+      stats.rejected_long_edge += r.stats.rejected_long_edge;
+      stats.rejected_depth_jump += r.stats.rejected_depth_jump;
+      stats.rejected_grazing += r.stats.rejected_grazing;
+    }
+    write_mesh_ply(out_, drive);
+    std::cout << fmt::format("{}: spinning layout, {} frame(s), {} points, {} triangles\n", out_, paths.size(), cells,
+                             drive.triangle_count());
+    print_rejected(stats);
+  }
+
+  static void print_rejected(const SensorMeshStats& s) {
+    std::cout << fmt::format("  rejected: {} long edges, {} depth jumps, {} grazing (of {} candidates)\n",
+                             s.rejected_long_edge, s.rejected_depth_jump, s.rejected_grazing, s.candidates);
+  }
+
   static std::string detect(const std::filesystem::path& file) {
     PlyReadParams read;
     read.require_sensor_origin = false;

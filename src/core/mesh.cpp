@@ -57,4 +57,27 @@ void append_vertex(const Mesh& from, std::uint32_t v, Mesh& to) {
   if (!from.colors.empty()) to.colors.push_back(from.colors[v]);
 }
 
+void append_mesh(const Mesh& from, Mesh& to) {
+  const Vec3f shift(from.origin - to.origin);
+  const auto base = static_cast<std::uint32_t>(to.positions.size());
+  for (std::size_t v = 0; v < from.vertex_count(); ++v) {
+    append_vertex(from, static_cast<std::uint32_t>(v), to);
+    to.positions.back() += shift;
+    if (from.has_sensor_positions()) to.sensor_positions.back() += shift;
+  }
+  for (std::size_t t = 0; t < from.triangle_count(); ++t) {
+    const Triangle& tri = from.triangles[t];
+    to.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
+    const std::uint32_t acquisition = t < from.triangle_ids.size() ? from.triangle_ids[t].acquisition : 0;
+    to.triangle_ids.push_back({acquisition, 0, to.triangle_ids.size()});
+  }
+  // An attribute one mesh carries and the other not leaves it short (checked without the
+  // triangles: the simulator appends hundreds of turns to one mesh).
+  const std::size_t n = to.positions.size();
+  check_size(to.sensor_positions.size(), n, "sensor_positions");
+  check_size(to.times.size(), n, "times");
+  check_size(to.intensities.size(), n, "intensities");
+  check_size(to.colors.size(), n, "colors");
+}
+
 }  // namespace citymesh

@@ -100,22 +100,6 @@ SensorMeshingParams meshing_for(const SimulateParams& p) {
   return m;
 }
 
-/// Appends one street's meshed scan to the epoch's mesh (whose origin may differ).
-void append_mesh(Mesh& to, const Mesh& from) {
-  const Vec3f shift(from.origin - to.origin);
-  const auto base = static_cast<std::uint32_t>(to.positions.size());
-  for (std::size_t v = 0; v < from.vertex_count(); ++v) {
-    to.positions.push_back(from.positions[v] + shift);
-    to.sensor_positions.push_back(from.sensor_positions[v] + shift);
-    to.times.push_back(from.times[v]);
-  }
-  for (std::size_t t = 0; t < from.triangle_count(); ++t) {
-    const Triangle& tri = from.triangles[t];
-    to.triangles.push_back({tri[0] + base, tri[1] + base, tri[2] + base});
-    to.triangle_ids.push_back({from.triangle_ids[t].acquisition, 0, to.triangle_ids.size()});
-  }
-}
-
 }  // namespace
 
 std::uint64_t SimulationReport::triangles() const {
@@ -149,11 +133,11 @@ SimulationReport simulate(const SimulateParams& p) {
       Mesh street;
       street.origin = epoch.origin;
       for (const SensorGrid& grid : grids) {
-        append_mesh(street, mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)).mesh);
+        append_mesh(mesh_sensor_grid(grid, meshing_for(p), static_cast<std::uint32_t>(k)).mesh, street);
       }
       const std::vector<std::uint32_t> labels = surface_labels(scene, k, street, kTruthTolerance);
       truth.insert(truth.end(), labels.begin(), labels.end());
-      append_mesh(epoch, street);
+      append_mesh(street, epoch);
       report.mesh_seconds += stage.seconds();
       e.rays += rays_per_epoch(scene, k, p.scanner);
     }

@@ -1,10 +1,13 @@
 // SPDX-License-Identifier: MIT
 // The citymesh binary as a user runs it.
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/config/config.h"
+#include "citymesh/io/mesh_io.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -83,6 +86,61 @@ TEST(Cli, LogJsonWritesOneObjectPerLine) {
   const auto j = nlohmann::json::parse(r.err.substr(0, r.err.find('\n')));
   EXPECT_EQ(j["level"], "error");
   EXPECT_NE(j["msg"].get<std::string>().find("not a PLY file"), std::string::npos);
+}
+
+/// A spinning sensor's frame at (sx, 0, 1.5): 8 rings from -10 to +10 degrees, 64 columns,
+/// every return 6 m away (a round wall about the sensor), as ASCII PLY with ring and column.
+void write_spinning_frame(const std::filesystem::path& path, double sx) {
+  std::string body;
+  int count = 0;
+  for (int ring = 0; ring < 8; ++ring) {
+    for (int column = 0; column < 64; ++column) {
+      const double elevation = (-10.0 + 20.0 * ring / 7) * M_PI / 180, azimuth = 2 * M_PI * column / 64;
+      const double x = sx + 6 * std::cos(elevation) * std::cos(azimuth),
+                   y = 6 * std::cos(elevation) * std::sin(azimuth), z = 1.5 + 6 * std::sin(elevation);
+      body += fmt::format("{:.4f} {:.4f} {:.4f} {:.4f} 0 1.5 {} {} 1\n", x, y, z, sx, ring, column);
+      ++count;
+    }
+  }
+  test::write_text(path, fmt::format("ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n"
+                                     "property double z\nproperty double x_origin\nproperty double y_origin\n"
+                                     "property double z_origin\nproperty int ring\nproperty int column\n"
+                                     "property int valid\nend_header\n{}",
+                                     count, body));
+}
+
+TEST(Cli, MeshPutsTheSpinningFramesOfOneDriveInOneMeshEachMeshedOnItsOwn) {
+  test::TempDir dir;
+  write_spinning_frame(dir / "f1.ply", 0.0);
+  write_spinning_frame(dir / "f2.ply", 0.05);
+  for (const char* name : {"f1", "f2"}) {
+    const auto one =
+        test::run_citymesh(fmt::format("mesh {0}/{1}.ply --out {0}/{1}_mesh.ply", dir.path().string(), name));
+    ASSERT_EQ(one.exit_code, 0) << one.err;
+  }
+  const auto both =
+      test::run_citymesh(fmt::format("mesh {0}/f1.ply {0}/f2.ply --out {0}/drive.ply", dir.path().string()));
+  ASSERT_EQ(both.exit_code, 0) << both.err;
+  EXPECT_NE(both.out.find("2 frame(s)"), std::string::npos) << both.out;
+  const Mesh f1 = read_mesh(dir / "f1_mesh.ply").mesh, f2 = read_mesh(dir / "f2_mesh.ply").mesh;
+  const Mesh drive = read_mesh(dir / "drive.ply").mesh;
+  ASSERT_GT(f1.triangle_count(), 500u);
+  ASSERT_EQ(drive.triangle_count(), f1.triangle_count() + f2.triangle_count());
+  ASSERT_EQ(drive.vertex_count(), f1.vertex_count() + f2.vertex_count());
+  // The first frame's triangles, then the second's, the same corners (world coordinates) and
+  // sensor positions as meshed alone: no triangle joins the two frames.
+  for (std::size_t t = 0; t < drive.triangle_count(); ++t) {
+    const bool first = t < f1.triangle_count();
+    const Mesh& alone = first ? f1 : f2;
+    const std::size_t u = first ? t : t - f1.triangle_count();
+    for (int k = 0; k < 3; ++k) {
+      const Vec3d a = drive.world_position(drive.triangles[t][k]), b = alone.world_position(alone.triangles[u][k]);
+      ASSERT_LT(norm(a - b), 1e-4) << t;
+      const Vec3d sa = drive.world_sensor_position(drive.triangles[t][k]);
+      const Vec3d sb = alone.world_sensor_position(alone.triangles[u][k]);
+      ASSERT_LT(norm(sa - sb), 1e-4) << t;
+    }
+  }
 }
 
 }  // namespace

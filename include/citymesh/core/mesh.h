@@ -91,6 +91,12 @@ struct Mesh {
 /// meshes share one origin.
 void append_vertex(const Mesh& from, std::uint32_t v, Mesh& to);
 
+/// Appends every vertex and triangle of `from` to `to`, whose origin may differ: positions and
+/// sensor positions are moved into `to`'s frame, the other per-vertex attributes `from`
+/// carries are copied, and each triangle keeps its acquisition and takes its index in `to` as
+/// its face. Throws ProcessingError when the two carry different attributes.
+void append_mesh(const Mesh& from, Mesh& to);
+
 /// Converts an absolute position to floats relative to `origin`.
 inline Vec3f to_local(const Vec3d& p, const Vec3d& origin) { return Vec3f(p - origin); }
 
