@@ -72,7 +72,12 @@ class MeshCommand final : public Command {
       const SensorGrid grid = spinning_grid(path);
       const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
       if (drive.vertex_count() == 0) drive.origin = r.mesh.origin;
-      append_mesh(r.mesh, drive);
+      try {
+        append_mesh(r.mesh, drive);
+      } catch (const ProcessingError& e) {
+        throw InputError(fmt::format("{}: its points carry other properties than the frames before it ({})",
+                                     path.string(), e.what()));
+      }
       cells += std::count(grid.valid.begin(), grid.valid.end(), 1);
       stats.candidates += r.stats.candidates;
       stats.rejected_long_edge += r.stats.rejected_long_edge;
