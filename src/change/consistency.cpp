@@ -68,9 +68,11 @@ void pairs_of(const TriangleFrames& f, std::size_t g, std::span<const std::uint3
   for (const std::uint32_t u : hits) {
     const bool same_acquisition = u >= own_begin && u < own_end;
     if (u == t || dot(f.normal[g], f.normal[u]) < cos_min) continue;
+    // Most hits of g's own pass are its neighbours on one sheet: told apart before the
+    // overlap tests, which they would mostly fail anyway.
+    if (same_acquisition && share_a_corner(f, t, u)) continue;
     if (!overlaps(Vec3d(f.centroid[g]), f, u, threshold)) continue;
     if (t > u && f.asks(u) && overlaps(Vec3d(f.centroid[u]), f, t, threshold)) continue;  // u lists it
-    if (same_acquisition && share_a_corner(f, t, u)) continue;                            // neighbours on one sheet
     (same_acquisition ? out.layers : out.consistent).emplace_back(std::min(t, u), std::max(t, u));
   }
 }

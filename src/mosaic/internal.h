@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "citymesh/core/geometry.h"
 #include "citymesh/mosaic/mosaic.h"
 
 namespace citymesh::mosaic_detail {
@@ -17,5 +18,9 @@ void check_mosaic_input(const MosaicInput& input);
 /// that where a pass is listed in the config (a late delivery appended after newer passes)
 /// does not change what is selected.
 std::vector<std::size_t> date_order(const MosaicInput& input);
+
+/// Whether p lies within `reach` of triangle q's plane and projects inside it (edges
+/// included): p is on q, not merely beside it.
+bool lies_over(const Vec3d& p, const TriangleCorners& q, double reach);
 
 }  // namespace citymesh::mosaic_detail

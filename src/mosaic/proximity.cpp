@@ -8,27 +8,9 @@
 #include "citymesh/core/geometry.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/spatial/box_tree.h"
+#include "internal.h"
 
 namespace citymesh {
-
-namespace {
-
-/// p within `reach` of the triangle's plane and projecting inside it.
-bool over(const Vec3d& p, const TriangleCorners& q, double reach) {
-  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
-  const double len = norm(winding);
-  if (!(len > 0)) return false;
-  const Vec3d n = winding / len;
-  const double h = dot(p - q[0], n);
-  if (std::abs(h) > reach) return false;
-  const Vec3d f = p - n * h;
-  for (int k = 0; k < 3; ++k) {
-    if (dot(cross(q[(k + 1) % 3] - q[k], f - q[k]), winding) < 0) return false;
-  }
-  return true;
-}
-
-}  // namespace
 
 MeshProximity::MeshProximity(const Mesh& mesh, double max_reach) : mesh_(mesh) {
   std::vector<Box3f> boxes(mesh.triangle_count());
@@ -69,11 +51,26 @@ void MeshProximity::any_within_each(std::span<const Vec3d> points, double reach,
 
 namespace citymesh {
 
+bool mosaic_detail::lies_over(const Vec3d& p, const TriangleCorners& q, double reach) {
+  const Vec3d winding = cross(q[1] - q[0], q[2] - q[0]);
+  const double len = norm(winding);
+  if (!(len > 0)) return false;
+  const Vec3d n = winding / len;
+  const double h = dot(p - q[0], n);
+  if (std::abs(h) > reach) return false;
+  const Vec3d f = p - n * h;
+  for (int k = 0; k < 3; ++k) {
+    if (dot(cross(q[(k + 1) % 3] - q[k], f - q[k]), winding) < 0) return false;
+  }
+  return true;
+}
+
 bool MeshProximity::any_over(const Vec3d& p, double reach, const std::function<bool(std::uint32_t)>& accept) const {
   thread_local std::vector<std::uint32_t> hits;
   tree_->containing(Vec3f(p), hits);
-  return std::any_of(hits.begin(), hits.end(),
-                     [&](std::uint32_t t) { return (!accept || accept(t)) && over(p, mesh_.corners(t), reach); });
+  return std::any_of(hits.begin(), hits.end(), [&](std::uint32_t t) {
+    return (!accept || accept(t)) && mosaic_detail::lies_over(p, mesh_.corners(t), reach);
+  });
 }
 
 }  // namespace citymesh

@@ -170,8 +170,7 @@ MosaicSelection select_update_model(const MosaicInput& input) {
 
 namespace {
 
-/// Whether the centroid of global triangle g lies on global triangle u: within `reach` of its
-/// plane, projecting inside it (edges included).
+/// Whether the centroid of global triangle g lies on global triangle u (lies_over).
 bool centroid_on(const MosaicInput& input, std::uint32_t g, std::uint32_t u, double reach) {
   const GlobalTriangles& index = input.change->index;
   const auto corners = [&](std::uint32_t t) {
@@ -179,17 +178,7 @@ bool centroid_on(const MosaicInput& input, std::uint32_t g, std::uint32_t u, dou
     return input.meshes[a].corners(t - index.offsets[a]);
   };
   const auto [p, q, r] = corners(g);
-  const TriangleCorners on = corners(u);
-  const Vec3d n = cross(on[1] - on[0], on[2] - on[0]);
-  const double n_sq = dot(n, n);
-  if (!(n_sq > 0)) return false;
-  const Vec3d c = (p + q + r) / 3.0;
-  const double h = dot(c - on[0], n) / std::sqrt(n_sq);
-  if (std::abs(h) > reach) return false;
-  for (int k = 0; k < 3; ++k) {
-    if (dot(cross(on[(k + 1) % 3] - on[k], c - on[k]), n) < 0) return false;  // c's foot is outside
-  }
-  return true;
+  return mosaic_detail::lies_over((p + q + r) / 3.0, corners(u), reach);
 }
 
 }  // namespace
