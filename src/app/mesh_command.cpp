@@ -63,30 +63,38 @@ class MeshCommand final : public Command {
 
  private:
   /// Each frame meshed on its own grid, the frames of one drive in one mesh (as the simulator
-  /// writes a spinning pass: its turns overlap, and the mosaic keeps one layer of them).
+  /// writes a spinning pass: its turns overlap, and the mosaic keeps one layer of them). The
+  /// frames go to the file one by one: a drive of thousands of frames never is in memory.
   void mesh_spinning_frames(const std::vector<std::filesystem::path>& paths) const {
-    Mesh drive;
+    std::unique_ptr<PlySpoolWriter> out;
     SensorMeshStats stats;
     std::int64_t cells = 0;
+    std::uint64_t triangles = 0;
     for (const std::filesystem::path& path : paths) {
       const SensorGrid grid = spinning_grid(path);
-      const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
-      if (drive.vertex_count() == 0) drive.origin = r.mesh.origin;
+      SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
+      const MeshVertexRows rows = mesh_vertex_rows(r.mesh, 0, r.mesh.vertex_count());
+      const PlyWriteInput frame{rows.positions, {}, rows.columns(), {}, {std::string(kPlyComment)}};
+      if (out == nullptr) out = std::make_unique<PlySpoolWriter>(out_, frame);
+      const auto first = static_cast<std::uint32_t>(out->vertices());
+      for (Triangle& t : r.mesh.triangles) t = {t[0] + first, t[1] + first, t[2] + first};
       try {
-        append_mesh(r.mesh, drive);
+        out->add_vertices(frame);
       } catch (const ProcessingError& e) {
         throw InputError(fmt::format("{}: its points carry other properties than the frames before it ({})",
                                      path.string(), e.what()));
       }
+      out->add_faces({{}, r.mesh.triangles, {}, {}, {}});
       cells += std::count(grid.valid.begin(), grid.valid.end(), 1);
+      triangles += r.mesh.triangle_count();
       stats.candidates += r.stats.candidates;
       stats.rejected_long_edge += r.stats.rejected_long_edge;
       stats.rejected_depth_jump += r.stats.rejected_depth_jump;
       stats.rejected_grazing += r.stats.rejected_grazing;
     }
-    write_mesh_ply(out_, drive);
+    out->commit();
     std::cout << fmt::format("{}: spinning layout, {} frame(s), {} points, {} triangles\n", out_, paths.size(), cells,
-                             drive.triangle_count());
+                             triangles);
     print_rejected(stats);
   }
 

@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <bit>
+#include <cstdio>
 #include <cstring>
+#include <functional>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
@@ -74,12 +76,19 @@ inline char* put_value(char* at, const char* from, std::size_t size) {
   return at + size;
 }
 
+/// Where rows go: the output file, or a spool file behind it.
+using ByteSink = std::function<void(const char*, std::size_t)>;
+
+ByteSink sink_of(AtomicFile& file) {
+  return [&file](const char* data, std::size_t size) { file.write(data, size); };
+}
+
 /// Fixed-size rows gathered in a buffer and handed to the file in large blocks: a value at a
 /// time through a growing vector and a variant visit was a tenth of writing a labelled PLY.
 class RowWriter {
  public:
-  RowWriter(AtomicFile& file, std::span<const RawColumn> columns, std::size_t lead_bytes)
-      : file_(file), columns_(columns), row_bytes_(lead_bytes) {
+  RowWriter(ByteSink sink, std::span<const RawColumn> columns, std::size_t lead_bytes)
+      : sink_(std::move(sink)), columns_(columns), row_bytes_(lead_bytes) {
     for (const RawColumn& c : columns_) row_bytes_ += c.size;
     buffer_.resize(std::max(kBlock, row_bytes_));
   }
@@ -96,18 +105,43 @@ class RowWriter {
     used_ += row_bytes_;
   }
   void flush() {
-    file_.write(buffer_.data(), used_);
+    sink_(buffer_.data(), used_);
     used_ = 0;
   }
 
  private:
   static constexpr std::size_t kBlock = 1u << 20;
-  AtomicFile& file_;
+  ByteSink sink_;
   std::span<const RawColumn> columns_;
   std::size_t row_bytes_;
   std::vector<char> buffer_;
   std::size_t used_ = 0;
 };
+
+/// `chunk`'s vertex rows (x, y, z, then its vertex columns), as the header declares them.
+void write_vertex_rows(const ByteSink& sink, const PlyWriteInput& chunk) {
+  const std::vector<RawColumn> columns = raw_columns(chunk.vertex_columns);
+  RowWriter out(sink, columns, sizeof(Vec3d));
+  for (std::size_t v = 0; v < chunk.positions.size(); ++v) {
+    char* at = out.start_row();
+    std::memcpy(at, &chunk.positions[v], sizeof(Vec3d));
+    out.finish_row(at + sizeof(Vec3d), v);
+  }
+  out.flush();
+}
+
+/// `chunk`'s face rows (the corner list, then its face columns), as the header declares them.
+void write_face_rows(const ByteSink& sink, const PlyWriteInput& chunk) {
+  const std::vector<RawColumn> columns = raw_columns(chunk.face_columns);
+  RowWriter out(sink, columns, 1 + sizeof(Triangle));
+  for (std::size_t f = 0; f < chunk.triangles.size(); ++f) {
+    char* at = out.start_row();
+    *at = 3;  // the list's length
+    std::memcpy(at + 1, &chunk.triangles[f], sizeof(Triangle));
+    out.finish_row(at + 1 + sizeof(Triangle), f);
+  }
+  out.flush();
+}
 
 std::string make_header(const PlyWriteInput& in, std::uint64_t vertices, std::uint64_t faces) {
   std::string h = "ply\nformat binary_little_endian 1.0\n";
@@ -160,14 +194,7 @@ void PlyStreamWriter::add_vertices(const PlyWriteInput& chunk) {
     throw ProcessingError(fmt::format("{}: vertex rows that do not fit the header", path.string()));
   }
   check_columns(chunk.vertex_columns, chunk.positions.size(), "vertex", path);
-  const std::vector<RawColumn> columns = raw_columns(chunk.vertex_columns);
-  RowWriter out(impl_->file, columns, sizeof(Vec3d));
-  for (std::size_t v = 0; v < chunk.positions.size(); ++v) {
-    char* at = out.start_row();
-    std::memcpy(at, &chunk.positions[v], sizeof(Vec3d));
-    out.finish_row(at + sizeof(Vec3d), v);
-  }
-  out.flush();
+  write_vertex_rows(sink_of(impl_->file), chunk);
   impl_->vertices_written += chunk.positions.size();
 }
 
@@ -178,15 +205,7 @@ void PlyStreamWriter::add_faces(const PlyWriteInput& chunk) {
     throw ProcessingError(fmt::format("{}: face rows that do not fit the header", path.string()));
   }
   check_columns(chunk.face_columns, chunk.triangles.size(), "face", path);
-  const std::vector<RawColumn> columns = raw_columns(chunk.face_columns);
-  RowWriter out(impl_->file, columns, 1 + sizeof(Triangle));
-  for (std::size_t f = 0; f < chunk.triangles.size(); ++f) {
-    char* at = out.start_row();
-    *at = 3;  // the list's length
-    std::memcpy(at + 1, &chunk.triangles[f], sizeof(Triangle));
-    out.finish_row(at + 1 + sizeof(Triangle), f);
-  }
-  out.flush();
+  write_face_rows(sink_of(impl_->file), chunk);
   impl_->faces_written += chunk.triangles.size();
 }
 
@@ -196,6 +215,99 @@ void PlyStreamWriter::commit() {
                                       impl_->vertices_written, impl_->vertices, impl_->faces_written, impl_->faces));
   }
   impl_->file.commit();
+}
+
+namespace {
+
+/// A scratch file beside `output`, unlinked as soon as it is open: nothing is left behind,
+/// even by a killed process, and the disk of the output (not /tmp) holds it.
+class SpoolFile {
+ public:
+  SpoolFile(const std::filesystem::path& output, std::string_view part) : output_(output) {
+    std::filesystem::path name = output;
+    name += fmt::format(".{}{}{}", part, kTemporaryInfix, process_tag());
+    file_ = std::fopen(name.c_str(), "w+b");
+    if (file_ == nullptr) throw OutputError(fmt::format("{}: cannot open a scratch file beside it", output.string()));
+    std::filesystem::remove(name);
+  }
+  SpoolFile(const SpoolFile&) = delete;
+  SpoolFile& operator=(const SpoolFile&) = delete;
+  ~SpoolFile() { std::fclose(file_); }
+
+  void write(const char* data, std::size_t size) {
+    if (size > 0 && std::fwrite(data, 1, size, file_) != size) {
+      throw OutputError(fmt::format("{}: cannot write its scratch file (disk full?)", output_.string()));
+    }
+  }
+  /// Everything written so far, appended to `out`.
+  void copy_to(AtomicFile& out) {
+    if (std::fflush(file_) != 0 || std::fseek(file_, 0, SEEK_SET) != 0) {
+      throw OutputError(fmt::format("{}: cannot read back its scratch file", output_.string()));
+    }
+    std::vector<char> block(1u << 20);
+    while (const std::size_t got = std::fread(block.data(), 1, block.size(), file_)) out.write(block.data(), got);
+    if (std::ferror(file_) != 0)
+      throw OutputError(fmt::format("{}: cannot read back its scratch file", output_.string()));
+  }
+
+ private:
+  std::filesystem::path output_;
+  std::FILE* file_ = nullptr;
+};
+
+}  // namespace
+
+struct PlySpoolWriter::Impl {
+  std::filesystem::path path;
+  PlyWriteInput layout;
+  SpoolFile vertex_rows, face_rows;
+  std::uint64_t vertices = 0, faces = 0;
+  std::uint32_t largest_corner = 0;
+  Impl(const std::filesystem::path& p, PlyWriteInput l)
+      : path(p), layout(std::move(l)), vertex_rows(p, "vertices"), face_rows(p, "faces") {}
+};
+
+PlySpoolWriter::PlySpoolWriter(const std::filesystem::path& path, const PlyWriteInput& layout)
+    : impl_(std::make_unique<Impl>(
+          path, PlyWriteInput{{}, {}, layout.vertex_columns, layout.face_columns, layout.comments})) {}
+
+PlySpoolWriter::~PlySpoolWriter() = default;
+
+void PlySpoolWriter::add_vertices(const PlyWriteInput& chunk) {
+  if (!same_columns(impl_->layout.vertex_columns, chunk.vertex_columns)) {
+    throw ProcessingError(fmt::format("{}: vertex rows with other properties than the first", impl_->path.string()));
+  }
+  check_columns(chunk.vertex_columns, chunk.positions.size(), "vertex", impl_->path);
+  if (impl_->vertices + chunk.positions.size() > std::uint64_t{UINT32_MAX} + 1) {
+    throw ProcessingError(
+        fmt::format("{}: more than 2^32 vertices, past what a face's uint index names", impl_->path.string()));
+  }
+  write_vertex_rows([&](const char* data, std::size_t size) { impl_->vertex_rows.write(data, size); }, chunk);
+  impl_->vertices += chunk.positions.size();
+}
+
+void PlySpoolWriter::add_faces(const PlyWriteInput& chunk) {
+  if (!same_columns(impl_->layout.face_columns, chunk.face_columns)) {
+    throw ProcessingError(fmt::format("{}: face rows with other properties than the first", impl_->path.string()));
+  }
+  check_columns(chunk.face_columns, chunk.triangles.size(), "face", impl_->path);
+  for (const Triangle& t : chunk.triangles) impl_->largest_corner = std::max({impl_->largest_corner, t[0], t[1], t[2]});
+  write_face_rows([&](const char* data, std::size_t size) { impl_->face_rows.write(data, size); }, chunk);
+  impl_->faces += chunk.triangles.size();
+}
+
+std::uint64_t PlySpoolWriter::vertices() const { return impl_->vertices; }
+
+void PlySpoolWriter::commit() {
+  if (impl_->faces > 0 && impl_->largest_corner >= impl_->vertices) {
+    throw ProcessingError(fmt::format("{}: a face uses vertex {}, of {} vertices", impl_->path.string(),
+                                      impl_->largest_corner, impl_->vertices));
+  }
+  AtomicFile out(impl_->path);
+  out.write(make_header(impl_->layout, impl_->vertices, impl_->faces));
+  impl_->vertex_rows.copy_to(out);
+  impl_->face_rows.copy_to(out);
+  out.commit();
 }
 
 void write_ply(const std::filesystem::path& path, const PlyWriteInput& in) {

@@ -155,5 +155,69 @@ TEST(PlyStreamWriter, RowsThatDoNotFitTheHeaderAreRefusedAndNothingIsWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir / "other.ply"));
 }
 
+TEST(PlySpoolWriter, InterleavedChunksGiveTheBytesOfTheWholeWriteAndLeaveNoScratchFile) {
+  test::TempDir dir;
+  const Mesh m = random_mesh(13, 300, 500);
+  std::vector<std::int32_t> source(m.triangle_count());
+  for (std::size_t t = 0; t < source.size(); ++t) source[t] = static_cast<std::int32_t>(t % 7) - 1;
+  write_mesh_ply(dir / "whole.ply", m, {{"source_acq", std::span<const std::int32_t>(source)}});
+
+  const MeshVertexRows all = rows_of(m, 0, m.vertex_count());
+  const PlyWriteInput layout{
+      {}, {}, all.columns(), {{"source_acq", std::span<const std::int32_t>(source)}}, {std::string(kPlyComment)}};
+  {
+    PlySpoolWriter out(dir / "spooled.ply", layout);
+    // Faces before the vertices they use, as a drive's frames come: rows of both kinds in turn.
+    std::size_t next_vertex = 0, next_face = 0;
+    while (next_vertex < m.vertex_count() || next_face < m.triangle_count()) {
+      const std::size_t n = std::min<std::size_t>(110, m.triangle_count() - next_face);
+      out.add_faces({{},
+                     std::span(m.triangles).subspan(next_face, n),
+                     {},
+                     {{"source_acq", std::span<const std::int32_t>(source).subspan(next_face, n)}},
+                     {}});
+      next_face += n;
+      const MeshVertexRows rows = rows_of(m, next_vertex, std::min(next_vertex + 70, m.vertex_count()));
+      out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
+      next_vertex += rows.positions.size();
+      EXPECT_EQ(out.vertices(), next_vertex);
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "spooled.ply")) << "nothing before commit";
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 1) << "scratch files are unlinked";
+    out.commit();
+  }
+  EXPECT_EQ(test::read_text(dir / "spooled.ply"), test::read_text(dir / "whole.ply"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 2) << "nothing but the two outputs";
+}
+
+TEST(PlySpoolWriter, RowsOfOtherColumnsOrFacesOnMissingVerticesAreRefusedAndNothingIsWritten) {
+  test::TempDir dir;
+  const Mesh m = random_mesh(14, 20, 10);
+  const MeshVertexRows rows = rows_of(m, 0, m.vertex_count());
+  const PlyWriteInput layout{{}, {}, rows.columns(), {}, {}};
+  {
+    PlySpoolWriter out(dir / "short.ply", layout);
+    out.add_vertices({std::span(rows.positions).first(m.vertex_count() - 1),
+                      {},
+                      rows_of(m, 0, m.vertex_count() - 1).columns(),
+                      {},
+                      {}});
+    const std::vector<Triangle> uses_the_missing{{0, 1, static_cast<std::uint32_t>(m.vertex_count() - 1)}};
+    out.add_faces({{}, uses_the_missing, {}, {}, {}});
+    EXPECT_THROW(out.commit(), ProcessingError);  // the face's last corner never came
+  }
+  {
+    PlySpoolWriter out(dir / "other.ply", layout);
+    const MeshVertexRows bare({});
+    EXPECT_THROW(out.add_vertices({rows.positions, {}, bare.columns(), {}, {}}), ProcessingError);  // other columns
+    const std::vector<std::int32_t> extra(m.triangle_count(), 1);
+    EXPECT_THROW(out.add_faces({{}, m.triangles, {}, {{"source_acq", std::span<const std::int32_t>(extra)}}, {}}),
+                 ProcessingError);
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "short.ply"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "other.ply"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir.path()), {}), 0) << "no scratch file left";
+}
+
 }  // namespace
 }  // namespace citymesh

@@ -58,6 +58,33 @@ class PlyStreamWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+/// A PLY written in parts whose counts are known only at the end (a drive meshed frame by
+/// frame): vertex and face rows may come in any order, faces naming vertices by their index
+/// in the whole file. Both are spooled to scratch files beside the output (unlinked at once:
+/// a killed process leaves nothing) and copied behind the header by commit(), which writes as
+/// write_ply writes. Memory: one chunk at a time.
+class PlySpoolWriter {
+ public:
+  /// `layout`'s columns name the vertex and face properties and their types (its rows are not
+  /// read). Throws OutputError naming the file when no scratch file can be made beside it.
+  PlySpoolWriter(const std::filesystem::path& path, const PlyWriteInput& layout);
+  ~PlySpoolWriter();
+  PlySpoolWriter(const PlySpoolWriter&) = delete;
+  PlySpoolWriter& operator=(const PlySpoolWriter&) = delete;
+  /// Appends `chunk`'s vertex rows. Throws ProcessingError when its columns are not the layout's.
+  void add_vertices(const PlyWriteInput& chunk);
+  /// Appends `chunk`'s face rows. Throws ProcessingError when its columns are not the layout's.
+  void add_faces(const PlyWriteInput& chunk);
+  /// The vertex rows added so far: the index the next chunk's first vertex takes.
+  [[nodiscard]] std::uint64_t vertices() const;
+  /// Writes the file. Throws ProcessingError when a face uses a vertex that never came.
+  void commit();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Writes `input` to `path` (temporary name, fsync, rename). Throws ProcessingError when a
 /// column's size disagrees with its element, OutputError when the file cannot be written.
 void write_ply(const std::filesystem::path& path, const PlyWriteInput& input);
