@@ -185,8 +185,15 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
   sort_unless_sorted(r.refuted.begin(), r.refuted.end());
   // The pairs of layers of one pass go with the consistent pairs: a reader tells them apart
-  // by their acquisitions, the same for both.
+  // by their acquisitions, the same for both. Each list comes sorted: merged, not sorted again
+  // (sorting them was 4 % of a spinning scanner's tile, which holds millions of both).
+  const auto by_ends = [](const LabelPair& x, const LabelPair& y) {
+    return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <
+           std::tie(y.a_acquisition, y.a_index, y.b_acquisition, y.b_index);
+  };
+  std::size_t layers_from = 0;
   for (const auto& pairs : {std::span(change.consistent_pairs), std::span(change.layer_pairs)}) {
+    layers_from = r.pairs.size();
     for (const auto& [g, h] : pairs) {
       if (!owned(g) && !owned(h)) continue;
       auto x = id(g), y = id(h);
@@ -194,10 +201,11 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
       r.pairs.push_back({x.first, x.second, y.first, y.second});
     }
   }
-  sort_unless_sorted(r.pairs.begin(), r.pairs.end(), [](const LabelPair& x, const LabelPair& y) {
-    return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <
-           std::tie(y.a_acquisition, y.a_index, y.b_acquisition, y.b_index);
-  });
+  const auto middle = r.pairs.begin() + static_cast<std::ptrdiff_t>(layers_from);
+  if (std::is_sorted(r.pairs.begin(), middle, by_ends) && std::is_sorted(middle, r.pairs.end(), by_ends)) {
+    std::inplace_merge(r.pairs.begin(), middle, r.pairs.end(), by_ends);
+  }
+  sort_unless_sorted(r.pairs.begin(), r.pairs.end(), by_ends);
   return r;
 }
 

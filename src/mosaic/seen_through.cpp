@@ -70,6 +70,8 @@ class EmptySpace {
 
 /// Triangles of the other pass whose empty spaces share one tree query.
 constexpr std::size_t kRun = 16;
+/// Above this many points in a run's box, each triangle's box is asked on its own.
+constexpr std::size_t kFewHits = 4 * kRun;
 
 }  // namespace
 
@@ -109,15 +111,26 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         }
         if (all.empty()) continue;
         tree.overlapping({Vec3f(all.min), Vec3f(all.max)}, hits);
-        for (const std::uint32_t i : hits) {
-          if (mesh_of[i] == b) continue;
-          for (std::size_t k = 0; k < spaces.size(); ++k) {
-            if (!boxes[k].contains(centroid[i])) continue;
-            // Flags are only raised: any order of raising gives the same result.
-            std::atomic_ref<std::uint8_t> flag(seen[i]);
-            if (flag.load(std::memory_order_relaxed) != 0) break;
-            if (spaces[k].contains(centroid[i], params)) flag.store(1, std::memory_order_relaxed);
+        // Flags are only raised: any order of raising gives the same result.
+        const auto ask = [&](std::uint32_t i, std::size_t k) {
+          if (mesh_of[i] == b || !boxes[k].contains(centroid[i])) return;
+          std::atomic_ref<std::uint8_t> flag(seen[i]);
+          if (flag.load(std::memory_order_relaxed) == 0 && spaces[k].contains(centroid[i], params)) {
+            flag.store(1, std::memory_order_relaxed);
           }
+        };
+        if (hits.size() <= kFewHits) {
+          for (const std::uint32_t i : hits) {
+            for (std::size_t k = 0; k < spaces.size(); ++k) ask(i, k);
+          }
+          continue;
+        }
+        // Large empty spaces (a spinning scanner's far, grazing triangles: thousands of points
+        // in a run's box): a query per triangle instead of every point against every box.
+        for (std::size_t k = 0; k < spaces.size(); ++k) {
+          if (boxes[k].empty()) continue;
+          tree.overlapping({Vec3f(boxes[k].min), Vec3f(boxes[k].max)}, hits);
+          for (const std::uint32_t i : hits) ask(i, k);
         }
       }
     });

@@ -103,8 +103,10 @@ bool brute_force_seen(const Vec3d& p, const Vec3d& v, const std::array<Vec3d, 3>
   return h > params.margin && h <= params.depth;
 }
 
-TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
-  std::mt19937 rng(5);
+/// Random scenes of three passes of `per_pass` small triangles each, seen from above: the
+/// flags of pass 0's triangles against brute force; returns how many are seen through.
+std::size_t check_random_scenes_against_brute_force(int per_pass, std::uint32_t seed) {
+  std::mt19937 rng(seed);
   std::uniform_real_distribution<float> u(-1.5f, 1.5f), corner(-0.4f, 0.4f), height(2.0f, 8.0f);
   const SeenThroughParams params{.margin = 0.1, .depth = 0.8};
   std::size_t seen_count = 0;
@@ -113,7 +115,7 @@ TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
     for (int pass = 0; pass < 3; ++pass) {
       std::vector<std::array<Vec3f, 3>> corners;
       std::vector<Vec3f> sensors;
-      for (int t = 0; t < 60; ++t) {
+      for (int t = 0; t < per_pass; ++t) {
         const Vec3f c{u(rng), u(rng), u(rng) * 0.3f};
         corners.push_back({c + Vec3f{corner(rng), corner(rng), corner(rng) * 0.2f},
                            c + Vec3f{corner(rng), corner(rng), corner(rng) * 0.2f},
@@ -123,7 +125,8 @@ TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
       meshes.push_back(triangles_seen_from(corners, sensors));
     }
     GlobalTriangles index;
-    index.offsets = {0, 60, 120, 180};
+    const auto n = static_cast<std::uint32_t>(per_pass);
+    index.offsets = {0, n, 2 * n, 3 * n};
     std::vector<std::uint32_t> ids(meshes[0].triangle_count());
     for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = i;
     const std::vector<std::uint8_t> seen = seen_through(meshes, index, ids, params);
@@ -140,7 +143,17 @@ TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
       seen_count += expected ? 1 : 0;
     }
   }
-  EXPECT_GT(seen_count, 50u) << "the scenes must exercise the positive case";
+  return seen_count;
+}
+
+TEST(SeenThrough, AgreesWithBarycentricCoordinatesOnRandomScenes) {
+  EXPECT_GT(check_random_scenes_against_brute_force(60, 5), 50u) << "the scenes must exercise the positive case";
+}
+
+TEST(SeenThrough, AgreesWithBarycentricCoordinatesWhereEachEmptySpaceHoldsManyPoints) {
+  // Ten times the triangles in the same volume: a run of empty spaces holds hundreds of the
+  // points asked about, and each space is asked on its own.
+  EXPECT_GT(check_random_scenes_against_brute_force(600, 6), 500u) << "the scenes must exercise the positive case";
 }
 
 /// Pass 0: three small triangles 0.3 m up, the first two over pass 1's 4 m x 4 m floor (in its
