@@ -49,12 +49,14 @@ class MeshCommand final : public Command {
     if (layout == "profiler") {
       ProfilerGridParams p;
       p.echo = echo_ == "last" ? ProfilerGridParams::Echo::last : ProfilerGridParams::Echo::first;
-      const SensorGrid grid = profiler_grid(paths, p);
+      SensorGrid grid = profiler_grid(paths, p);
       const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
-      write_mesh_ply(out_, r.mesh);
       const auto cells = std::count(grid.valid.begin(), grid.valid.end(), 1);
-      std::cout << fmt::format("{}: {} layout, grid {} x {}, {} points, {} triangles\n", out_, layout, grid.rows,
-                               grid.cols, cells, r.mesh.triangle_count());
+      const std::string shape = fmt::format("grid {} x {}", grid.rows, grid.cols);
+      grid = SensorGrid{};  // not needed to write the mesh: its memory goes back first
+      write_mesh_ply(out_, r.mesh);
+      std::cout << fmt::format("{}: {} layout, {}, {} points, {} triangles\n", out_, layout, shape, cells,
+                               r.mesh.triangle_count());
       print_rejected(r.stats);
       return;
     }

@@ -19,14 +19,15 @@ struct Pulse {
   std::size_t line = 0;
 };
 
-/// Reads every chosen echo of every file, in order, and numbers the scan lines.
-std::vector<Pulse> read_pulses(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& p,
-                               PlyReadParams read) {
+/// Calls visit(pulse) for every chosen echo of every file, in order, with its scan line.
+template <class Visit>
+void for_each_pulse(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& p, PlyReadParams read,
+                    Visit&& visit) {
   read.extra_vertex_properties = {p.angle_property, p.echo_index_property, p.echo_count_property};
   read.require_sensor_origin = true;
-  std::vector<Pulse> pulses;
   std::size_t line = 0;
   double previous = 0;
+  bool first = true;
   for (const auto& file : files) {
     PlyReader reader(file, read);
     PlyVertexChunk v;
@@ -37,48 +38,67 @@ std::vector<Pulse> read_pulses(const std::vector<std::filesystem::path>& files, 
         const double angle = v.extras[0][i], echo = v.extras[1][i], echoes = v.extras[2][i];
         const bool chosen = p.echo == ProfilerGridParams::Echo::first ? echo == 1 : echo == echoes;
         if (!chosen) continue;
-        if (!pulses.empty() && angle < previous - M_PI) ++line;  // the angle wrapped: next line
+        if (!first && angle < previous - M_PI) ++line;  // the angle wrapped: next line
+        first = false;
         previous = angle;
-        pulses.push_back({v.positions[i], v.sensor_positions[i], v.times.empty() ? 0.0 : v.times[i], angle, line});
+        visit(Pulse{v.positions[i], v.sensor_positions[i], v.times.empty() ? 0.0 : v.times[i], angle, line});
       }
     }
   }
-  return pulses;
 }
 
-/// Median angle step between successive pulses of a line (ignoring gaps and wraps).
-double median_step(const std::vector<Pulse>& pulses) {
+/// What the first pass over the pulses finds: how many, the scan lines, the first point (the
+/// grid's origin) and the median angle step between successive pulses of a line (ignoring
+/// gaps and wraps).
+struct PulseSurvey {
+  std::size_t pulses = 0, lines = 0;
+  Vec3d first_point;
+  double step = 0;
+};
+
+PulseSurvey survey_pulses(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& p,
+                          const PlyReadParams& read) {
+  PulseSurvey survey;
   std::vector<double> steps;
-  for (std::size_t i = 1; i < pulses.size(); ++i) {
-    const double d = pulses[i].angle - pulses[i - 1].angle;
-    if (pulses[i].line == pulses[i - 1].line && d > 0) steps.push_back(d);
-  }
+  Pulse previous;
+  for_each_pulse(files, p, read, [&](const Pulse& pulse) {
+    if (survey.pulses == 0) survey.first_point = pulse.point;
+    const double d = pulse.angle - previous.angle;
+    if (survey.pulses > 0 && pulse.line == previous.line && d > 0) steps.push_back(d);
+    previous = pulse;
+    ++survey.pulses;
+    survey.lines = pulse.line + 1;
+  });
+  if (survey.pulses < 2) throw InputError(fmt::format("{}: too few points to mesh", files.front().string()));
   if (steps.empty()) throw InputError("mesh: too few pulses to find the angular step of the scanner");
   std::nth_element(steps.begin(), steps.begin() + std::ptrdiff_t(steps.size() / 2), steps.end());
-  return steps[steps.size() / 2];
+  survey.step = steps[steps.size() / 2];
+  return survey;
 }
 
 }  // namespace
 
 SensorGrid profiler_grid(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& params,
                          PlyReadParams read) {
-  const std::vector<Pulse> pulses = read_pulses(files, params, std::move(read));
-  if (pulses.size() < 2) throw InputError(fmt::format("{}: too few points to mesh", files.front().string()));
-  const double step = median_step(pulses);
+  // Two passes over the files, so that the pulses are never all held (72 bytes each, and the
+  // list's regrowth, were the peak of meshing a long drive): the first finds the lines and
+  // the angular step, the second fills the grid.
+  const PulseSurvey survey = survey_pulses(files, params, read);
+  const double step = survey.step;
   const auto cols = static_cast<std::size_t>(std::lround(2 * M_PI / step));
   SensorGrid g;
-  g.resize(pulses.back().line + 1, cols, false);
+  g.resize(survey.lines, cols, false);
   g.wrap_columns = true;
-  g.origin = whole_metre_origin(pulses.front().point);
-  for (const Pulse& p : pulses) {
+  g.origin = whole_metre_origin(survey.first_point);
+  for_each_pulse(files, params, std::move(read), [&](const Pulse& p) {
     const double turn = std::fmod(p.angle + 4 * M_PI, 2 * M_PI);
     const std::size_t cell = g.index(p.line, static_cast<std::size_t>(turn / step) % cols);
-    if (g.valid[cell]) continue;  // two pulses in one bin: keep the first
+    if (g.valid[cell]) return;  // two pulses in one bin: keep the first
     g.points[cell] = to_local(p.point, g.origin);
     g.sensors[cell] = to_local(p.sensor, g.origin);
     g.times[cell] = p.time;
     g.valid[cell] = 1;
-  }
+  });
   return g;
 }
 
