@@ -228,7 +228,8 @@ class SpoolFile {
     name += fmt::format(".{}{}{}", part, kTemporaryInfix, process_tag());
     file_ = std::fopen(name.c_str(), "w+b");
     if (file_ == nullptr) throw OutputError(fmt::format("{}: cannot open a scratch file beside it", output.string()));
-    std::filesystem::remove(name);
+    std::error_code ignored;  // a name that cannot be removed only leaves an empty file behind
+    std::filesystem::remove(name, ignored);
   }
   SpoolFile(const SpoolFile&) = delete;
   SpoolFile& operator=(const SpoolFile&) = delete;
@@ -377,8 +378,8 @@ void write_mesh_ply(const std::filesystem::path& path, const Mesh& mesh, std::ve
   // mesh. The bytes are the same (PlyStreamWriter writes chunks as one write would).
   constexpr std::size_t kBlock = 1u << 18;
   const std::size_t n = mesh.vertex_count();
-  const MeshVertexRows layout = mesh_vertex_rows(mesh, 0, std::min(n, std::size_t{1}));
-  const PlyWriteInput header{{}, {}, layout.columns(), face_columns, {std::string(kPlyComment)}};
+  const MeshVertexRows no_rows(vertex_attributes(mesh));  // its columns name the properties
+  const PlyWriteInput header{{}, {}, no_rows.columns(), face_columns, {std::string(kPlyComment)}};
   check_columns(face_columns, mesh.triangle_count(), "face", path);
   PlyStreamWriter out(path, header, n, mesh.triangle_count());
   for (std::size_t first = 0; first < n; first += kBlock) {

@@ -111,17 +111,22 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         }
         if (all.empty()) continue;
         tree.overlapping({Vec3f(all.min), Vec3f(all.max)}, hits);
+        // Whether point i (of another mesh than b) is flagged once empty space k is asked.
         // Flags are only raised: any order of raising gives the same result.
-        const auto ask = [&](std::uint32_t i, std::size_t k) {
-          if (mesh_of[i] == b || !boxes[k].contains(centroid[i])) return;
+        const auto flagged_by = [&](std::uint32_t i, std::size_t k) {
+          if (!boxes[k].contains(centroid[i])) return false;
           std::atomic_ref<std::uint8_t> flag(seen[i]);
-          if (flag.load(std::memory_order_relaxed) == 0 && spaces[k].contains(centroid[i], params)) {
-            flag.store(1, std::memory_order_relaxed);
-          }
+          if (flag.load(std::memory_order_relaxed) != 0) return true;
+          if (!spaces[k].contains(centroid[i], params)) return false;
+          flag.store(1, std::memory_order_relaxed);
+          return true;
         };
         if (hits.size() <= kFewHits) {
           for (const std::uint32_t i : hits) {
-            for (std::size_t k = 0; k < spaces.size(); ++k) ask(i, k);
+            if (mesh_of[i] == b) continue;
+            for (std::size_t k = 0; k < spaces.size(); ++k) {
+              if (flagged_by(i, k)) break;
+            }
           }
           continue;
         }
@@ -130,7 +135,9 @@ std::vector<std::uint8_t> seen_through(std::span<const Mesh> meshes, const Globa
         for (std::size_t k = 0; k < spaces.size(); ++k) {
           if (boxes[k].empty()) continue;
           tree.overlapping({Vec3f(boxes[k].min), Vec3f(boxes[k].max)}, hits);
-          for (const std::uint32_t i : hits) ask(i, k);
+          for (const std::uint32_t i : hits) {
+            if (mesh_of[i] != b) (void)flagged_by(i, k);
+          }
         }
       }
     });

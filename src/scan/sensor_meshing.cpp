@@ -32,9 +32,13 @@ class Mesher {
     vertex_of_.assign(g_.points.size(), kNone);
     // Every range is needed by up to six triangles' tests: compute each once.
     range_.resize(g_.points.size());
-    for (std::size_t i = 0; i < range_.size(); ++i) range_[i] = g_.valid[i] ? norm(g_.points[i] - g_.sensors[i]) : 0.0f;
+    std::size_t valid_cells = 0;
+    for (std::size_t i = 0; i < range_.size(); ++i) {
+      range_[i] = g_.valid[i] ? norm(g_.points[i] - g_.sensors[i]) : 0.0f;
+      valid_cells += g_.valid[i] != 0 ? 1 : 0;
+    }
     result_.mesh.origin = g_.origin;
-    reserve_for_valid_cells();
+    reserve_for(valid_cells);
     const std::size_t col_end = g_.wrap_columns ? g_.cols : g_.cols - 1;
     for (std::size_t r = 0; r + 1 < g_.rows; ++r) {
       for (std::size_t c = 0; c < col_end; ++c) quad(r, c, (c + 1) % g_.cols);
@@ -45,13 +49,11 @@ class Mesher {
  private:
   static constexpr std::uint32_t kNone = UINT32_MAX;
 
-  /// Room for what the grid gives: a vertex per valid cell at most, and two triangles per
-  /// cell (a full grid's count; a ragged one may need more, and grows as before). Grown by
-  /// doubling from nothing, the arrays peaked at up to three times their final size while a
-  /// long drive's mesh was made (the peak of `citymesh mesh`).
-  void reserve_for_valid_cells() {
-    std::size_t cells = 0;
-    for (const std::uint8_t v : g_.valid) cells += v != 0 ? 1 : 0;
+  /// Room for what a grid of `cells` valid cells gives: a vertex per cell at most, and two
+  /// triangles per cell (a full grid's count; a ragged one may need more, and grows as
+  /// before). Grown by doubling from nothing, the arrays peaked at up to three times their
+  /// final size while a long drive's mesh was made (the peak of `citymesh mesh`).
+  void reserve_for(std::size_t cells) {
     Mesh& m = result_.mesh;
     m.positions.reserve(cells);
     m.sensor_positions.reserve(cells);

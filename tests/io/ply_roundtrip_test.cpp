@@ -109,17 +109,29 @@ MeshVertexRows rows_of(const Mesh& m, std::size_t first, std::size_t last) {
   return rows;
 }
 
+/// A random mesh with a source_acq column, written whole by write_mesh_ply to `file`: the
+/// bytes a writer in parts must give, from the layout it is given.
+struct WholeWrite {
+  Mesh mesh;
+  std::vector<std::int32_t> source;
+  MeshVertexRows rows;
+  WholeWrite(const std::filesystem::path& file, std::uint32_t seed, int sources)
+      : mesh(random_mesh(seed, 300, 500)), source(mesh.triangle_count()), rows(rows_of(mesh, 0, mesh.vertex_count())) {
+    for (std::size_t t = 0; t < source.size(); ++t) source[t] = static_cast<std::int32_t>(t % sources) - 1;
+    write_mesh_ply(file, mesh, {{"source_acq", std::span<const std::int32_t>(source)}});
+  }
+  [[nodiscard]] PlyWriteInput layout() const {
+    return {
+        {}, {}, rows.columns(), {{"source_acq", std::span<const std::int32_t>(source)}}, {std::string(kPlyComment)}};
+  }
+};
+
 TEST(PlyStreamWriter, ChunksGiveTheBytesOfTheWholeWrite) {
   test::TempDir dir;
-  const Mesh m = random_mesh(11, 300, 500);
-  std::vector<std::int32_t> source(m.triangle_count());
-  for (std::size_t t = 0; t < source.size(); ++t) source[t] = static_cast<std::int32_t>(t % 5) - 1;
-  write_mesh_ply(dir / "whole.ply", m, {{"source_acq", std::span<const std::int32_t>(source)}});
-
-  const MeshVertexRows all = rows_of(m, 0, m.vertex_count());
-  const PlyWriteInput layout{{}, {}, all.columns(), {{"source_acq", std::span<const std::int32_t>(source)}},
-                             {std::string(kPlyComment)}};
-  PlyStreamWriter out(dir / "chunks.ply", layout, m.vertex_count(), m.triangle_count());
+  const WholeWrite whole(dir / "whole.ply", 11, 5);
+  const Mesh& m = whole.mesh;
+  const std::vector<std::int32_t>& source = whole.source;
+  PlyStreamWriter out(dir / "chunks.ply", whole.layout(), m.vertex_count(), m.triangle_count());
   for (std::size_t first = 0; first < m.vertex_count(); first += 70) {
     const MeshVertexRows rows = rows_of(m, first, std::min(first + 70, m.vertex_count()));
     out.add_vertices({rows.positions, {}, rows.columns(), {}, {}});
@@ -157,14 +169,10 @@ TEST(PlyStreamWriter, RowsThatDoNotFitTheHeaderAreRefusedAndNothingIsWritten) {
 
 TEST(PlySpoolWriter, InterleavedChunksGiveTheBytesOfTheWholeWriteAndLeaveNoScratchFile) {
   test::TempDir dir;
-  const Mesh m = random_mesh(13, 300, 500);
-  std::vector<std::int32_t> source(m.triangle_count());
-  for (std::size_t t = 0; t < source.size(); ++t) source[t] = static_cast<std::int32_t>(t % 7) - 1;
-  write_mesh_ply(dir / "whole.ply", m, {{"source_acq", std::span<const std::int32_t>(source)}});
-
-  const MeshVertexRows all = rows_of(m, 0, m.vertex_count());
-  const PlyWriteInput layout{
-      {}, {}, all.columns(), {{"source_acq", std::span<const std::int32_t>(source)}}, {std::string(kPlyComment)}};
+  const WholeWrite whole(dir / "whole.ply", 13, 7);
+  const Mesh& m = whole.mesh;
+  const std::vector<std::int32_t>& source = whole.source;
+  const PlyWriteInput layout = whole.layout();
   {
     PlySpoolWriter out(dir / "spooled.ply", layout);
     // Faces before the vertices they use, as a drive's frames come: rows of both kinds in turn.
