@@ -18,9 +18,9 @@ namespace {
 double local_cost(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x, std::uint32_t v,
                   bool l) {
   double c = e.unary[v][l ? 1 : 0];
-  for (const std::uint32_t k : index.of(v)) {
-    const auto& p = e.pairs[k];
-    c += p.i == v ? p.value(l, x[p.j] != 0) : p.value(x[p.i] != 0, l);
+  for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
+    const std::uint32_t o = PairIndex::variable(index.ends[entry]);
+    c += index.values(entry)[(l ? 2 : 0) + (x[o] != 0 ? 1 : 0)];
   }
   return c;
 }
@@ -55,8 +55,8 @@ std::vector<std::vector<std::uint32_t>> free_components(const BinaryEnergy& e, c
     seen[s] = 1;
     c.push_back(s);
     for (std::size_t head = 0; head < c.size(); ++head) {
-      for (const std::uint32_t k : index.of(c[head])) {
-        const std::uint32_t o = e.pairs[k].i == c[head] ? e.pairs[k].j : e.pairs[k].i;
+      for (std::uint32_t entry = index.offsets[c[head]]; entry < index.offsets[c[head] + 1]; ++entry) {
+        const std::uint32_t o = PairIndex::variable(index.ends[entry]);
         if (is_free[o] != 0 && seen[o] == 0) {
           seen[o] = 1;
           c.push_back(o);
@@ -74,11 +74,10 @@ double component_energy(const BinaryEnergy& e, const PairIndex& index, std::span
   for (const std::uint32_t v : component) mark[v] = 1;
   for (const std::uint32_t v : component) {
     sum += e.unary[v][static_cast<std::size_t>(x[v])];
-    for (const std::uint32_t k : index.of(v)) {
-      const auto& p = e.pairs[k];
-      const std::uint32_t o = p.i == v ? p.j : p.i;
+    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
+      const std::uint32_t o = PairIndex::variable(index.ends[entry]);
       if (mark[o] != 0 && o < v) continue;  // both ends inside: counted once
-      sum += p.value(x[p.i] != 0, x[p.j] != 0);
+      sum += index.values(entry)[(x[v] != 0 ? 2 : 0) + (x[o] != 0 ? 1 : 0)];
     }
   }
   for (const std::uint32_t v : component) mark[v] = 0;

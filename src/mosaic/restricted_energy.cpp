@@ -2,6 +2,7 @@
 #include "restricted_energy.h"
 
 #include <algorithm>
+#include <bit>
 #include <iterator>
 
 #include "citymesh/core/error.h"
@@ -9,25 +10,48 @@
 
 namespace citymesh::mosaic_detail {
 
+namespace {
+
+/// Whether pair k's values differ from pair k - 1's, bit for bit (so that a shared row gives
+/// every entry exactly the values its own pair holds).
+bool starts_run(std::span<const BinaryEnergy::Pair> pairs, std::size_t k) {
+  if (k == 0) return true;
+  const auto bits = [](const BinaryEnergy::Pair& p) {
+    return std::array{std::bit_cast<std::uint64_t>(p.e00), std::bit_cast<std::uint64_t>(p.e01),
+                      std::bit_cast<std::uint64_t>(p.e10), std::bit_cast<std::uint64_t>(p.e11)};
+  };
+  return bits(pairs[k]) != bits(pairs[k - 1]);
+}
+
+}  // namespace
+
 PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
   if (e.size() >= kAtJ) throw ProcessingError("energy: too many variables");
   const std::size_t n = e.size();
+  const std::span<const BinaryEnergy::Pair> terms = e.pairs;
   // Blocks of consecutive pairs, each counted and then filled on its own thread, at entries
   // after those of the blocks before it: every row lists its pairs in increasing order, as a
   // single pass would, whatever the number of blocks (the serial pass was half the index's time).
   constexpr std::size_t kMinBlockPairs = 1 << 16;
   const std::size_t blocks =
-      std::clamp<std::size_t>(e.pairs.size() / kMinBlockPairs, 1, std::min(4u, available_threads()));
-  const auto block_begin = [&](std::size_t b) { return e.pairs.size() * b / blocks; };
+      std::clamp<std::size_t>(terms.size() / kMinBlockPairs, 1, std::min(4u, available_threads()));
+  const auto block_begin = [&](std::size_t b) { return terms.size() * b / blocks; };
   std::vector<std::vector<std::uint32_t>> at(blocks, std::vector<std::uint32_t>(n, 0));
+  std::vector<std::uint32_t> runs_before(blocks + 1, 0);  // runs starting in the blocks before
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        ++at[b][e.pairs[k].i];
-        ++at[b][e.pairs[k].j];
+        if (terms[k].i == terms[k].j) throw ProcessingError("energy: a pair joins a variable to itself");
+        ++at[b][terms[k].i];
+        ++at[b][terms[k].j];
+        if (starts_run(terms, k)) ++runs_before[b + 1];
       }
     }
   });
+  for (std::size_t b = 0; b < blocks; ++b) {
+    if (runs_before[b + 1] > (kAtJ >> 1) - runs_before[b]) throw ProcessingError("energy: too many pairs");
+    runs_before[b + 1] += runs_before[b];
+  }
   for (std::size_t v = 0; v < n; ++v) {
     std::uint32_t row = offsets[v];
     for (std::vector<std::uint32_t>& counts : at) {
@@ -37,27 +61,25 @@ PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
     }
     offsets[v + 1] = row;
   }
-  pairs.resize(offsets.back());
   ends.resize(offsets.back());
+  value_rows.resize(offsets.back());
+  rows.resize(2 * std::size_t{runs_before.back()});
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       std::vector<std::uint32_t>& fill = at[b];
+      std::uint32_t run = runs_before[b] - 1;  // a block may go on with the run its predecessor ended with
       for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        const std::uint32_t i = e.pairs[k].i, j = e.pairs[k].j;
-        ends[fill[i]] = j;
-        pairs[fill[i]++] = static_cast<std::uint32_t>(k);
-        ends[fill[j]] = i | kAtJ;
-        pairs[fill[j]++] = static_cast<std::uint32_t>(k);
+        const BinaryEnergy::Pair& p = terms[k];
+        if (starts_run(terms, k)) {
+          ++run;
+          rows[2 * std::size_t{run}] = {p.e00, p.e01, p.e10, p.e11};
+          rows[2 * std::size_t{run} + 1] = {p.e00, p.e10, p.e01, p.e11};
+        }
+        ends[fill[p.i]] = p.j;
+        value_rows[fill[p.i]++] = 2 * run;
+        ends[fill[p.j]] = p.i | kAtJ;
+        value_rows[fill[p.j]++] = 2 * run + 1;
       }
-    }
-  });
-  // The values are the bulk (32 bytes an entry) and each entry is independent: in parallel.
-  values = std::make_unique_for_overwrite<std::array<double, 4>[]>(offsets.back());
-  parallel_for_blocks(offsets.back(), 1 << 16, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t entry = begin; entry < end; ++entry) {
-      const auto& p = e.pairs[pairs[entry]];
-      values[entry] =
-          (ends[entry] & kAtJ) == 0 ? std::array{p.e00, p.e01, p.e10, p.e11} : std::array{p.e00, p.e10, p.e01, p.e11};
     }
   });
 }
@@ -73,7 +95,7 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
     r.unary[l] = e.unary[v];
     for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
       const std::uint32_t end = index.ends[entry], o = PairIndex::variable(end);
-      const auto& w = index.values[entry];  // w[2 * (this end) + (other end)]
+      const auto& w = index.values(entry);  // w[2 * (this end) + (other end)]
       if (to_local[o] != UINT32_MAX) {
         // Both ends open: the pair is taken once, from its i end.
         if ((end & PairIndex::kAtJ) == 0) r.pairs.push_back({l, to_local[o], w[0], w[1], w[2], w[3]});
@@ -145,7 +167,7 @@ std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const s
                                        std::uint32_t hops, std::vector<std::uint8_t>& mark) {
   const auto on_seam = [&](std::uint32_t v) {
     for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-      const auto& w = index.values[entry];
+      const auto& w = index.values(entry);
       if (w[1] + w[2] > w[0] + w[3] && x[PairIndex::variable(index.ends[entry])] != x[v]) return true;
     }
     return false;

@@ -6,7 +6,6 @@
 
 #include <array>
 #include <cstdint>
-#include <memory>
 #include <span>
 #include <vector>
 
@@ -14,23 +13,25 @@
 
 namespace citymesh::mosaic_detail {
 
-/// Pair indices per variable (compressed rows), with the pair's other end and values beside
-/// each, so that a walk over neighbours or a restricted energy reads memory in order instead
-/// of loading pairs at random (32 more bytes an entry: 92 MB for a 300 k-triangle tile, which
-/// cut the restricted energies' time by 60 %).
+/// The pair terms of each variable (compressed rows): per entry the term's other end and its
+/// values seen from this end, so that a walk over neighbours or a restricted energy reads
+/// memory in order instead of loading pairs at random (that cut the restricted energies' time
+/// by 60 %). The values are kept once per run of equal consecutive pairs, not per entry: the
+/// mosaic's overlap terms all have the same values, and a spinning scanner's tile holds about
+/// 12 of them per variable (80 bytes a term when each entry held its own four values; 16 now).
+/// Pairs must join two distinct variables.
 struct PairIndex {
   static constexpr std::uint32_t kAtJ = 1u << 31;  ///< in `ends`: the variable is the pair's j
-  std::vector<std::uint32_t> offsets, pairs;
-  std::vector<std::uint32_t> ends;  ///< per entry: the other end, | kAtJ when the variable is j
-  /// Per entry: the pair's values e[this end][other end] as {e00, e01, e10, e11}. Not a
-  /// vector: its zeroing of every entry (about 90 MB on the bench street) before they are
-  /// written took a fifth of the index's time.
-  std::unique_ptr<std::array<double, 4>[]> values;
+  std::vector<std::uint32_t> offsets;
+  std::vector<std::uint32_t> ends;        ///< per entry: the other end, | kAtJ when the variable is j
+  std::vector<std::uint32_t> value_rows;  ///< per entry: its row of `rows`
+  /// Rows 2r and 2r + 1: the r-th run's values {e00, e01, e10, e11} seen from i, and seen from j
+  /// ({e00, e10, e01, e11}).
+  std::vector<std::array<double, 4>> rows;
 
   explicit PairIndex(const BinaryEnergy& e);
-  [[nodiscard]] std::span<const std::uint32_t> of(std::uint32_t v) const {
-    return {pairs.data() + offsets[v], pairs.data() + offsets[v + 1]};
-  }
+  /// The entry's pair values e[this end][other end], at index 2 * (this end) + (other end).
+  [[nodiscard]] const std::array<double, 4>& values(std::uint32_t entry) const { return rows[value_rows[entry]]; }
   [[nodiscard]] static std::uint32_t variable(std::uint32_t end) { return end & ~kAtJ; }
 };
 
