@@ -5,8 +5,11 @@
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cmath>
 #include <nlohmann/json.hpp>
+#include <optional>
 
+#include "citymesh/config/config.h"
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
@@ -75,12 +78,42 @@ std::string objects_json(const std::vector<Scene>& scenes, const SimulateParams&
   return j.dump(1) + "\n";
 }
 
-std::string config_toml(const Scene& scene, const SimulateParams& p) {
+/// The largest x-y distance from a triangle's centroid to one of its corners, as `run`'s
+/// tiling measures it (TilingStats::largest_radius).
+double largest_horizontal_reach(const Mesh& mesh) {
+  double largest_squared = 0;
+  for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const auto [a, b, c] = mesh.corners(t);
+    const Vec3d centroid = (a + b + c) / 3.0;
+    for (const Vec3d& q : {a, b, c}) {
+      const double dx = q.x - centroid.x, dy = q.y - centroid.y;
+      largest_squared = std::max(largest_squared, dx * dx + dy * dy);
+    }
+  }
+  return std::sqrt(largest_squared);
+}
+
+/// The [tiling] halo the street needs when the default is too narrow: its largest triangle's
+/// reach plus the distance threshold (else `run` warns that labels near tile borders may
+/// differ from an untiled run's), rounded up to 10 cm; none when the default will do.
+std::optional<double> needed_halo(double largest_reach) {
+  const double needed = largest_reach + ChangeParams{}.distance_threshold;
+  if (needed <= TilingParams{}.halo) return std::nullopt;
+  return std::ceil(needed * 10 + 1e-9) / 10;
+}
+
+std::string config_toml(const Scene& scene, const SimulateParams& p, double largest_reach) {
   std::string out = fmt::format(
       "# Written by citymesh simulate (seed {}): runs the pipeline on this simulated street.\n"
       "[project]\ncrs = \"EPSG:2154\"\nvertical_datum = \"orthometric\"\ngeoid_undulation = 44.6\n"
       "output = \"out\"\nwork = \"work\"\n\n[change]\nsustainability = \"{}\"\n",
       p.street.seed, format_duration(p.sustainability));
+  if (const std::optional<double> halo = needed_halo(largest_reach)) {
+    out += fmt::format(
+        "\n[tiling]\n# this scanner meshes far surfaces with long triangles (up to {:.2f} m from their centroid)\n"
+        "halo = {:.1f}\n",
+        largest_reach, *halo);
+  }
   for (std::size_t k = 0; k < scene.epochs.size(); ++k) {
     out += fmt::format("\n[[acquisition]]\npath = \"acq_{}.ply\"\ntime = \"{}\"\nname = \"epoch {}\"\n", k,
                        format_iso8601(scene.epochs[k].date), k);
@@ -120,6 +153,7 @@ SimulationReport simulate(const SimulateParams& p) {
   SimulationReport report;
   for (const Scene& scene : scenes) report.objects += scene.objects.size();
   const std::size_t epochs = scenes.front().epochs.size();
+  double largest_reach = 0;
   for (std::size_t k = 0; k < epochs; ++k) {
     Mesh epoch;
     epoch.origin = scenes.front().origin;
@@ -145,6 +179,7 @@ SimulationReport simulate(const SimulateParams& p) {
     e.ply = p.out / fmt::format("acq_{}.ply", k);
     e.truth = p.out / fmt::format("acq_{}.truth", k);
     e.triangles = epoch.triangle_count();
+    largest_reach = std::max(largest_reach, largest_horizontal_reach(epoch));
     write_mesh_ply(e.ply, epoch);
     write_truth(e.truth, truth);
     report.write_seconds += writing.seconds();
@@ -153,7 +188,7 @@ SimulationReport simulate(const SimulateParams& p) {
     report.epochs.push_back(e);
   }
   write_file_atomically(p.out / "objects.json", objects_json(scenes, p));
-  write_file_atomically(p.out / "config.toml", config_toml(scenes.front(), p));
+  write_file_atomically(p.out / "config.toml", config_toml(scenes.front(), p, largest_reach));
   return report;
 }
 

@@ -1,15 +1,19 @@
 // SPDX-License-Identifier: MIT
+#include "citymesh/sim/simulate.h"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/sim/scanner.h"
-#include "citymesh/sim/simulate.h"
 #include "test_support.h"
 
 namespace citymesh {
@@ -20,6 +24,33 @@ SimulateParams small_street(const std::filesystem::path& out) {
   p.street.length = 40.0f;
   p.out = out;
   return p;
+}
+
+/// Brute force: the largest x-y distance from a triangle's centroid to a corner over the
+/// simulated passes.
+double largest_reach(const SimulationReport& report) {
+  double largest = 0;
+  for (const SimulatedEpoch& e : report.epochs) {
+    const Mesh mesh = read_mesh(e.ply).mesh;
+    for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
+      const auto corners = mesh.corners(t);
+      const Vec3d centroid = (corners[0] + corners[1] + corners[2]) / 3.0;
+      for (const Vec3d& q : corners) largest = std::max(largest, std::hypot(q.x - centroid.x, q.y - centroid.y));
+    }
+  }
+  return largest;
+}
+
+/// The written config's halo against the one the passes need (`run` warns below it).
+void expect_halo_that_tiles_need(const SimulationReport& report, const std::filesystem::path& dir) {
+  const Config config = load_config(dir / "config.toml");
+  const double needed = largest_reach(report) + config.change.distance_threshold;
+  if (needed <= TilingParams{}.halo) {
+    EXPECT_EQ(config.tiling.halo, TilingParams{}.halo);
+    return;
+  }
+  EXPECT_GE(config.tiling.halo, needed);
+  EXPECT_LE(config.tiling.halo, needed + 0.1 + 1e-6);  // rounded up to 10 cm
 }
 
 TEST(StreetScene, ScriptedChangesHaveTheExpectedFates) {
@@ -123,9 +154,11 @@ TEST(Simulate, SameSeedSameBytesWhateverTheThreadCount) {
 
 TEST(Simulate, WrittenConfigIsValid) {
   test::TempDir dir;
-  simulate(small_street(dir.path()));
+  expect_halo_that_tiles_need(simulate(small_street(dir.path())), dir.path());
   const auto r = test::run_citymesh("config --check " + (dir / "config.toml").string());
   EXPECT_EQ(r.exit_code, 0) << r.err;
+  const Config config = load_config(dir / "config.toml");
+  EXPECT_EQ(config.tiling.halo, TilingParams{}.halo);  // a profiler's triangles are short
 }
 
 TEST(Simulate, CityModeKeepsObjectIdsUniqueAndStreetsApart) {
@@ -170,6 +203,9 @@ TEST(Simulate, SpinningScannerMeshesEachTurnConsistently) {
     ASSERT_EQ(truth.size(), m.mesh.triangle_count());
     EXPECT_GT(m.mesh.triangle_count(), 1000u);
   }
+  // Its far, grazing triangles are long: the config asks for the halo they need.
+  ASSERT_GT(largest_reach(r) + 0.1, TilingParams{}.halo);
+  expect_halo_that_tiles_need(r, a.path());
   {
     ThreadLimit one(1);
     p.out = b.path();
