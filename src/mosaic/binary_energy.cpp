@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <bit>
 #include <numeric>
 #include <random>
 
@@ -11,6 +12,19 @@
 #include "citymesh/mosaic/max_flow.h"
 
 namespace citymesh {
+
+void PairList::push_back(const EnergyPair& p) {
+  const std::array<double, 4> w{p.e00, p.e01, p.e10, p.e11};
+  const auto bits = [](const std::array<double, 4>& v) {
+    return std::array{std::bit_cast<std::uint64_t>(v[0]), std::bit_cast<std::uint64_t>(v[1]),
+                      std::bit_cast<std::uint64_t>(v[2]), std::bit_cast<std::uint64_t>(v[3])};
+  };
+  if (rows_.empty() || bits(rows_.back()) != bits(w)) {
+    if (rows_.size() >= (1u << 31)) throw ProcessingError("energy: too many distinct pair terms");
+    rows_.push_back(w);
+  }
+  ends_.push_back({p.i, p.j, static_cast<std::uint32_t>(rows_.size() - 1)});
+}
 
 double BinaryEnergy::evaluate(std::span<const std::int8_t> x) const {
   double e = 0;
@@ -205,9 +219,10 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   // triangle, so three meshes overlapping close a cycle within the last meshes' overlaps.
   const std::size_t n = e.size();
   ParitySets sets(n);
-  for (auto p = e.pairs.rbegin(); p != e.pairs.rend(); ++p) {
-    const double c = coupling(*p);
-    if (c != 0 && !sets.join(p->i, p->j, c < 0)) return std::nullopt;
+  for (std::size_t k = e.pairs.size(); k-- > 0;) {
+    const BinaryEnergy::Pair p = e.pairs[k];
+    const double c = coupling(p);
+    if (c != 0 && !sets.join(p.i, p.j, c < 0)) return std::nullopt;
   }
   // The colouring that leaves the lowest variable of each connected set unflipped: every
   // variable's parity against the root, less that lowest variable's.

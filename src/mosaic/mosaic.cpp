@@ -185,7 +185,8 @@ MosaicEnergy build_mosaic_energy(const MosaicInput& input, const MosaicParams& p
   });
   std::size_t seam_count = 0;
   for (const MeshEdges& e : edges) seam_count += e.shared.size();
-  out.energy.pairs.reserve(seam_count + change.consistent_pairs.size());  // ~50 MB: no regrowth copies
+  // No regrowth copies: at most a row of values per seam term, one for the overlap terms.
+  out.energy.pairs.reserve(seam_count + change.consistent_pairs.size(), seam_count + 1);
   const Crease crease{std::cos(params.crease_angle * std::numbers::pi / 180.0), params.crease_weight};
   for (std::size_t a = 0; a < edges.size(); ++a) {
     for (const auto& s : edges[a].shared) {

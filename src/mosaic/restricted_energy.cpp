@@ -2,7 +2,6 @@
 #include "restricted_energy.h"
 
 #include <algorithm>
-#include <bit>
 #include <iterator>
 
 #include "citymesh/core/error.h"
@@ -10,25 +9,10 @@
 
 namespace citymesh::mosaic_detail {
 
-namespace {
-
-/// Whether pair k's values differ from pair k - 1's, bit for bit (so that a shared row gives
-/// every entry exactly the values its own pair holds).
-bool starts_run(std::span<const BinaryEnergy::Pair> pairs, std::size_t k) {
-  if (k == 0) return true;
-  const auto bits = [](const BinaryEnergy::Pair& p) {
-    return std::array{std::bit_cast<std::uint64_t>(p.e00), std::bit_cast<std::uint64_t>(p.e01),
-                      std::bit_cast<std::uint64_t>(p.e10), std::bit_cast<std::uint64_t>(p.e11)};
-  };
-  return bits(pairs[k]) != bits(pairs[k - 1]);
-}
-
-}  // namespace
-
 PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
   if (e.size() >= kAtJ) throw ProcessingError("energy: too many variables");
   const std::size_t n = e.size();
-  const std::span<const BinaryEnergy::Pair> terms = e.pairs;
+  const PairList& terms = e.pairs;
   // Blocks of consecutive pairs, each counted and then filled on its own thread, at entries
   // after those of the blocks before it: every row lists its pairs in increasing order, as a
   // single pass would, whatever the number of blocks (the serial pass was half the index's time).
@@ -37,21 +21,16 @@ PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
       std::clamp<std::size_t>(terms.size() / kMinBlockPairs, 1, std::min(4u, available_threads()));
   const auto block_begin = [&](std::size_t b) { return terms.size() * b / blocks; };
   std::vector<std::vector<std::uint32_t>> at(blocks, std::vector<std::uint32_t>(n, 0));
-  std::vector<std::uint32_t> runs_before(blocks + 1, 0);  // runs starting in the blocks before
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        if (terms[k].i == terms[k].j) throw ProcessingError("energy: a pair joins a variable to itself");
-        ++at[b][terms[k].i];
-        ++at[b][terms[k].j];
-        if (starts_run(terms, k)) ++runs_before[b + 1];
+        const auto [i, j] = terms.variables(k);
+        if (i == j) throw ProcessingError("energy: a pair joins a variable to itself");
+        ++at[b][i];
+        ++at[b][j];
       }
     }
   });
-  for (std::size_t b = 0; b < blocks; ++b) {
-    if (runs_before[b + 1] > (kAtJ >> 1) - runs_before[b]) throw ProcessingError("energy: too many pairs");
-    runs_before[b + 1] += runs_before[b];
-  }
   for (std::size_t v = 0; v < n; ++v) {
     std::uint32_t row = offsets[v];
     for (std::vector<std::uint32_t>& counts : at) {
@@ -63,22 +42,24 @@ PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
   }
   ends.resize(offsets.back());
   value_rows.resize(offsets.back());
-  rows.resize(2 * std::size_t{runs_before.back()});
+  // Each of the energy's rows twice: seen from i, and from j (e01 and e10 swapped).
+  const std::span<const std::array<double, 4>> shared = terms.values();
+  rows.resize(2 * shared.size());
+  for (std::size_t r = 0; r < shared.size(); ++r) {
+    const auto& [e00, e01, e10, e11] = shared[r];
+    rows[2 * r] = {e00, e01, e10, e11};
+    rows[2 * r + 1] = {e00, e10, e01, e11};
+  }
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
       std::vector<std::uint32_t>& fill = at[b];
-      std::uint32_t run = runs_before[b] - 1;  // a block may go on with the run its predecessor ended with
       for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        const BinaryEnergy::Pair& p = terms[k];
-        if (starts_run(terms, k)) {
-          ++run;
-          rows[2 * std::size_t{run}] = {p.e00, p.e01, p.e10, p.e11};
-          rows[2 * std::size_t{run} + 1] = {p.e00, p.e10, p.e01, p.e11};
-        }
-        ends[fill[p.i]] = p.j;
-        value_rows[fill[p.i]++] = 2 * run;
-        ends[fill[p.j]] = p.i | kAtJ;
-        value_rows[fill[p.j]++] = 2 * run + 1;
+        const auto [i, j] = terms.variables(k);
+        const std::uint32_t row = 2 * terms.row(k);
+        ends[fill[i]] = j;
+        value_rows[fill[i]++] = row;
+        ends[fill[j]] = i | kAtJ;
+        value_rows[fill[j]++] = row + 1;
       }
     }
   });

@@ -16,17 +16,17 @@ namespace citymesh::mosaic_detail {
 /// The pair terms of each variable (compressed rows): per entry the term's other end and its
 /// values seen from this end, so that a walk over neighbours or a restricted energy reads
 /// memory in order instead of loading pairs at random (that cut the restricted energies' time
-/// by 60 %). The values are kept once per run of equal consecutive pairs, not per entry: the
-/// mosaic's overlap terms all have the same values, and a spinning scanner's tile holds about
-/// 12 of them per variable (80 bytes a term when each entry held its own four values; 16 now).
-/// Pairs must join two distinct variables.
+/// by 60 %). The values are the energy's rows (PairList), each held twice (seen from i, from
+/// j), not four doubles per entry: a spinning scanner's tile holds about 12 overlap terms per
+/// variable, all with the same values (80 bytes a term when each entry held its own values;
+/// 16 now). Pairs must join two distinct variables.
 struct PairIndex {
   static constexpr std::uint32_t kAtJ = 1u << 31;  ///< in `ends`: the variable is the pair's j
   std::vector<std::uint32_t> offsets;
   std::vector<std::uint32_t> ends;        ///< per entry: the other end, | kAtJ when the variable is j
   std::vector<std::uint32_t> value_rows;  ///< per entry: its row of `rows`
-  /// Rows 2r and 2r + 1: the r-th run's values {e00, e01, e10, e11} seen from i, and seen from j
-  /// ({e00, e10, e01, e11}).
+  /// Rows 2r and 2r + 1: the energy's r-th row of values {e00, e01, e10, e11} seen from i, and
+  /// seen from j ({e00, e10, e01, e11}).
   std::vector<std::array<double, 4>> rows;
 
   explicit PairIndex(const BinaryEnergy& e);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <random>
 #include <span>
@@ -310,19 +311,20 @@ TEST(GroupMoves, ThePairIndexListsEachVariablesTermsInOrderOnAnyThreadCount) {
   BinaryEnergy e;
   e.unary.assign(n, {0, 0});
   std::uniform_real_distribution<double> u(-2, 2);
+  std::vector<BinaryEnergy::Pair> terms;
   for (std::size_t k = 0; k < 300000; ++k) {
     const auto i = static_cast<std::uint32_t>(rng() % n), j = static_cast<std::uint32_t>(rng() % n);
-    if (i != j) e.pairs.push_back({i, j, u(rng), u(rng), u(rng), u(rng)});
+    if (i != j) terms.push_back({i, j, u(rng), u(rng), u(rng), u(rng)});
   }
   // Runs of equal terms (as the mosaic's overlap terms are) across the blocks' borders (at
   // halves or quarters of the list), which share their values' rows.
-  const std::size_t m = e.pairs.size();
+  const std::size_t m = terms.size();
   for (const auto& [from, to] : {std::pair{20, 30}, std::pair{45, 55}, std::pair{70, 80}}) {
     for (std::size_t k = m * from / 100; k < m * to / 100; ++k) {
-      auto& p = e.pairs[k];
-      std::tie(p.e00, p.e01, p.e10, p.e11) = std::tuple{0.0, 0.5, -0.25, 1.0};
+      std::tie(terms[k].e00, terms[k].e01, terms[k].e10, terms[k].e11) = std::tuple{0.0, 0.5, -0.25, 1.0};
     }
   }
+  for (const BinaryEnergy::Pair& p : terms) e.pairs.push_back(p);
   const auto check = [&](const mosaic_detail::PairIndex& index) {
     ASSERT_LE(index.rows.size(), 2 * (m - 3 * (m / 10) + 6));
     // Brute force: each variable's terms in increasing order, with the other end and the
@@ -336,7 +338,7 @@ TEST(GroupMoves, ThePairIndexListsEachVariablesTermsInOrderOnAnyThreadCount) {
       ASSERT_EQ(index.offsets[v + 1] - index.offsets[v], rows[v].size()) << v;
       for (std::size_t r = 0; r < rows[v].size(); ++r) {
         const std::uint32_t entry = index.offsets[v] + static_cast<std::uint32_t>(r);
-        const auto& p = e.pairs[rows[v][r]];
+        const auto& p = terms[rows[v][r]];
         const bool at_j = p.i != v;
         ASSERT_EQ(index.ends[entry], at_j ? (p.i | mosaic_detail::PairIndex::kAtJ) : p.j);
         const std::array<double, 4> seen =
@@ -419,10 +421,42 @@ TEST(Qpbo, FlipsAreFoundExactlyWhenSomeFlippingMakesEveryCouplingAttractive) {
   EXPECT_GT(refused, 200);
 }
 
+TEST(PairList, GivesBackEachTermBitForBitAndSharesTheValuesOfEqualNeighboursOnly) {
+  const std::vector<BinaryEnergy::Pair> terms{{0, 1, 0, 0, 0, 10},    {2, 3, 0, 0, 0, 10},
+                                              {1, 2, 0, 0, 0, 10},                          // one row
+                                              {0, 2, -0.0, 0, 0, 10},                       // -0 is not +0: its own row
+                                              {3, 4, 0, 2.5, 2.5, 0}, {1, 4, 0, 0, 0, 10},  // a row each
+                                              {2, 4, 0, 0, 0, 10}};                         // shares the row before it
+  PairList list;
+  for (const BinaryEnergy::Pair& p : terms) list.push_back(p);
+  ASSERT_EQ(list.size(), terms.size());
+  EXPECT_EQ(list.values().size(), 4u);
+  const auto bits = [](const BinaryEnergy::Pair& p) {
+    return std::array{std::uint64_t{p.i},
+                      std::uint64_t{p.j},
+                      std::bit_cast<std::uint64_t>(p.e00),
+                      std::bit_cast<std::uint64_t>(p.e01),
+                      std::bit_cast<std::uint64_t>(p.e10),
+                      std::bit_cast<std::uint64_t>(p.e11)};
+  };
+  std::size_t k = 0;
+  for (const BinaryEnergy::Pair p : list) {
+    EXPECT_EQ(bits(p), bits(terms[k])) << k;
+    EXPECT_EQ(list.variables(k), (std::array{terms[k].i, terms[k].j})) << k;
+    ++k;
+  }
+  EXPECT_EQ(k, terms.size());
+  EXPECT_EQ(list.row(5), list.row(6));
+  EXPECT_NE(list.row(2), list.row(3));
+}
+
 TEST(Qpbo, ThreeMutuallyOverlappingTrianglesCannotBeFlipped) {
   BinaryEnergy e;
   e.unary = {{0, -1}, {0, -1}, {0, -1}};
-  e.pairs = {{0, 1, 0, 0, 0, 10}, {1, 2, 0, 0, 0, 10}, {0, 2, 0, 0, 0, 10}};
+  for (const BinaryEnergy::Pair& p :
+       {BinaryEnergy::Pair{0, 1, 0, 0, 0, 10}, {1, 2, 0, 0, 0, 10}, {0, 2, 0, 0, 0, 10}}) {
+    e.pairs.push_back(p);
+  }
   EXPECT_FALSE(submodular_flips(e).has_value());
   MinimiseStats stats;
   const std::vector<std::int8_t> x = minimise(e, {}, stats);
