@@ -30,6 +30,10 @@ class MeshCommand final : public Command {
     app.add_option("--layout", layout_, "auto (from the properties), profiler (angle wraps per line), spinning (ring x column)")
         ->check(CLI::IsMember({"auto", "profiler", "spinning"}));
     app.add_option("--echo", echo_, "profiler: which echo of a multi-echo pulse to mesh")->check(CLI::IsMember({"first", "last"}));
+    app.add_option("--band-lines", band_lines_,
+                   "profiler: scan lines meshed at a time, at least 2 (memory: ~40 bytes per cell of a band; 0: "
+                   "about a million cells; the output does not depend on it)")
+        ->check(CLI::Range(std::size_t{0}, std::size_t{1} << 24));
     app.add_option("--max-edge-base", meshing_.max_edge_base, "metres")->check(CLI::Range(0.0, 100.0));
     app.add_option("--max-edge-per-metre", meshing_.max_edge_per_metre, "extra edge length per metre of range")
         ->check(CLI::Range(0.0, 10.0));
@@ -47,23 +51,71 @@ class MeshCommand final : public Command {
     std::vector<std::filesystem::path> paths(files_.begin(), files_.end());
     const std::string layout = layout_ == "auto" ? detect(paths.front()) : layout_;
     if (layout == "profiler") {
-      ProfilerGridParams p;
-      p.echo = echo_ == "last" ? ProfilerGridParams::Echo::last : ProfilerGridParams::Echo::first;
-      SensorGrid grid = profiler_grid(paths, p);
-      const SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
-      const auto cells = std::count(grid.valid.begin(), grid.valid.end(), 1);
-      const std::string shape = fmt::format("grid {} x {}", grid.rows, grid.cols);
-      grid = SensorGrid{};  // not needed to write the mesh: its memory goes back first
-      write_mesh_ply(out_, r.mesh);
-      std::cout << fmt::format("{}: {} layout, {}, {} points, {} triangles\n", out_, layout, shape, cells,
-                               r.mesh.triangle_count());
-      print_rejected(r.stats);
+      mesh_profiler_drive(paths);
       return;
     }
     mesh_spinning_frames(paths);
   }
 
  private:
+  /// A profiler drive's grid, meshed and written a band of scan lines at a time: its memory
+  /// does not grow with the drive's length. The same bytes as meshing the whole grid at once.
+  void mesh_profiler_drive(const std::vector<std::filesystem::path>& paths) const {
+    ProfilerGridParams p;
+    p.echo = echo_ == "last" ? ProfilerGridParams::Echo::last : ProfilerGridParams::Echo::first;
+    std::unique_ptr<PlySpoolWriter> out;
+    SensorBand where;
+    SensorMeshStats stats;
+    std::int64_t cells = 0;
+    std::uint64_t triangles = 0;
+    // Bands of about a million cells by default (some 40 bytes each with the mesher's arrays).
+    const ProfilerBandSize size{band_lines_};
+    const ProfilerGridShape shape = for_each_profiler_band(paths, p, size, [&](const SensorGrid& band) {
+      // Row 0 repeats the band before's last row: its cells were counted there.
+      const auto from = static_cast<std::ptrdiff_t>(where.carried.empty() ? 0 : band.cols);
+      cells +=
+          std::count(band.valid.begin() + std::min<std::ptrdiff_t>(from, std::ssize(band.valid)), band.valid.end(), 1);
+      const SensorMeshResult r = mesh_sensor_band(band, meshing_, 0, where);
+      add_to(stats, r.stats);
+      triangles += r.mesh.triangle_count();
+      if (r.mesh.vertex_count() == 0) return;  // then no triangle either: each has a corner in a new row
+      append(out, r.mesh, {});
+    });
+    if (out == nullptr) {
+      Mesh empty;
+      empty.origin = shape.origin;
+      write_mesh_ply(out_, empty);
+    } else {
+      out->commit();
+    }
+    std::cout << fmt::format("{}: profiler layout, grid {} x {}, {} points, {} triangles\n", out_, shape.rows,
+                             shape.cols, cells, triangles);
+    print_rejected(stats);
+  }
+
+  /// Appends a mesh whose triangles name vertices by their ids in the whole output (those
+  /// before it included) to `out`, made at the first mesh with that mesh's columns.
+  void append(std::unique_ptr<PlySpoolWriter>& out, const Mesh& mesh, const std::filesystem::path& source) const {
+    const MeshVertexRows rows = mesh_vertex_rows(mesh, 0, mesh.vertex_count());
+    const PlyWriteInput part{rows.positions, {}, rows.columns(), {}, {std::string(kPlyComment)}};
+    if (out == nullptr) out = std::make_unique<PlySpoolWriter>(out_, part);
+    try {
+      out->add_vertices(part);
+    } catch (const ProcessingError& e) {
+      if (source.empty()) throw;
+      throw InputError(fmt::format("{}: its points carry other properties than the frames before it ({})",
+                                   source.string(), e.what()));
+    }
+    out->add_faces({{}, mesh.triangles, {}, {}, {}});
+  }
+
+  static void add_to(SensorMeshStats& total, const SensorMeshStats& s) {
+    total.candidates += s.candidates;
+    total.rejected_long_edge += s.rejected_long_edge;
+    total.rejected_depth_jump += s.rejected_depth_jump;
+    total.rejected_grazing += s.rejected_grazing;
+  }
+
   /// Each frame meshed on its own grid, the frames of one drive in one mesh (as the simulator
   /// writes a spinning pass: its turns overlap, and the mosaic keeps one layer of them). The
   /// frames go to the file one by one: a drive of thousands of frames never is in memory.
@@ -75,24 +127,12 @@ class MeshCommand final : public Command {
     for (const std::filesystem::path& path : paths) {
       const SensorGrid grid = spinning_grid(path);
       SensorMeshResult r = mesh_sensor_grid(grid, meshing_);
-      const MeshVertexRows rows = mesh_vertex_rows(r.mesh, 0, r.mesh.vertex_count());
-      const PlyWriteInput frame{rows.positions, {}, rows.columns(), {}, {std::string(kPlyComment)}};
-      if (out == nullptr) out = std::make_unique<PlySpoolWriter>(out_, frame);
-      const auto first = static_cast<std::uint32_t>(out->vertices());
+      const auto first = static_cast<std::uint32_t>(out == nullptr ? 0 : out->vertices());
       for (Triangle& t : r.mesh.triangles) t = {t[0] + first, t[1] + first, t[2] + first};
-      try {
-        out->add_vertices(frame);
-      } catch (const ProcessingError& e) {
-        throw InputError(fmt::format("{}: its points carry other properties than the frames before it ({})",
-                                     path.string(), e.what()));
-      }
-      out->add_faces({{}, r.mesh.triangles, {}, {}, {}});
+      append(out, r.mesh, path);
       cells += std::count(grid.valid.begin(), grid.valid.end(), 1);
       triangles += r.mesh.triangle_count();
-      stats.candidates += r.stats.candidates;
-      stats.rejected_long_edge += r.stats.rejected_long_edge;
-      stats.rejected_depth_jump += r.stats.rejected_depth_jump;
-      stats.rejected_grazing += r.stats.rejected_grazing;
+      add_to(stats, r.stats);
     }
     out->commit();
     std::cout << fmt::format("{}: spinning layout, {} frame(s), {} points, {} triangles\n", out_, paths.size(), cells,
@@ -119,6 +159,7 @@ class MeshCommand final : public Command {
   std::string out_;
   std::string layout_ = "auto";
   std::string echo_ = "first";
+  std::size_t band_lines_ = 0;  ///< 0: about a million cells
   SensorMeshingParams meshing_;
 };
 

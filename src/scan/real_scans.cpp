@@ -76,7 +76,66 @@ PulseSurvey survey_pulses(const std::vector<std::filesystem::path>& files, const
   return survey;
 }
 
+/// Puts a pulse in row `row` of `g` (whose columns are angle bins of `step`), unless its bin
+/// holds one already (two pulses in one bin: the first is kept).
+void place(SensorGrid& g, std::size_t row, const Pulse& p, double step) {
+  const double turn = std::fmod(p.angle + 4 * M_PI, 2 * M_PI);
+  const std::size_t cell = g.index(row, static_cast<std::size_t>(turn / step) % g.cols);
+  if (g.valid[cell]) return;
+  g.points[cell] = to_local(p.point, g.origin);
+  g.sensors[cell] = to_local(p.sensor, g.origin);
+  g.times[cell] = p.time;
+  g.valid[cell] = 1;
+}
+
+std::size_t columns_of(double step) { return static_cast<std::size_t>(std::lround(2 * M_PI / step)); }
+
+/// Makes `band` rows [first, first + height) of a grid of `lines` rows (height at most
+/// `rows`), its row 0 the old band's last row when `keep_last` (the next band overlaps the
+/// one before by a row).
+void start_band(SensorGrid& band, std::size_t first, std::size_t rows, std::size_t lines, bool keep_last) {
+  const std::size_t cols = band.cols, height = std::min(rows, lines - first);
+  SensorGrid last;
+  if (keep_last) {
+    const auto from = static_cast<std::ptrdiff_t>(band.index(band.rows - 1, 0)), n = static_cast<std::ptrdiff_t>(cols);
+    last.points.assign(band.points.begin() + from, band.points.begin() + from + n);
+    last.sensors.assign(band.sensors.begin() + from, band.sensors.begin() + from + n);
+    last.times.assign(band.times.begin() + from, band.times.begin() + from + n);
+    last.valid.assign(band.valid.begin() + from, band.valid.begin() + from + n);
+  }
+  band.resize(height, cols, false);
+  if (!keep_last) return;
+  std::copy(last.points.begin(), last.points.end(), band.points.begin());
+  std::copy(last.sensors.begin(), last.sensors.end(), band.sensors.begin());
+  std::copy(last.times.begin(), last.times.end(), band.times.begin());
+  std::copy(last.valid.begin(), last.valid.end(), band.valid.begin());
+}
+
 }  // namespace
+
+ProfilerGridShape for_each_profiler_band(const std::vector<std::filesystem::path>& files,
+                                         const ProfilerGridParams& params, const ProfilerBandSize& size,
+                                         const std::function<void(const SensorGrid&)>& visit, PlyReadParams read) {
+  const PulseSurvey survey = survey_pulses(files, params, read);
+  const ProfilerGridShape shape{survey.lines, columns_of(survey.step), whole_metre_origin(survey.first_point)};
+  const std::size_t rows = std::max<std::size_t>(2, size.rows > 0 ? size.rows : size.cells / shape.cols);
+  SensorGrid band;
+  band.cols = shape.cols;
+  band.wrap_columns = true;
+  band.origin = shape.origin;
+  std::size_t first = 0;  // the band's row 0 in the whole grid
+  start_band(band, first, rows, shape.rows, false);
+  for_each_pulse(files, params, std::move(read), [&](const Pulse& p) {
+    while (p.line >= first + band.rows) {  // the band is full: mesh it, go on from its last row
+      visit(band);
+      first += band.rows - 1;
+      start_band(band, first, rows, shape.rows, true);
+    }
+    place(band, p.line - first, p, survey.step);
+  });
+  visit(band);
+  return shape;
+}
 
 SensorGrid profiler_grid(const std::vector<std::filesystem::path>& files, const ProfilerGridParams& params,
                          PlyReadParams read) {
@@ -84,21 +143,11 @@ SensorGrid profiler_grid(const std::vector<std::filesystem::path>& files, const 
   // list's regrowth, were the peak of meshing a long drive): the first finds the lines and
   // the angular step, the second fills the grid.
   const PulseSurvey survey = survey_pulses(files, params, read);
-  const double step = survey.step;
-  const auto cols = static_cast<std::size_t>(std::lround(2 * M_PI / step));
   SensorGrid g;
-  g.resize(survey.lines, cols, false);
+  g.resize(survey.lines, columns_of(survey.step), false);
   g.wrap_columns = true;
   g.origin = whole_metre_origin(survey.first_point);
-  for_each_pulse(files, params, std::move(read), [&](const Pulse& p) {
-    const double turn = std::fmod(p.angle + 4 * M_PI, 2 * M_PI);
-    const std::size_t cell = g.index(p.line, static_cast<std::size_t>(turn / step) % cols);
-    if (g.valid[cell]) return;  // two pulses in one bin: keep the first
-    g.points[cell] = to_local(p.point, g.origin);
-    g.sensors[cell] = to_local(p.sensor, g.origin);
-    g.times[cell] = p.time;
-    g.valid[cell] = 1;
-  });
+  for_each_pulse(files, params, std::move(read), [&](const Pulse& p) { place(g, p.line, p, survey.step); });
   return g;
 }
 

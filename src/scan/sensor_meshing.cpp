@@ -3,6 +3,7 @@
 // pulses of a line and the same pulse of successive lines).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "citymesh/core/error.h"
@@ -24,12 +25,17 @@ namespace {
 
 class Mesher {
  public:
-  Mesher(const SensorGrid& g, const SensorMeshingParams& p, std::uint32_t acquisition)
-      : g_(g), p_(p), acquisition_(acquisition), cos_limit_(std::cos(p.max_incidence_deg * float(M_PI) / 180.0f)) {}
+  Mesher(const SensorGrid& g, const SensorMeshingParams& p, std::uint32_t acquisition, SensorBand& where)
+      : g_(g),
+        p_(p),
+        acquisition_(acquisition),
+        cos_limit_(std::cos(p.max_incidence_deg * float(M_PI) / 180.0f)),
+        where_(where) {}
 
   SensorMeshResult run() {
     check();
     vertex_of_.assign(g_.points.size(), kNone);
+    std::copy(where_.carried.begin(), where_.carried.end(), vertex_of_.begin());
     // Every range is needed by up to six triangles' tests: compute each once.
     range_.resize(g_.points.size());
     std::size_t valid_cells = 0;
@@ -38,11 +44,17 @@ class Mesher {
       valid_cells += g_.valid[i] != 0 ? 1 : 0;
     }
     result_.mesh.origin = g_.origin;
+    if (g_.rows == 0) return std::move(result_);
     reserve_for(valid_cells);
     const std::size_t col_end = g_.wrap_columns ? g_.cols : g_.cols - 1;
     for (std::size_t r = 0; r + 1 < g_.rows; ++r) {
       for (std::size_t c = 0; c < col_end; ++c) quad(r, c, (c + 1) % g_.cols);
     }
+    // What the next band, whose row 0 is this band's last row, starts from.
+    const auto last_row = vertex_of_.begin() + static_cast<std::ptrdiff_t>(g_.index(g_.rows - 1, 0));
+    where_.carried.assign(last_row, last_row + static_cast<std::ptrdiff_t>(g_.cols));
+    where_.first_row += g_.rows - 1;
+    where_.first_vertex = next_vertex();
     return std::move(result_);
   }
 
@@ -65,6 +77,10 @@ class Mesher {
 
   void check() const {
     const std::size_t n = g_.rows * g_.cols;
+    if (!where_.carried.empty() && (where_.carried.size() != g_.cols || g_.rows == 0)) {
+      throw ProcessingError(
+          fmt::format("sensor meshing: a band of {} columns follows one of {}", g_.cols, where_.carried.size()));
+    }
     if (g_.points.size() != n || g_.sensors.size() != n || g_.valid.size() != n || g_.times.size() != n ||
         (!g_.labels.empty() && g_.labels.size() != n) || g_.cols < 2) {
       throw ProcessingError(fmt::format("sensor meshing: grid of {} x {} has inconsistent arrays", g_.rows, g_.cols));
@@ -99,10 +115,17 @@ class Mesher {
     return false;
   }
 
+  /// The id the next new vertex gets (the ids go on from the bands before).
+  std::uint32_t next_vertex() const {
+    const std::uint64_t id = std::uint64_t{where_.first_vertex} + result_.mesh.positions.size();
+    if (id >= kNone) throw ProcessingError("sensor meshing: more than 2^32 - 1 vertices in one mesh");
+    return static_cast<std::uint32_t>(id);
+  }
+
   std::uint32_t vertex(std::size_t cell) {
     if (vertex_of_[cell] == kNone) {
       Mesh& m = result_.mesh;
-      vertex_of_[cell] = static_cast<std::uint32_t>(m.positions.size());
+      vertex_of_[cell] = next_vertex();
       m.positions.push_back(g_.points[cell]);
       m.sensor_positions.push_back(g_.sensors[cell]);
       m.times.push_back(g_.times[cell]);
@@ -125,7 +148,7 @@ class Mesher {
     if (dot(n, g_.sensors[a] - g_.points[a]) < 0) std::swap(b, c);
     Mesh& m = result_.mesh;
     m.triangles.push_back({vertex(a), vertex(b), vertex(c)});
-    m.triangle_ids.push_back({acquisition_, which, quad_cell});
+    m.triangle_ids.push_back({acquisition_, which, where_.first_row * g_.cols + quad_cell});
     if (!g_.labels.empty()) result_.face_labels.push_back(face_label(a, b, c));
   }
 
@@ -157,6 +180,7 @@ class Mesher {
   float cos_limit_;
   std::vector<std::uint32_t> vertex_of_;
   std::vector<float> range_;  ///< sensor-to-point distance per cell
+  SensorBand& where_;
   SensorMeshResult result_;
 };
 
@@ -164,7 +188,13 @@ class Mesher {
 
 SensorMeshResult mesh_sensor_grid(const SensorGrid& grid, const SensorMeshingParams& params,
                                   std::uint32_t acquisition) {
-  return Mesher(grid, params, acquisition).run();
+  SensorBand whole;
+  return Mesher(grid, params, acquisition, whole).run();
+}
+
+SensorMeshResult mesh_sensor_band(const SensorGrid& band, const SensorMeshingParams& params, std::uint32_t acquisition,
+                                  SensorBand& where) {
+  return Mesher(band, params, acquisition, where).run();
 }
 
 }  // namespace citymesh

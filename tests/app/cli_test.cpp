@@ -109,6 +109,26 @@ void write_spinning_frame(const std::filesystem::path& path, double sx) {
                                      count, body));
 }
 
+TEST(Cli, MeshMakesAProfilerDriveBandByBandWithTheBytesOfOneBand) {
+  test::TempDir dir;
+  test::write_profiler_lines(dir / "a.ply", 0, 2);
+  test::write_profiler_lines(dir / "b.ply", 2, test::kProfilerLines);
+  const std::string files = fmt::format("{0}/a.ply {0}/b.ply", dir.path().string());
+  const auto whole = test::run_citymesh(fmt::format("mesh {} --out {}/whole.ply", files, dir.path().string()));
+  ASSERT_EQ(whole.exit_code, 0) << whole.err;
+  EXPECT_NE(whole.out.find("grid 5 x 360, 1799 points"), std::string::npos) << whole.out;
+  const Mesh mesh = read_mesh(dir / "whole.ply").mesh;
+  EXPECT_GT(mesh.triangle_count(), 2u * 4 * 350);  // four quads' rows around the circle, but for a few
+  for (const int lines : {2, 3, 4}) {
+    const auto bands = test::run_citymesh(
+        fmt::format("mesh {} --band-lines {} --out {}/bands.ply", files, lines, dir.path().string()));
+    ASSERT_EQ(bands.exit_code, 0) << bands.err;
+    EXPECT_EQ(bands.out, whole.out.substr(0, whole.out.find("whole.ply")) +
+                             whole.out.substr(whole.out.find("whole.ply")).replace(0, 9, "bands.ply"));
+    EXPECT_EQ(test::read_text(dir / "bands.ply"), test::read_text(dir / "whole.ply")) << lines;
+  }
+}
+
 TEST(Cli, MeshPutsTheSpinningFramesOfOneDriveInOneMeshEachMeshedOnItsOwn) {
   test::TempDir dir;
   write_spinning_frame(dir / "f1.ply", 0.0);

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "citymesh/core/error.h"
 #include "citymesh/scan/real_scans.h"
@@ -12,35 +14,7 @@
 namespace citymesh {
 namespace {
 
-constexpr int kLines = 5, kBins = 360;  // a pulse every degree
-
-/// A profiler at (651000 + 0.1 line, 6860000, 40) turning in the x = const plane: line l, bin
-/// b at angle b degrees, 5 m away; every third pulse has a second echo 1 m further, and the
-/// pulses of bin 7 of line 2 are missing. Lines [first, last) as ASCII PLY.
-void write_lines(const std::filesystem::path& path, int first, int last) {
-  std::string body;
-  int rows = 0;
-  for (int line = first; line < last; ++line) {
-    for (int bin = 0; bin < kBins; ++bin) {
-      if (line == 2 && bin == 7) continue;
-      const double angle = bin * M_PI / 180.0, sx = 651000 + 0.1 * line;
-      const int echoes = bin % 3 == 0 ? 2 : 1;
-      for (int echo = 1; echo <= echoes; ++echo) {
-        const double range = 5.0 + (echo - 1);
-        const double reported = angle;  // in [0, 2 pi): the angle wraps where a line starts
-        body += fmt::format("{:.4f} {:.4f} {:.4f} {:.4f} 6860000 40 {} {} {} {:.6f}\n", sx,
-                            6860000 + range * std::cos(angle), 40 + range * std::sin(angle), sx, reported + 1e-9, echo,
-                            echoes, 100.0 + line + bin * 1e-4);
-        ++rows;
-      }
-    }
-  }
-  test::write_text(path, fmt::format("ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n"
-                                     "property double z\nproperty double x_origin\nproperty double y_origin\n"
-                                     "property double z_origin\nproperty double theta\nproperty int num_echo\n"
-                                     "property int nb_of_echo\nproperty double gps_time\nend_header\n{}",
-                                     rows, body));
-}
+constexpr int kLines = test::kProfilerLines, kBins = test::kProfilerBins;
 
 void expect_the_synthetic_grid(const SensorGrid& g) {
   EXPECT_EQ(g.cols, static_cast<std::size_t>(kBins));
@@ -62,15 +36,15 @@ void expect_the_synthetic_grid(const SensorGrid& g) {
 
 TEST(ProfilerGrid, LinesWrapAnglesAndFirstEchoesLandInTheirCells) {
   test::TempDir dir;
-  write_lines(dir / "all.ply", 0, kLines);
+  test::write_profiler_lines(dir / "all.ply", 0, kLines);
   expect_the_synthetic_grid(profiler_grid({dir / "all.ply"}, {}));
 }
 
 TEST(ProfilerGrid, ChunksOfOneDriveGiveTheGridOfOneFile) {
   test::TempDir dir;
-  write_lines(dir / "all.ply", 0, kLines);
-  write_lines(dir / "a.ply", 0, 2);
-  write_lines(dir / "b.ply", 2, kLines);
+  test::write_profiler_lines(dir / "all.ply", 0, kLines);
+  test::write_profiler_lines(dir / "a.ply", 0, 2);
+  test::write_profiler_lines(dir / "b.ply", 2, kLines);
   const SensorGrid whole = profiler_grid({dir / "all.ply"}, {});
   const SensorGrid chunks = profiler_grid({dir / "a.ply", dir / "b.ply"}, {});
   expect_the_synthetic_grid(chunks);
@@ -79,9 +53,50 @@ TEST(ProfilerGrid, ChunksOfOneDriveGiveTheGridOfOneFile) {
   EXPECT_EQ(chunks.times, whole.times);
 }
 
+TEST(ProfilerGrid, BandsHoldTheWholeGridsCellsAndEachRepeatsTheLastLineOfTheOneBefore) {
+  test::TempDir dir;
+  test::write_profiler_lines(dir / "a.ply", 0, 2);
+  test::write_profiler_lines(dir / "b.ply", 2, kLines);
+  const std::vector<std::filesystem::path> files{dir / "a.ply", dir / "b.ply"};
+  const SensorGrid whole = profiler_grid(files, {});
+  for (const std::size_t rows : {1, 2, 3, 4, 5, 9}) {  // 1 asks for 2: a band needs a quad's two rows
+    std::vector<SensorGrid> bands;
+    const ProfilerGridShape shape =
+        for_each_profiler_band(files, {}, {0, rows * kBins}, [&](const SensorGrid& band) { bands.push_back(band); });
+    EXPECT_EQ(shape.rows, whole.rows);
+    EXPECT_EQ(shape.cols, whole.cols);
+    EXPECT_EQ(shape.origin, whole.origin);
+    // Row by row, the bands (less each one's repeated first row) are the whole grid.
+    SensorGrid joined;
+    joined.resize(0, whole.cols, false);
+    for (std::size_t b = 0; b < bands.size(); ++b) {
+      const SensorGrid& band = bands[b];
+      ASSERT_LE(band.rows, std::max<std::size_t>(rows, 2)) << rows;
+      EXPECT_EQ(band.origin, whole.origin);
+      EXPECT_TRUE(band.wrap_columns);
+      const std::size_t skip = b == 0 ? 0 : whole.cols;
+      if (b > 0) {
+        const SensorGrid& before = bands[b - 1];
+        const auto last = static_cast<std::ptrdiff_t>(before.index(before.rows - 1, 0));
+        EXPECT_TRUE(std::equal(band.points.begin(), band.points.begin() + kBins, before.points.begin() + last));
+        EXPECT_TRUE(std::equal(band.valid.begin(), band.valid.begin() + kBins, before.valid.begin() + last));
+      }
+      const auto from = static_cast<std::ptrdiff_t>(skip);
+      joined.points.insert(joined.points.end(), band.points.begin() + from, band.points.end());
+      joined.sensors.insert(joined.sensors.end(), band.sensors.begin() + from, band.sensors.end());
+      joined.times.insert(joined.times.end(), band.times.begin() + from, band.times.end());
+      joined.valid.insert(joined.valid.end(), band.valid.begin() + from, band.valid.end());
+    }
+    EXPECT_EQ(joined.points, whole.points) << rows;
+    EXPECT_EQ(joined.sensors, whole.sensors) << rows;
+    EXPECT_EQ(joined.times, whole.times) << rows;
+    EXPECT_EQ(joined.valid, whole.valid) << rows;
+  }
+}
+
 TEST(ProfilerGrid, LastEchoesAreTakenWhenAsked) {
   test::TempDir dir;
-  write_lines(dir / "all.ply", 0, kLines);
+  test::write_profiler_lines(dir / "all.ply", 0, kLines);
   ProfilerGridParams last;
   last.echo = ProfilerGridParams::Echo::last;
   const SensorGrid g = profiler_grid({dir / "all.ply"}, last);

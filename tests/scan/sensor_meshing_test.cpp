@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -146,6 +147,65 @@ TEST(SensorMeshing, RandomGridsOnlyJoinGridNeighboursWithinLimits) {
       const Vec3f p0 = g.points[cell];
       EXPECT_LE(std::abs(r.mesh.positions[v].x - p0.x), 0.2f + 1e-4f);
       EXPECT_LE(std::abs(r.mesh.positions[v].y - p0.y), 0.2f + 1e-4f);
+    }
+  }
+}
+
+/// Rows [first, first + height) of `g`.
+SensorGrid rows_of(const SensorGrid& g, std::size_t first, std::size_t height) {
+  SensorGrid band;
+  band.resize(height, g.cols, !g.labels.empty());
+  band.origin = g.origin;
+  band.wrap_columns = g.wrap_columns;
+  const auto from = static_cast<std::ptrdiff_t>(g.index(first, 0)), n = static_cast<std::ptrdiff_t>(height * g.cols);
+  std::copy(g.points.begin() + from, g.points.begin() + from + n, band.points.begin());
+  std::copy(g.sensors.begin() + from, g.sensors.begin() + from + n, band.sensors.begin());
+  std::copy(g.times.begin() + from, g.times.begin() + from + n, band.times.begin());
+  std::copy(g.valid.begin() + from, g.valid.begin() + from + n, band.valid.begin());
+  if (!g.labels.empty()) std::copy(g.labels.begin() + from, g.labels.begin() + from + n, band.labels.begin());
+  return band;
+}
+
+TEST(SensorMeshing, BandsMeshedOneAfterAnotherGiveTheWholeGridsMesh) {
+  // A bumpy, holed grid (some quads lose a corner, some triangles are refused), meshed whole
+  // and in bands of each height, each band repeating the last row of the one before.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> bump(-0.05f, 0.05f);
+  for (const bool wrap : {false, true}) {
+    SensorGrid g = plane(23, 17, 0.1f);
+    g.wrap_columns = wrap;
+    for (std::size_t i = 0; i < g.points.size(); ++i) {
+      g.points[i].z += bump(rng) + (rng() % 15 == 0 ? 1.0f : 0.0f);  // a spike: its edges are too long
+      g.times[i] = 0.001 * static_cast<double>(i);
+      g.labels[i] = static_cast<std::uint32_t>(rng() % 3);
+      g.valid[i] = rng() % 9 != 0 ? 1 : 0;
+    }
+    const SensorMeshResult whole = mesh_sensor_grid(g, {}, 4);
+    ASSERT_GT(whole.stats.rejected_long_edge, 0u);
+    for (const std::size_t height : {2, 3, 5, 22, 23}) {
+      SensorBand where;
+      SensorMeshResult joined;
+      for (std::size_t first = 0; first + 1 < g.rows; first += height - 1) {
+        ASSERT_EQ(where.first_row, first);
+        const SensorMeshResult r = mesh_sensor_band(rows_of(g, first, std::min(height, g.rows - first)), {}, 4, where);
+        const Mesh& m = r.mesh;
+        joined.mesh.positions.insert(joined.mesh.positions.end(), m.positions.begin(), m.positions.end());
+        joined.mesh.sensor_positions.insert(joined.mesh.sensor_positions.end(), m.sensor_positions.begin(),
+                                            m.sensor_positions.end());
+        joined.mesh.times.insert(joined.mesh.times.end(), m.times.begin(), m.times.end());
+        joined.mesh.triangles.insert(joined.mesh.triangles.end(), m.triangles.begin(), m.triangles.end());
+        joined.mesh.triangle_ids.insert(joined.mesh.triangle_ids.end(), m.triangle_ids.begin(), m.triangle_ids.end());
+        joined.face_labels.insert(joined.face_labels.end(), r.face_labels.begin(), r.face_labels.end());
+        joined.stats.candidates += r.stats.candidates;
+        EXPECT_EQ(where.first_vertex, joined.mesh.positions.size());
+      }
+      EXPECT_EQ(joined.mesh.positions, whole.mesh.positions) << height;
+      EXPECT_EQ(joined.mesh.sensor_positions, whole.mesh.sensor_positions) << height;
+      EXPECT_EQ(joined.mesh.times, whole.mesh.times) << height;
+      EXPECT_EQ(joined.mesh.triangles, whole.mesh.triangles) << height;
+      EXPECT_EQ(joined.mesh.triangle_ids, whole.mesh.triangle_ids) << height;
+      EXPECT_EQ(joined.face_labels, whole.face_labels) << height;
+      EXPECT_EQ(joined.stats.candidates, whole.stats.candidates) << height;
     }
   }
 }

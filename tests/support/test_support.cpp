@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 #include "test_support.h"
 
+#include <fmt/format.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <random>
@@ -83,6 +85,31 @@ std::map<std::string, std::string> result_bytes(const std::filesystem::path& out
     }
   }
   return files;
+}
+
+void write_profiler_lines(const std::filesystem::path& path, int first, int last) {
+  std::string body;
+  int rows = 0;
+  for (int line = first; line < last; ++line) {
+    for (int bin = 0; bin < kProfilerBins; ++bin) {
+      if (line == 2 && bin == 7) continue;
+      const double angle = bin * M_PI / 180.0, sx = 651000 + 0.1 * line;
+      const int echoes = bin % 3 == 0 ? 2 : 1;
+      for (int echo = 1; echo <= echoes; ++echo) {
+        const double range = 5.0 + (echo - 1);
+        const double reported = angle;  // in [0, 2 pi): the angle wraps where a line starts
+        body += fmt::format("{:.4f} {:.4f} {:.4f} {:.4f} 6860000 40 {} {} {} {:.6f}\n", sx,
+                            6860000 + range * std::cos(angle), 40 + range * std::sin(angle), sx, reported + 1e-9, echo,
+                            echoes, 100.0 + line + bin * 1e-4);
+        ++rows;
+      }
+    }
+  }
+  write_text(path, fmt::format("ply\nformat ascii 1.0\nelement vertex {}\nproperty double x\nproperty double y\n"
+                               "property double z\nproperty double x_origin\nproperty double y_origin\n"
+                               "property double z_origin\nproperty double theta\nproperty int num_echo\n"
+                               "property int nb_of_echo\nproperty double gps_time\nend_header\n{}",
+                               rows, body));
 }
 
 }  // namespace citymesh::test

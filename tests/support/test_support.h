@@ -49,4 +49,12 @@ std::string read_text(const std::filesystem::path& path);
 std::map<std::string, std::string> result_bytes(const std::filesystem::path& output);
 void write_text(const std::filesystem::path& path, const std::string& text);
 
+/// A synthetic profiler drive of kProfilerLines scan lines, a pulse every degree: a profiler at
+/// (651000 + 0.1 line, 6860000, 40) turning in the x = const plane, line l, bin b at angle b
+/// degrees, 5 m away; every third pulse has a second echo 1 m further, and the pulses of bin 7
+/// of line 2 are missing. Lines [first, last) as ASCII PLY with theta, num_echo, nb_of_echo,
+/// gps_time and the sensor origin.
+constexpr int kProfilerLines = 5, kProfilerBins = 360;
+void write_profiler_lines(const std::filesystem::path& path, int first, int last);
+
 }  // namespace citymesh::test

@@ -63,4 +63,24 @@ struct SensorMeshResult {
 SensorMeshResult mesh_sensor_grid(const SensorGrid& grid, const SensorMeshingParams& params = {},
                                   std::uint32_t acquisition = 0);
 
+/// Where a band of consecutive rows sits in a grid meshed band by band (mesh_sensor_band),
+/// and what the band before left for it. Starts as the first band's (row 0, vertex 0).
+struct SensorBand {
+  std::size_t first_row = 0;       ///< the band's row 0 is this row of the whole grid
+  std::uint32_t first_vertex = 0;  ///< the id the band's first new vertex gets
+  /// Per column of the band's row 0 (the previous band's last row): the vertex id that cell
+  /// got there, or UINT32_MAX; empty for the first band.
+  std::vector<std::uint32_t> carried;
+};
+
+/// Meshes a grid that is never whole in memory (a long profiler drive), a band of rows at a
+/// time: `band` holds rows where.first_row ... of the whole grid, its row 0 repeating the
+/// previous band's last row (for all bands but the first). Gives the triangles, ids and
+/// orientations mesh_sensor_grid() gives the band's quads in the whole grid, with the vertices
+/// numbered on from where.first_vertex in order of first use: the bands' results, appended,
+/// are the whole grid's mesh. Returns the band's new vertices only (triangles name earlier
+/// bands' vertices by their ids) and advances `where` to the next band.
+SensorMeshResult mesh_sensor_band(const SensorGrid& band, const SensorMeshingParams& params, std::uint32_t acquisition,
+                                  SensorBand& where);
+
 }  // namespace citymesh
