@@ -14,6 +14,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/core/triangle_reach.h"
 #include "store_files.h"
 #include "tile_block_writer.h"
 
@@ -187,11 +188,7 @@ class AcquisitionTiler {
   void note_radius(const std::array<Vec3d, 3>& c, const Box3d& box) {
     const double dx = box.max.x - box.min.x, dy = box.max.y - box.min.y;
     if (dx * dx + dy * dy <= largest_radius_squared_) return;
-    const Vec3d centroid = (c[0] + c[1] + c[2]) / 3.0;
-    for (const Vec3d& p : c) {
-      const double ex = p.x - centroid.x, ey = p.y - centroid.y;
-      largest_radius_squared_ = std::max(largest_radius_squared_, ex * ex + ey * ey);
-    }
+    largest_radius_squared_ = std::max(largest_radius_squared_, horizontal_reach_squared(c));
   }
 
   void add_copy(TileKey key, std::uint32_t triangle, TileRole role) {

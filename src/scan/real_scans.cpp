@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
 
 #include "citymesh/core/error.h"
 
@@ -91,24 +92,25 @@ void place(SensorGrid& g, std::size_t row, const Pulse& p, double step) {
 std::size_t columns_of(double step) { return static_cast<std::size_t>(std::lround(2 * M_PI / step)); }
 
 /// Makes `band` rows [first, first + height) of a grid of `lines` rows (height at most
-/// `rows`), its row 0 the old band's last row when `keep_last` (the next band overlaps the
-/// one before by a row).
+/// `rows`), empty; with `keep_last`, its row 0 is the old band's last row (the next band
+/// overlaps the one before by a row).
 void start_band(SensorGrid& band, std::size_t first, std::size_t rows, std::size_t lines, bool keep_last) {
   const std::size_t cols = band.cols, height = std::min(rows, lines - first);
-  SensorGrid last;
-  if (keep_last) {
-    const auto from = static_cast<std::ptrdiff_t>(band.index(band.rows - 1, 0)), n = static_cast<std::ptrdiff_t>(cols);
-    last.points.assign(band.points.begin() + from, band.points.begin() + from + n);
-    last.sensors.assign(band.sensors.begin() + from, band.sensors.begin() + from + n);
-    last.times.assign(band.times.begin() + from, band.times.begin() + from + n);
-    last.valid.assign(band.valid.begin() + from, band.valid.begin() + from + n);
+  if (!keep_last) {
+    band.resize(height, cols, false);
+    return;
   }
-  band.resize(height, cols, false);
-  if (!keep_last) return;
-  std::copy(last.points.begin(), last.points.end(), band.points.begin());
-  std::copy(last.sensors.begin(), last.sensors.end(), band.sensors.begin());
-  std::copy(last.times.begin(), last.times.end(), band.times.begin());
-  std::copy(last.valid.begin(), last.valid.end(), band.valid.begin());
+  const auto last = static_cast<std::ptrdiff_t>(band.index(band.rows - 1, 0)), n = static_cast<std::ptrdiff_t>(cols);
+  const auto keep_last_row_only = [&](auto& cells) {
+    if (last > 0) std::copy(cells.begin() + last, cells.begin() + last + n, cells.begin());  // rows never overlap
+    cells.resize(height * cols);
+    std::fill(cells.begin() + n, cells.end(), typename std::decay_t<decltype(cells)>::value_type{});
+  };
+  keep_last_row_only(band.points);
+  keep_last_row_only(band.sensors);
+  keep_last_row_only(band.times);
+  keep_last_row_only(band.valid);
+  band.rows = height;
 }
 
 }  // namespace

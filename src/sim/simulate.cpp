@@ -15,6 +15,7 @@
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/core/triangle_reach.h"
 #include "citymesh/io/ply_writer.h"
 
 namespace citymesh {
@@ -78,17 +79,12 @@ std::string objects_json(const std::vector<Scene>& scenes, const SimulateParams&
   return j.dump(1) + "\n";
 }
 
-/// The largest x-y distance from a triangle's centroid to one of its corners, as `run`'s
-/// tiling measures it (TilingStats::largest_radius).
+/// The largest x-y reach of the mesh's triangles from their centroids, as `run`'s tiling
+/// measures it (TilingStats::largest_radius).
 double largest_horizontal_reach(const Mesh& mesh) {
   double largest_squared = 0;
   for (std::size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const auto [a, b, c] = mesh.corners(t);
-    const Vec3d centroid = (a + b + c) / 3.0;
-    for (const Vec3d& q : {a, b, c}) {
-      const double dx = q.x - centroid.x, dy = q.y - centroid.y;
-      largest_squared = std::max(largest_squared, dx * dx + dy * dy);
-    }
+    largest_squared = std::max(largest_squared, horizontal_reach_squared(mesh.corners(t)));
   }
   return std::sqrt(largest_squared);
 }
