@@ -19,11 +19,18 @@ void PairList::push_back(const EnergyPair& p) {
     return std::array{std::bit_cast<std::uint64_t>(v[0]), std::bit_cast<std::uint64_t>(v[1]),
                       std::bit_cast<std::uint64_t>(v[2]), std::bit_cast<std::uint64_t>(v[3])};
   };
+  if (ends_.size() >= UINT32_MAX) throw ProcessingError("energy: too many pair terms");
   if (rows_.empty() || bits(rows_.back()) != bits(w)) {
-    if (rows_.size() >= (1u << 31)) throw ProcessingError("energy: too many distinct pair terms");
     rows_.push_back(w);
+    row_starts_.push_back(static_cast<std::uint32_t>(ends_.size()));
   }
-  ends_.push_back({p.i, p.j, static_cast<std::uint32_t>(rows_.size() - 1)});
+  ends_.push_back({p.i, p.j});
+}
+
+std::uint32_t PairList::row(std::size_t k) const {
+  const auto after = std::upper_bound(row_starts_.begin(), row_starts_.end(), k,
+                                      [](std::size_t term, std::uint32_t start) { return term < start; });
+  return after == row_starts_.begin() ? 0 : static_cast<std::uint32_t>(after - row_starts_.begin() - 1);
 }
 
 double BinaryEnergy::evaluate(std::span<const std::int8_t> x) const {
@@ -219,8 +226,8 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   // triangle, so three meshes overlapping close a cycle within the last meshes' overlaps.
   const std::size_t n = e.size();
   ParitySets sets(n);
-  for (std::size_t k = e.pairs.size(); k-- > 0;) {
-    const BinaryEnergy::Pair p = e.pairs[k];
+  for (auto it = e.pairs.end(); it != e.pairs.begin();) {
+    const BinaryEnergy::Pair p = *--it;
     const double c = coupling(p);
     if (c != 0 && !sets.join(p.i, p.j, c < 0)) return std::nullopt;
   }

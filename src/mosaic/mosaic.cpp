@@ -222,9 +222,9 @@ void account(const MosaicEnergy& e, std::span<const std::int8_t> x, MosaicStats&
     stats.boundary += e.boundary[v];
     ++stats.selected;
   }
-  for (std::size_t k = 0; k < e.energy.pairs.size(); ++k) {
-    const auto& p = e.energy.pairs[k];
-    if (k < stats.seam_terms) {
+  std::size_t k = 0;
+  for (const EnergyPair p : e.energy.pairs) {
+    if (k++ < stats.seam_terms) {
       if (x[p.i] != x[p.j]) stats.seam += p.e01;
     } else if (x[p.i] != 0 && x[p.j] != 0) {
       stats.overlap += p.e11;

@@ -18,10 +18,9 @@ namespace {
 double local_cost(const BinaryEnergy& e, const PairIndex& index, std::span<const std::int8_t> x, std::uint32_t v,
                   bool l) {
   double c = e.unary[v][l ? 1 : 0];
-  for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-    const std::uint32_t o = PairIndex::variable(index.ends[entry]);
-    c += index.values(entry)[(l ? 2 : 0) + (x[o] != 0 ? 1 : 0)];
-  }
+  index.for_each_term(v, [&](std::uint32_t end, const PairIndex::Values& w) {
+    c += w[(l ? 2 : 0) + (x[PairIndex::variable(end)] != 0 ? 1 : 0)];
+  });
   return c;
 }
 
@@ -55,8 +54,8 @@ std::vector<std::vector<std::uint32_t>> free_components(const BinaryEnergy& e, c
     seen[s] = 1;
     c.push_back(s);
     for (std::size_t head = 0; head < c.size(); ++head) {
-      for (std::uint32_t entry = index.offsets[c[head]]; entry < index.offsets[c[head] + 1]; ++entry) {
-        const std::uint32_t o = PairIndex::variable(index.ends[entry]);
+      for (const std::uint32_t end : index.ends(c[head])) {
+        const std::uint32_t o = PairIndex::variable(end);
         if (is_free[o] != 0 && seen[o] == 0) {
           seen[o] = 1;
           c.push_back(o);
@@ -74,11 +73,11 @@ double component_energy(const BinaryEnergy& e, const PairIndex& index, std::span
   for (const std::uint32_t v : component) mark[v] = 1;
   for (const std::uint32_t v : component) {
     sum += e.unary[v][static_cast<std::size_t>(x[v])];
-    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-      const std::uint32_t o = PairIndex::variable(index.ends[entry]);
-      if (mark[o] != 0 && o < v) continue;  // both ends inside: counted once
-      sum += index.values(entry)[(x[v] != 0 ? 2 : 0) + (x[o] != 0 ? 1 : 0)];
-    }
+    index.for_each_term(v, [&](std::uint32_t end, const PairIndex::Values& w) {
+      const std::uint32_t o = PairIndex::variable(end);
+      if (mark[o] != 0 && o < v) return;  // both ends inside: counted once
+      sum += w[(x[v] != 0 ? 2 : 0) + (x[o] != 0 ? 1 : 0)];
+    });
   }
   for (const std::uint32_t v : component) mark[v] = 0;
   return sum;

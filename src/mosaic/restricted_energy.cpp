@@ -9,57 +9,78 @@
 
 namespace citymesh::mosaic_detail {
 
-PairIndex::PairIndex(const BinaryEnergy& e) : offsets(e.size() + 1, 0) {
+namespace {
+
+/// Per block of terms, per variable: a count, then where the block's next item of the
+/// variable goes.
+using BlockCounts = std::vector<std::vector<std::uint32_t>>;
+
+/// Turns per-block counts into cursors: block b's items of variable v go after those of v in
+/// blocks before b, and after those of the variables before v. Returns the offsets (n + 1).
+std::vector<std::uint32_t> counts_to_cursors(BlockCounts& counts, std::size_t n) {
+  std::vector<std::uint32_t> offsets(n + 1, 0);
+  std::uint64_t at = 0;
+  for (std::size_t v = 0; v < n; ++v) {
+    offsets[v] = static_cast<std::uint32_t>(at);
+    for (std::vector<std::uint32_t>& block : counts) {
+      const std::uint32_t count = block[v];
+      block[v] = static_cast<std::uint32_t>(at);
+      at += count;
+    }
+    if (at >= PairIndex::kAtJ) throw ProcessingError("energy: too many pair terms");
+  }
+  offsets[n] = static_cast<std::uint32_t>(at);
+  return offsets;
+}
+
+}  // namespace
+
+PairIndex::PairIndex(const BinaryEnergy& e) : rows_(e.pairs.values()) {
   if (e.size() >= kAtJ) throw ProcessingError("energy: too many variables");
   const std::size_t n = e.size();
   const PairList& terms = e.pairs;
   // Blocks of consecutive pairs, each counted and then filled on its own thread, at entries
   // after those of the blocks before it: every row lists its pairs in increasing order, as a
-  // single pass would, whatever the number of blocks (the serial pass was half the index's time).
+  // single pass would, whatever the number of blocks (the serial pass was half the index's
+  // time). A run starts where a variable's row changes within a block: a block's first run of
+  // a variable may repeat the row of the block before's last, which reads the same.
   constexpr std::size_t kMinBlockPairs = 1 << 16;
   const std::size_t blocks =
       std::clamp<std::size_t>(terms.size() / kMinBlockPairs, 1, std::min(4u, available_threads()));
   const auto block_begin = [&](std::size_t b) { return terms.size() * b / blocks; };
-  std::vector<std::vector<std::uint32_t>> at(blocks, std::vector<std::uint32_t>(n, 0));
+  BlockCounts entry_at(blocks, std::vector<std::uint32_t>(n, 0)), run_at = entry_at;
+  BlockCounts last_row(blocks, std::vector<std::uint32_t>(n, UINT32_MAX));
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
-      for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        const auto [i, j] = terms.variables(k);
+      for (auto term = terms.begin() + block_begin(b); term != terms.begin() + block_begin(b + 1); ++term) {
+        const auto [i, j] = term.variables();
         if (i == j) throw ProcessingError("energy: a pair joins a variable to itself");
-        ++at[b][i];
-        ++at[b][j];
+        const std::uint32_t row = term.row();
+        for (const std::uint32_t v : {i, j}) {
+          ++entry_at[b][v];
+          if (last_row[b][v] != row) ++run_at[b][v];
+          last_row[b][v] = row;
+        }
       }
     }
   });
-  for (std::size_t v = 0; v < n; ++v) {
-    std::uint32_t row = offsets[v];
-    for (std::vector<std::uint32_t>& counts : at) {
-      const std::uint32_t count = counts[v];
-      counts[v] = row;  // from here on: where block b's next entry of v goes
-      row += count;
-    }
-    offsets[v + 1] = row;
-  }
-  ends.resize(offsets.back());
-  value_rows.resize(offsets.back());
-  // Each of the energy's rows twice: seen from i, and from j (e01 and e10 swapped).
-  const std::span<const std::array<double, 4>> shared = terms.values();
-  rows.resize(2 * shared.size());
-  for (std::size_t r = 0; r < shared.size(); ++r) {
-    const auto& [e00, e01, e10, e11] = shared[r];
-    rows[2 * r] = {e00, e01, e10, e11};
-    rows[2 * r + 1] = {e00, e10, e01, e11};
-  }
+  offsets_ = counts_to_cursors(entry_at, n);
+  run_offsets_ = counts_to_cursors(run_at, n);
+  ends_.resize(offsets_.back());
+  runs_.resize(run_offsets_.back());
+  for (std::vector<std::uint32_t>& rows : last_row) std::fill(rows.begin(), rows.end(), UINT32_MAX);
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
-      std::vector<std::uint32_t>& fill = at[b];
-      for (std::size_t k = block_begin(b); k < block_begin(b + 1); ++k) {
-        const auto [i, j] = terms.variables(k);
-        const std::uint32_t row = 2 * terms.row(k);
-        ends[fill[i]] = j;
-        value_rows[fill[i]++] = row;
-        ends[fill[j]] = i | kAtJ;
-        value_rows[fill[j]++] = row + 1;
+      const auto add = [&, b](std::uint32_t v, std::uint32_t other_end, std::uint32_t row) {
+        if (last_row[b][v] != row) runs_[run_at[b][v]++] = {entry_at[b][v], row};
+        last_row[b][v] = row;
+        ends_[entry_at[b][v]++] = other_end;
+      };
+      for (auto term = terms.begin() + block_begin(b); term != terms.begin() + block_begin(b + 1); ++term) {
+        const auto [i, j] = term.variables();
+        const std::uint32_t row = term.row();
+        add(i, j, row);
+        add(j, i | kAtJ, row);
       }
     }
   });
@@ -74,18 +95,17 @@ BinaryEnergy restricted(const BinaryEnergy& e, const PairIndex& index, std::span
   for (std::uint32_t l = 0; l < open.size(); ++l) {
     const std::uint32_t v = open[l];
     r.unary[l] = e.unary[v];
-    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-      const std::uint32_t end = index.ends[entry], o = PairIndex::variable(end);
-      const auto& w = index.values(entry);  // w[2 * (this end) + (other end)]
+    index.for_each_term(v, [&](std::uint32_t end, const PairIndex::Values& w) {
+      const std::uint32_t o = PairIndex::variable(end);
       if (to_local[o] != UINT32_MAX) {
         // Both ends open: the pair is taken once, from its i end.
         if ((end & PairIndex::kAtJ) == 0) r.pairs.push_back({l, to_local[o], w[0], w[1], w[2], w[3]});
-        continue;
+        return;
       }
       const std::size_t other = x[o] != 0 ? 1 : 0;
       r.unary[l][0] += w[other];
       r.unary[l][1] += w[2 + other];
-    }
+    });
   }
   for (const std::uint32_t v : open) to_local[v] = UINT32_MAX;
   return r;
@@ -115,8 +135,8 @@ std::vector<std::uint32_t> grow_region(const PairIndex& index, std::vector<std::
   for (std::uint32_t hop = 0; hop < hops && ring_begin < region.size(); ++hop) {
     const std::size_t ring_end = region.size();
     for (std::size_t r = ring_begin; r < ring_end; ++r) {
-      for (std::uint32_t entry = index.offsets[region[r]]; entry < index.offsets[region[r] + 1]; ++entry) {
-        const std::uint32_t o = PairIndex::variable(index.ends[entry]);
+      for (const std::uint32_t end : index.ends(region[r])) {
+        const std::uint32_t o = PairIndex::variable(end);
         if (open[o] == 0 || mark[o] != 0) continue;
         mark[o] = 1;
         region.push_back(o);
@@ -147,11 +167,9 @@ std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const s
                                        std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
                                        std::uint32_t hops, std::vector<std::uint8_t>& mark) {
   const auto on_seam = [&](std::uint32_t v) {
-    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-      const auto& w = index.values(entry);
-      if (w[1] + w[2] > w[0] + w[3] && x[PairIndex::variable(index.ends[entry])] != x[v]) return true;
-    }
-    return false;
+    return index.any_term(v, [&](std::uint32_t end, const PairIndex::Values& w) {
+      return w[1] + w[2] > w[0] + w[3] && x[PairIndex::variable(end)] != x[v];
+    });
   };
   const std::vector<std::uint8_t> seam_flag = flags_of(all, on_seam);
   std::vector<std::uint32_t> seeds;
@@ -164,11 +182,11 @@ std::vector<std::uint32_t> seam_region(const PairIndex& index, std::span<const s
 SlabSplit split_by_slab(const PairIndex& index, std::span<const std::uint32_t> all, std::span<const std::uint8_t> open,
                         std::span<const std::uint32_t> slab, std::uint32_t slabs) {
   const auto on_border = [&](std::uint32_t v) {
-    for (std::uint32_t entry = index.offsets[v]; entry < index.offsets[v + 1]; ++entry) {
-      const std::uint32_t o = PairIndex::variable(index.ends[entry]);
-      if (open[o] != 0 && slab[o] != slab[v]) return true;
-    }
-    return false;
+    const std::span<const std::uint32_t> ends = index.ends(v);
+    return std::any_of(ends.begin(), ends.end(), [&](std::uint32_t end) {
+      const std::uint32_t o = PairIndex::variable(end);
+      return open[o] != 0 && slab[o] != slab[v];
+    });
   };
   const std::vector<std::uint8_t> border_flag = flags_of(all, on_border);
   SlabSplit out;

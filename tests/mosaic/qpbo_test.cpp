@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <random>
+#include <ranges>
 #include <span>
 #include <tuple>
 #include <utility>
@@ -325,33 +326,53 @@ TEST(GroupMoves, ThePairIndexListsEachVariablesTermsInOrderOnAnyThreadCount) {
     }
   }
   for (const BinaryEnergy::Pair& p : terms) e.pairs.push_back(p);
-  const auto check = [&](const mosaic_detail::PairIndex& index) {
-    ASSERT_LE(index.rows.size(), 2 * (m - 3 * (m / 10) + 6));
-    // Brute force: each variable's terms in increasing order, with the other end and the
-    // values seen from this end.
-    std::vector<std::vector<std::uint32_t>> rows(n);
-    for (std::uint32_t k = 0; k < e.pairs.size(); ++k) {
-      rows[e.pairs[k].i].push_back(k);
-      rows[e.pairs[k].j].push_back(k);
-    }
+  // Brute force: each variable's terms in increasing order, and how many runs of one row
+  // (of the energy's shared rows) they make.
+  std::vector<std::vector<std::uint32_t>> rows(n);
+  for (std::uint32_t k = 0; k < e.pairs.size(); ++k) {
+    rows[e.pairs[k].i].push_back(k);
+    rows[e.pairs[k].j].push_back(k);
+  }
+  std::size_t runs = 0;
+  for (const std::vector<std::uint32_t>& r : rows) {
+    for (std::size_t t = 0; t < r.size(); ++t) runs += t == 0 || e.pairs.row(r[t]) != e.pairs.row(r[t - 1]) ? 1 : 0;
+  }
+  // The equal terms share runs: at most one per variable and range of them.
+  std::size_t equal = 0;
+  for (const auto& p : terms) equal += p.e01 == 0.5 && p.e10 == -0.25 ? 1 : 0;
+  ASSERT_GT(equal, m / 4);
+  ASSERT_LE(runs, 2 * (m - equal) + 3 * n);
+  const auto check = [&](const mosaic_detail::PairIndex& index, std::size_t blocks) {
+    ASSERT_EQ(index.entries(), 2 * m);
+    // A block may start a run its predecessor's last run continues: at most one per
+    // variable and block border.
+    ASSERT_GE(index.runs(), runs);
+    ASSERT_LE(index.runs(), runs + (blocks - 1) * n);
     for (std::uint32_t v = 0; v < n; ++v) {
-      ASSERT_EQ(index.offsets[v + 1] - index.offsets[v], rows[v].size()) << v;
+      std::vector<std::pair<std::uint32_t, std::array<double, 4>>> seen;
+      index.for_each_term(v, [&](std::uint32_t end, const std::array<double, 4>& w) { seen.emplace_back(end, w); });
+      ASSERT_EQ(seen.size(), rows[v].size()) << v;
+      ASSERT_TRUE(std::ranges::equal(index.ends(v), seen | std::views::keys)) << v;
       for (std::size_t r = 0; r < rows[v].size(); ++r) {
-        const std::uint32_t entry = index.offsets[v] + static_cast<std::uint32_t>(r);
         const auto& p = terms[rows[v][r]];
         const bool at_j = p.i != v;
-        ASSERT_EQ(index.ends[entry], at_j ? (p.i | mosaic_detail::PairIndex::kAtJ) : p.j);
-        const std::array<double, 4> seen =
+        ASSERT_EQ(seen[r].first, at_j ? (p.i | mosaic_detail::PairIndex::kAtJ) : p.j);
+        const std::array<double, 4> from_v =
             at_j ? std::array{p.e00, p.e10, p.e01, p.e11} : std::array{p.e00, p.e01, p.e10, p.e11};
-        ASSERT_EQ(index.values(entry), seen);
+        ASSERT_EQ(seen[r].second, from_v) << v << " term " << r;
       }
+      // any_term stops at the first visit that says so.
+      std::size_t visits = 0;
+      const bool found = index.any_term(v, [&](std::uint32_t, const std::array<double, 4>&) { return ++visits == 2; });
+      ASSERT_EQ(found, rows[v].size() >= 2);
+      ASSERT_EQ(visits, std::min<std::size_t>(2, rows[v].size()));
     }
   };
   {
     const ThreadLimit one(1);
-    check(mosaic_detail::PairIndex(e));
+    check(mosaic_detail::PairIndex(e), 1);
   }
-  check(mosaic_detail::PairIndex(e));
+  check(mosaic_detail::PairIndex(e), std::min(4u, available_threads()));
 }
 
 TEST(Qpbo, FlipsAreFoundExactlyWhenSomeFlippingMakesEveryCouplingAttractive) {
@@ -446,6 +467,18 @@ TEST(PairList, GivesBackEachTermBitForBitAndSharesTheValuesOfEqualNeighboursOnly
     ++k;
   }
   EXPECT_EQ(k, terms.size());
+  // Indexed, walked backwards and jumped to: the same terms, on the same rows.
+  for (auto it = list.end(); it != list.begin();) {
+    --it;
+    k = static_cast<std::size_t>(it - list.begin());
+    EXPECT_EQ(bits(*it), bits(terms[k])) << k;
+    EXPECT_EQ(bits(list[k]), bits(terms[k])) << k;
+    EXPECT_EQ(it.row(), list.row(k)) << k;
+    EXPECT_EQ(bits(list.begin()[static_cast<std::ptrdiff_t>(k)]), bits(terms[k])) << k;
+  }
+  EXPECT_EQ(list.row(0), 0u);
+  EXPECT_EQ(list.row(2), 0u);
+  EXPECT_EQ(list.row(3), 1u);
   EXPECT_EQ(list.row(5), list.row(6));
   EXPECT_NE(list.row(2), list.row(3));
 }

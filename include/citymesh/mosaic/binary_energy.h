@@ -25,10 +25,11 @@ struct EnergyPair {
 };
 
 /// The pairwise terms of an energy, in the order they were added, kept compactly: each term's
-/// two variables and the row of its values {e00, e01, e10, e11}, a row shared by consecutive
-/// terms whose values are equal bit for bit. The mosaic's overlap terms all have the same
-/// values and a spinning scanner's tile holds about 12 of them per variable: 12 bytes a term
-/// instead of 40 (a term read back is the one added, bit for bit).
+/// two variables, and rows of values {e00, e01, e10, e11}, each shared by a run of consecutive
+/// terms whose values are equal bit for bit (a row holds where its run starts). The mosaic's
+/// overlap terms all have the same values and a spinning scanner's tile holds ~28 of them per
+/// variable: 8 bytes a term instead of 40 (a term read back is the one added, bit for bit).
+/// Walk the terms in order (the iterator keeps its row); indexing finds the row by bisection.
 class PairList {
  public:
   /// Reads a term back, by value (the list holds no EnergyPair).
@@ -40,25 +41,52 @@ class PairList {
     using pointer = void;
     using reference = EnergyPair;
     Iterator() = default;
-    Iterator(const PairList* list, std::size_t k) : list_(list), k_(static_cast<difference_type>(k)) {}
-    EnergyPair operator*() const { return (*list_)[static_cast<std::size_t>(k_)]; }
+    Iterator(const PairList* list, std::size_t k) : list_(list), k_(k), row_(list->row(k)) {}
+    EnergyPair operator*() const { return list_->term(k_, row_); }
     EnergyPair operator[](difference_type d) const { return *(*this + d); }
-    Iterator& operator++() { return ++k_, *this; }
-    Iterator operator++(int) { return {list_, static_cast<std::size_t>(k_++)}; }
-    Iterator& operator--() { return --k_, *this; }
-    Iterator operator--(int) { return {list_, static_cast<std::size_t>(k_--)}; }
-    Iterator& operator+=(difference_type d) { return k_ += d, *this; }
-    Iterator& operator-=(difference_type d) { return k_ -= d, *this; }
+    Iterator& operator++() {
+      ++k_;
+      if (row_ + 1 < list_->row_starts_.size() && list_->row_starts_[row_ + 1] <= k_) ++row_;
+      return *this;
+    }
+    Iterator operator++(int) {
+      const Iterator old = *this;
+      ++*this;
+      return old;
+    }
+    Iterator& operator--() {
+      --k_;
+      if (list_->row_starts_[row_] > k_) --row_;
+      return *this;
+    }
+    Iterator operator--(int) {
+      const Iterator old = *this;
+      --*this;
+      return old;
+    }
+    Iterator& operator+=(difference_type d) {
+      k_ = static_cast<std::size_t>(static_cast<difference_type>(k_) + d);
+      row_ = list_->row(k_);
+      return *this;
+    }
+    Iterator& operator-=(difference_type d) { return *this += -d; }
     friend Iterator operator+(Iterator it, difference_type d) { return it += d; }
     friend Iterator operator+(difference_type d, Iterator it) { return it += d; }
     friend Iterator operator-(Iterator it, difference_type d) { return it -= d; }
-    friend difference_type operator-(const Iterator& a, const Iterator& b) { return a.k_ - b.k_; }
+    friend difference_type operator-(const Iterator& a, const Iterator& b) {
+      return static_cast<difference_type>(a.k_) - static_cast<difference_type>(b.k_);
+    }
     friend bool operator==(const Iterator& a, const Iterator& b) { return a.k_ == b.k_; }
     friend auto operator<=>(const Iterator& a, const Iterator& b) { return a.k_ <=> b.k_; }
+    /// The term's variables {i, j}, without its values.
+    [[nodiscard]] std::array<std::uint32_t, 2> variables() const { return list_->variables(k_); }
+    /// The term's row of values().
+    [[nodiscard]] std::uint32_t row() const { return row_; }
 
    private:
     const PairList* list_ = nullptr;
-    difference_type k_ = 0;
+    std::size_t k_ = 0;
+    std::uint32_t row_ = 0;
   };
 
   void push_back(const EnergyPair& p);
@@ -66,33 +94,39 @@ class PairList {
   void reserve(std::size_t terms, std::size_t rows = 0) {
     ends_.reserve(terms);
     rows_.reserve(rows);
+    row_starts_.reserve(rows);
   }
   void clear() {
     ends_.clear();
     rows_.clear();
+    row_starts_.clear();
   }
   [[nodiscard]] std::size_t size() const { return ends_.size(); }
   [[nodiscard]] bool empty() const { return ends_.empty(); }
-  [[nodiscard]] EnergyPair operator[](std::size_t k) const {
-    const Ends& t = ends_[k];
-    const std::array<double, 4>& w = rows_[t.row];
-    return {t.i, t.j, w[0], w[1], w[2], w[3]};
-  }
+  /// Term k (its row found by bisection: walk with an iterator instead).
+  [[nodiscard]] EnergyPair operator[](std::size_t k) const { return term(k, row(k)); }
   [[nodiscard]] Iterator begin() const { return {this, 0}; }
   [[nodiscard]] Iterator end() const { return {this, size()}; }
   /// Term k's variables {i, j}, without its values.
   [[nodiscard]] std::array<std::uint32_t, 2> variables(std::size_t k) const { return {ends_[k].i, ends_[k].j}; }
-  /// Term k's row of values(), which equal terms share.
-  [[nodiscard]] std::uint32_t row(std::size_t k) const { return ends_[k].row; }
-  /// The distinct rows of values {e00, e01, e10, e11}.
+  /// Term k's row of values(), which equal consecutive terms share (by bisection; the last
+  /// row for k = size()).
+  [[nodiscard]] std::uint32_t row(std::size_t k) const;
+  /// The distinct rows of values {e00, e01, e10, e11}; a later term's row is never before an
+  /// earlier term's.
   [[nodiscard]] std::span<const std::array<double, 4>> values() const { return rows_; }
 
  private:
   struct Ends {
-    std::uint32_t i, j, row;
+    std::uint32_t i, j;
   };
+  [[nodiscard]] EnergyPair term(std::size_t k, std::uint32_t row) const {
+    const std::array<double, 4>& w = rows_[row];
+    return {ends_[k].i, ends_[k].j, w[0], w[1], w[2], w[3]};
+  }
   std::vector<Ends> ends_;
   std::vector<std::array<double, 4>> rows_;
+  std::vector<std::uint32_t> row_starts_;  ///< per row: its first term
 };
 
 /// E(x) = sum_i unary[i][x_i] + sum_(i,j) e[x_i][x_j].
