@@ -6,6 +6,7 @@
 #include <unordered_map>
 
 #include "citymesh/core/checksum.h"
+#include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/mosaic.h"
 
@@ -115,6 +116,51 @@ std::optional<bool> SettledSelection::selected(std::uint32_t acquisition, std::u
   return (*it & 1u) != 0;
 }
 
+namespace {
+
+bool by_ends(const LabelPair& x, const LabelPair& y) {
+  return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <
+         std::tie(y.a_acquisition, y.a_index, y.b_acquisition, y.b_index);
+}
+
+/// The consistent pairs and the pairs of layers of one pass with an owned end, as result
+/// pairs (a reader tells the two apart by their acquisitions, the same for both), sorted; the
+/// change step's lists are let go. `owned(g)` and `id(g)` tell a global triangle's role and
+/// (acquisition, index). The list is counted before it is made: a spinning scanner's tile
+/// holds ~25 M of them, and growing the list by doubling took that tile's peak from 2.3 to
+/// 3.1 GB.
+template <class Owned, class Id>
+std::vector<LabelPair> owned_pairs(ChangeResult& change, const Owned& owned, const Id& id) {
+  std::size_t count = 0;
+  for (const auto& pairs : {std::span(change.consistent_pairs), std::span(change.layer_pairs)}) {
+    count += static_cast<std::size_t>(std::count_if(
+        pairs.begin(), pairs.end(), [&](const TrianglePair& p) { return owned(p.first) || owned(p.second); }));
+  }
+  std::vector<LabelPair> out;
+  out.reserve(count);
+  std::size_t layers_from = 0;
+  for (std::vector<TrianglePair>* pairs : {&change.consistent_pairs, &change.layer_pairs}) {
+    layers_from = out.size();
+    for (const auto& [g, h] : *pairs) {
+      if (!owned(g) && !owned(h)) continue;
+      auto x = id(g), y = id(h);
+      if (y < x) std::swap(x, y);
+      out.push_back({x.first, x.second, y.first, y.second});
+    }
+    *pairs = {};
+  }
+  // Each list comes sorted (a tile keeps each acquisition's triangles in input order): merged,
+  // not sorted again (sorting them was 4 % of a spinning scanner's tile).
+  const auto middle = out.begin() + static_cast<std::ptrdiff_t>(layers_from);
+  if (std::is_sorted(out.begin(), middle, by_ends) && std::is_sorted(middle, out.end(), by_ends)) {
+    std::inplace_merge(out.begin(), middle, out.end(), by_ends);
+  }
+  sort_unless_sorted(out.begin(), out.end(), by_ends);
+  return out;
+}
+
+}  // namespace
+
 int tile_phase(TileKey key) { return (key.i & 1) * 2 + (key.j & 1); }
 
 TileResult process_tile(const TileStore& store, TileKey key, const Config& config, const SettledSelection& settled) {
@@ -149,6 +195,11 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   }
   const MosaicSelection selection = select(config, meshes, dates, change, forced);
   r.seconds_mosaic = clock.restart();
+  // The allocator keeps what the mosaic freed (its energy and pair index: ~1 GB on a spinning
+  // scanner's tile) in pieces the result's pair list, made next, does not fit: handed back when
+  // that list would take the process past the budget (it took such a tile from 2.3 to 2.6 GB).
+  const std::uint64_t pair_bytes = (change.consistent_pairs.size() + change.layer_pairs.size()) * sizeof(LabelPair);
+  if (resident_bytes() + pair_bytes > config.run.memory) release_freed_memory();
 
   const auto owned = [&](std::uint32_t g) {
     const std::uint32_t a = change.index.acquisition_of(g);
@@ -158,6 +209,10 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
     const std::uint32_t a = change.index.acquisition_of(g);
     return std::pair{a, pieces[a].triangle_index[g - change.index.offsets[a]]};
   };
+  std::size_t owned_count = 0;
+  for (const TilePiece& p : pieces)
+    owned_count += static_cast<std::size_t>(std::count(p.roles.begin(), p.roles.end(), TileRole::owned));
+  r.labels.reserve(owned_count);
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
     for (std::size_t t = 0; t < pieces[a].roles.size(); ++t) {
       const std::size_t g = change.index.offsets[a] + t;
@@ -179,33 +234,16 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
     pieces[a].mesh = std::move(meshes[a]);
     r.selected.push_back(selected_part(
         pieces[a], std::span(selection.selected).subspan(change.index.offsets[a], pieces[a].triangle_count())));
+    // Only the roles and triangle indices are read from here on: the mesh goes before the
+    // pairs are made, the largest list of the result.
+    pieces[a].mesh = Mesh{};
+    pieces[a].vertex_ids = {};
   }
   // A tile keeps each acquisition's triangles in input order, so the labels and the pairs
   // (from sorted global pairs) come sorted already (sorting them was 1 % of a run).
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
   sort_unless_sorted(r.refuted.begin(), r.refuted.end());
-  // The pairs of layers of one pass go with the consistent pairs: a reader tells them apart
-  // by their acquisitions, the same for both. Each list comes sorted: merged, not sorted again
-  // (sorting them was 4 % of a spinning scanner's tile, which holds millions of both).
-  const auto by_ends = [](const LabelPair& x, const LabelPair& y) {
-    return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <
-           std::tie(y.a_acquisition, y.a_index, y.b_acquisition, y.b_index);
-  };
-  std::size_t layers_from = 0;
-  for (const auto& pairs : {std::span(change.consistent_pairs), std::span(change.layer_pairs)}) {
-    layers_from = r.pairs.size();
-    for (const auto& [g, h] : pairs) {
-      if (!owned(g) && !owned(h)) continue;
-      auto x = id(g), y = id(h);
-      if (y < x) std::swap(x, y);
-      r.pairs.push_back({x.first, x.second, y.first, y.second});
-    }
-  }
-  const auto middle = r.pairs.begin() + static_cast<std::ptrdiff_t>(layers_from);
-  if (std::is_sorted(r.pairs.begin(), middle, by_ends) && std::is_sorted(middle, r.pairs.end(), by_ends)) {
-    std::inplace_merge(r.pairs.begin(), middle, r.pairs.end(), by_ends);
-  }
-  sort_unless_sorted(r.pairs.begin(), r.pairs.end(), by_ends);
+  r.pairs = owned_pairs(change, owned, id);
   return r;
 }
 
