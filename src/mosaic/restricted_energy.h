@@ -34,19 +34,15 @@ class PairIndex {
   /// from v: e[x_v][x_other] at 2 * x_v + x_other. Returns whether a visit returned true.
   template <class Visit>
   bool any_term(std::uint32_t v, Visit&& visit) const {
-    std::uint32_t run = run_offsets_[v];
-    std::uint32_t next_run_entry = run + 1 < run_offsets_[v + 1] ? runs_[run + 1].first_entry : UINT32_MAX;
-    const Values* w = run < run_offsets_[v + 1] ? &rows_[runs_[run].row] : nullptr;
-    for (std::uint32_t entry = offsets_[v]; entry < offsets_[v + 1]; ++entry) {
-      if (entry == next_run_entry) {
-        ++run;
-        w = &rows_[runs_[run].row];
-        next_run_entry = run + 1 < run_offsets_[v + 1] ? runs_[run + 1].first_entry : UINT32_MAX;
+    const std::uint32_t last_run = run_offsets_[v + 1];
+    for (std::uint32_t run = run_offsets_[v]; run < last_run; ++run) {
+      const Values& w = rows_[runs_[run].row];
+      const Values from_i = w, from_j{w[0], w[2], w[1], w[3]};  // seen from j, e01 and e10 trade places
+      const std::uint32_t run_end = run + 1 < last_run ? runs_[run + 1].first_entry : offsets_[v + 1];
+      for (std::uint32_t entry = runs_[run].first_entry; entry < run_end; ++entry) {
+        const std::uint32_t end = ends_[entry];
+        if (visit(end, (end & kAtJ) != 0 ? from_j : from_i)) return true;
       }
-      const std::uint32_t end = ends_[entry];
-      const bool at_j = (end & kAtJ) != 0;
-      // Seen from j, e01 and e10 trade places.
-      if (visit(end, Values{(*w)[0], (*w)[at_j ? 2 : 1], (*w)[at_j ? 1 : 2], (*w)[3]})) return true;
     }
     return false;
   }
