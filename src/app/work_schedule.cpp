@@ -175,4 +175,14 @@ void run_workers(WorkChannel& channel, unsigned workers, const std::function<voi
   });
 }
 
+std::size_t batch_within(std::span<const std::uint64_t> bytes, std::size_t first, std::size_t most,
+                         std::uint64_t room) {
+  if (first >= bytes.size() || most == 0) return 0;
+  std::uint64_t sum = bytes[first];
+  std::size_t count = 1;
+  while (count < most && first + count < bytes.size() && sum + bytes[first + count] <= room)
+    sum += bytes[first + count++];
+  return count;
+}
+
 }  // namespace citymesh::app

@@ -10,6 +10,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -106,5 +107,9 @@ class LocalChannel final : public WorkChannel {
 /// nothing to do helps the items in flight with their nested parallel loops; on a cluster's
 /// channel the loops wait for work. The first exception stops every loop and is rethrown.
 void run_workers(WorkChannel& channel, unsigned workers, const std::function<void(std::size_t)>& body);
+
+/// How many items from `first` on to take at once: up to `most`, while the sum of their
+/// `bytes` stays within `room`; always at least one (when first < bytes.size()).
+std::size_t batch_within(std::span<const std::uint64_t> bytes, std::size_t first, std::size_t most, std::uint64_t room);
 
 }  // namespace citymesh::app

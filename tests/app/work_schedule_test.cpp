@@ -86,6 +86,26 @@ TEST(WorkSchedule, HandsOutTheLargestReadyItemLikeBruteForce) {
   }
 }
 
+TEST(BatchWithin, TakesTheLongestRunFromFirstThatFitsTheRoomAndAlwaysOne) {
+  std::mt19937 rng(7);
+  for (int trial = 0; trial < 2000; ++trial) {
+    std::vector<std::uint64_t> bytes(rng() % 8);
+    for (std::uint64_t& b : bytes) b = rng() % 100;
+    const std::size_t first = rng() % (bytes.size() + 1), most = rng() % 5;
+    const std::uint64_t room = rng() % 250;
+    // Brute force: the largest count <= most whose run from first sums within the room,
+    // at least one item when there is one to take.
+    std::size_t expected = 0;
+    for (std::size_t count = 1; count <= most && first + count <= bytes.size(); ++count) {
+      std::uint64_t sum = 0;
+      for (std::size_t k = first; k < first + count; ++k) sum += bytes[k];
+      if (count == 1 || sum <= room) expected = count;
+      if (sum > room) break;
+    }
+    ASSERT_EQ(batch_within(bytes, first, most, room), expected) << trial;
+  }
+}
+
 TEST(WorkSchedule, RefusesBadDependencies) {
   EXPECT_THROW(WorkSchedule({1, 1}, {{1}, {5}}, {0, 0}), std::invalid_argument);
   EXPECT_THROW(WorkSchedule({1}, {{0}}, {0}), std::invalid_argument);
