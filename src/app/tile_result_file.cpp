@@ -172,10 +172,29 @@ std::nullopt_t older_version(const std::filesystem::path& file) {
   return std::nullopt;
 }
 
-template <class T>
-void append_raw(std::string& bytes, const T& value) {
-  bytes.append(reinterpret_cast<const char*>(&value), sizeof value);
-}
+/// A file written part by part with the checksum of everything written so far, which ends it.
+class ChecksummedFile {
+ public:
+  explicit ChecksummedFile(const std::filesystem::path& path) : file_(path) {}
+  void write(std::string_view bytes) {
+    file_.write(bytes);
+    sum_.add(bytes.data(), bytes.size());
+  }
+  template <class T>
+  void write_raw(const T& value) {
+    write(std::string_view(reinterpret_cast<const char*>(&value), sizeof value));
+  }
+  /// Appends the checksum, then flushes, fsyncs and renames (AtomicFile::commit).
+  void commit() {
+    const std::uint64_t sum = sum_.value();
+    file_.write(&sum, sizeof sum);
+    file_.commit();
+  }
+
+ private:
+  AtomicFile file_;
+  BulkChecksum sum_;
+};
 
 }  // namespace
 
@@ -201,18 +220,20 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, R
   h.refuted_bytes = refuted.bytes().size();
   h.inputs_fingerprint = digests.inputs;
   h.settled_fingerprint = r.settled_fingerprint;
-  std::string bytes;
-  append_raw(bytes, h);
-  bytes += labels.bytes();
-  bytes += pairs.bytes();
-  bytes += refuted.bytes();
+  // Written section by section, not gathered first: a spinning scanner's tile result is a
+  // 0.3 GB file, and gathering it (grown by doubling) beside the sections took that tile's
+  // peak from 1.9 to 2.5 GB.
+  ChecksummedFile out(file);
+  out.write_raw(h);
+  out.write(labels.bytes());
+  out.write(pairs.bytes());
+  out.write(refuted.bytes());
   for (const TilePiece& p : r.selected) {
     const std::string block = p.triangle_count() == 0 ? std::string() : encode_tile_block(p);
-    append_raw(bytes, std::uint64_t{block.size()});
-    bytes += block;
+    out.write_raw(std::uint64_t{block.size()});
+    out.write(block);
   }
-  append_raw(bytes, bulk_checksum(bytes.data(), bytes.size()));
-  write_file_atomically(file, bytes);
+  out.commit();
 }
 
 namespace {
