@@ -226,7 +226,8 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   // triangle, so three meshes overlapping close a cycle within the last meshes' overlaps.
   const std::size_t n = e.size();
   ParitySets sets(n);
-  for (auto it = e.pairs.end(); it != e.pairs.begin();) {
+  const auto first = e.pairs.begin();  // made once: an iterator finds its row by bisection
+  for (auto it = e.pairs.end(); it != first;) {
     const BinaryEnergy::Pair p = *--it;
     const double c = coupling(p);
     if (c != 0 && !sets.join(p.i, p.j, c < 0)) return std::nullopt;

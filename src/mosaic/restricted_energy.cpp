@@ -52,7 +52,8 @@ PairIndex::PairIndex(const BinaryEnergy& e) : rows_(e.pairs.values()) {
   BlockCounts last_row(blocks, std::vector<std::uint32_t>(n, UINT32_MAX));
   parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
     for (std::size_t b = begin; b < end; ++b) {
-      for (auto term = terms.begin() + block_begin(b); term != terms.begin() + block_begin(b + 1); ++term) {
+      const auto last = terms.begin() + block_begin(b + 1);  // made once: it finds its row by bisection
+      for (auto term = terms.begin() + block_begin(b); term != last; ++term) {
         const auto [i, j] = term.variables();
         if (i == j) throw ProcessingError("energy: a pair joins a variable to itself");
         const std::uint32_t row = term.row();
@@ -76,7 +77,8 @@ PairIndex::PairIndex(const BinaryEnergy& e) : rows_(e.pairs.values()) {
         last_row[b][v] = row;
         ends_[entry_at[b][v]++] = other_end;
       };
-      for (auto term = terms.begin() + block_begin(b); term != terms.begin() + block_begin(b + 1); ++term) {
+      const auto last = terms.begin() + block_begin(b + 1);  // made once: it finds its row by bisection
+      for (auto term = terms.begin() + block_begin(b); term != last; ++term) {
         const auto [i, j] = term.variables();
         const std::uint32_t row = term.row();
         add(i, j, row);
