@@ -76,7 +76,7 @@ class MeshCommand final : public Command {
       cells +=
           std::count(band.valid.begin() + std::min<std::ptrdiff_t>(from, std::ssize(band.valid)), band.valid.end(), 1);
       const SensorMeshResult r = mesh_sensor_band(band, meshing_, 0, where);
-      add_to(stats, r.stats);
+      stats += r.stats;
       triangles += r.mesh.triangle_count();
       if (r.mesh.vertex_count() == 0) return;  // then no triangle either: each has a corner in a new row
       append(out, r.mesh, {});
@@ -109,13 +109,6 @@ class MeshCommand final : public Command {
     out->add_faces({{}, mesh.triangles, {}, {}, {}});
   }
 
-  static void add_to(SensorMeshStats& total, const SensorMeshStats& s) {
-    total.candidates += s.candidates;
-    total.rejected_long_edge += s.rejected_long_edge;
-    total.rejected_depth_jump += s.rejected_depth_jump;
-    total.rejected_grazing += s.rejected_grazing;
-  }
-
   /// Each frame meshed on its own grid, the frames of one drive in one mesh (as the simulator
   /// writes a spinning pass: its turns overlap, and the mosaic keeps one layer of them). The
   /// frames go to the file one by one: a drive of thousands of frames never is in memory.
@@ -132,7 +125,7 @@ class MeshCommand final : public Command {
       append(out, r.mesh, path);
       cells += std::count(grid.valid.begin(), grid.valid.end(), 1);
       triangles += r.mesh.triangle_count();
-      add_to(stats, r.stats);
+      stats += r.stats;
     }
     out->commit();
     std::cout << fmt::format("{}: spinning layout, {} frame(s), {} points, {} triangles\n", out_, paths.size(), cells,

@@ -28,6 +28,9 @@ void PairList::push_back(const EnergyPair& p) {
 }
 
 std::uint32_t PairList::row(std::size_t k) const {
+  // The ends first, without bisection: every begin() and end() asks for them.
+  if (k == 0 || row_starts_.empty()) return 0;
+  if (k >= ends_.size()) return static_cast<std::uint32_t>(row_starts_.size() - 1);
   const auto after = std::upper_bound(row_starts_.begin(), row_starts_.end(), k,
                                       [](std::size_t term, std::uint32_t start) { return term < start; });
   return after == row_starts_.begin() ? 0 : static_cast<std::uint32_t>(after - row_starts_.begin() - 1);
@@ -226,8 +229,7 @@ std::optional<std::vector<std::uint8_t>> submodular_flips(const BinaryEnergy& e)
   // triangle, so three meshes overlapping close a cycle within the last meshes' overlaps.
   const std::size_t n = e.size();
   ParitySets sets(n);
-  const auto first = e.pairs.begin();  // made once: an iterator finds its row by bisection
-  for (auto it = e.pairs.end(); it != first;) {
+  for (auto it = e.pairs.end(); it != e.pairs.begin();) {
     const BinaryEnergy::Pair p = *--it;
     const double c = coupling(p);
     if (c != 0 && !sets.join(p.i, p.j, c < 0)) return std::nullopt;

@@ -50,19 +50,24 @@ PairIndex::PairIndex(const BinaryEnergy& e) : rows_(e.pairs.values()) {
   const auto block_begin = [&](std::size_t b) { return terms.size() * b / blocks; };
   BlockCounts entry_at(blocks, std::vector<std::uint32_t>(n, 0)), run_at = entry_at;
   BlockCounts last_row(blocks, std::vector<std::uint32_t>(n, UINT32_MAX));
-  parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t b = begin; b < end; ++b) {
-      const auto last = terms.begin() + block_begin(b + 1);  // made once: it finds its row by bisection
-      for (auto term = terms.begin() + block_begin(b); term != last; ++term) {
-        const auto [i, j] = term.variables();
-        if (i == j) throw ProcessingError("energy: a pair joins a variable to itself");
-        const std::uint32_t row = term.row();
-        for (const std::uint32_t v : {i, j}) {
-          ++entry_at[b][v];
-          if (last_row[b][v] != row) ++run_at[b][v];
-          last_row[b][v] = row;
+  // visit(b, i, j, row) for each term of each block, the blocks on their own threads.
+  const auto walk_blocks = [&](const auto& visit) {
+    parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t b = begin; b < end; ++b) {
+        const auto last = terms.begin() + block_begin(b + 1);  // made once: it finds its row by bisection
+        for (auto term = terms.begin() + block_begin(b); term != last; ++term) {
+          const auto [i, j] = term.variables();
+          visit(b, i, j, term.row());
         }
       }
+    });
+  };
+  walk_blocks([&](std::size_t b, std::uint32_t i, std::uint32_t j, std::uint32_t row) {
+    if (i == j) throw ProcessingError("energy: a pair joins a variable to itself");
+    for (const std::uint32_t v : {i, j}) {
+      ++entry_at[b][v];
+      if (last_row[b][v] != row) ++run_at[b][v];
+      last_row[b][v] = row;
     }
   });
   offsets_ = counts_to_cursors(entry_at, n);
@@ -70,21 +75,14 @@ PairIndex::PairIndex(const BinaryEnergy& e) : rows_(e.pairs.values()) {
   ends_.resize(offsets_.back());
   runs_.resize(run_offsets_.back());
   for (std::vector<std::uint32_t>& rows : last_row) std::fill(rows.begin(), rows.end(), UINT32_MAX);
-  parallel_for_blocks(blocks, 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t b = begin; b < end; ++b) {
-      const auto add = [&, b](std::uint32_t v, std::uint32_t other_end, std::uint32_t row) {
-        if (last_row[b][v] != row) runs_[run_at[b][v]++] = {entry_at[b][v], row};
-        last_row[b][v] = row;
-        ends_[entry_at[b][v]++] = other_end;
-      };
-      const auto last = terms.begin() + block_begin(b + 1);  // made once: it finds its row by bisection
-      for (auto term = terms.begin() + block_begin(b); term != last; ++term) {
-        const auto [i, j] = term.variables();
-        const std::uint32_t row = term.row();
-        add(i, j, row);
-        add(j, i | kAtJ, row);
-      }
-    }
+  walk_blocks([&](std::size_t b, std::uint32_t i, std::uint32_t j, std::uint32_t row) {
+    const auto add = [&](std::uint32_t v, std::uint32_t other_end) {
+      if (last_row[b][v] != row) runs_[run_at[b][v]++] = {entry_at[b][v], row};
+      last_row[b][v] = row;
+      ends_[entry_at[b][v]++] = other_end;
+    };
+    add(i, j);
+    add(j, i | kAtJ);
   });
 }
 

@@ -20,7 +20,7 @@ namespace citymesh::mosaic_detail {
 /// only grow, so each variable keeps runs of entries sharing a row (a spinning scanner's tile
 /// holds ~28 overlap terms per variable, all one row, and ~3 seam terms with their own: the
 /// index went from 16 bytes an entry with the rows held twice to 4 bytes plus 8 per run,
-/// 950 -> 410 MB on its largest tile). Pairs must join two distinct variables. The index
+/// 955 -> 448 MB on its largest tile). Pairs must join two distinct variables. The index
 /// reads the energy's rows: it is valid while the energy lives, unchanged.
 class PairIndex {
  public:

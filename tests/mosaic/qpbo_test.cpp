@@ -477,6 +477,7 @@ TEST(PairList, GivesBackEachTermBitForBitAndSharesTheValuesOfEqualNeighboursOnly
     EXPECT_EQ(bits(list.begin()[static_cast<std::ptrdiff_t>(k)]), bits(terms[k])) << k;
   }
   EXPECT_EQ(list.row(0), 0u);
+  EXPECT_EQ(list.row(list.size()), list.values().size() - 1);  // end()'s row: the last
   EXPECT_EQ(list.row(2), 0u);
   EXPECT_EQ(list.row(3), 1u);
   EXPECT_EQ(list.row(5), list.row(6));

@@ -29,7 +29,8 @@ struct EnergyPair {
 /// terms whose values are equal bit for bit (a row holds where its run starts). The mosaic's
 /// overlap terms all have the same values and a spinning scanner's tile holds ~28 of them per
 /// variable: 8 bytes a term instead of 40 (a term read back is the one added, bit for bit).
-/// Walk the terms in order (the iterator keeps its row); indexing finds the row by bisection.
+/// Walk the terms in order (the iterator keeps its row); indexing, or an iterator made
+/// elsewhere than at begin() or end(), finds the row by bisection.
 class PairList {
  public:
   /// Reads a term back, by value (the list holds no EnergyPair).

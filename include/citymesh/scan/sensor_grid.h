@@ -46,6 +46,14 @@ struct SensorMeshStats {
   std::uint64_t rejected_long_edge = 0;
   std::uint64_t rejected_depth_jump = 0;
   std::uint64_t rejected_grazing = 0;
+  /// Adds another grid's figures (a drive meshed band by band or frame by frame).
+  SensorMeshStats& operator+=(const SensorMeshStats& o) {
+    candidates += o.candidates;
+    rejected_long_edge += o.rejected_long_edge;
+    rejected_depth_jump += o.rejected_depth_jump;
+    rejected_grazing += o.rejected_grazing;
+    return *this;
+  }
 };
 
 struct SensorMeshResult {
