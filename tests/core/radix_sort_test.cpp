@@ -35,6 +35,17 @@ TEST(RadixSortPairs, MatchesStdSortOnSmallAndLargeKeys) {
   expect_sorted_like_std(random_pairs(3'001, (1u << 30) - 1, 0, 5));          // odd pass count
 }
 
+TEST(RadixSortPairs, LargeListsSplitInPlaceFirstAndStillMatchStdSort) {
+  constexpr std::size_t kLarge = (std::size_t{1} << 20) + 3;                  // past the in-place split
+  expect_sorted_like_std(random_pairs(kLarge, 3'000'000, 3'000'000, 6));      // a spinning tile's ids
+  expect_sorted_like_std(random_pairs(kLarge, 0xffffffffu, 0xffffffffu, 7));  // the top bit in use
+  expect_sorted_like_std(random_pairs(kLarge, 0, 100, 8));                    // every key below 8 bits
+  expect_sorted_like_std(random_pairs(kLarge, 1, 0xffffffffu, 9));            // two parts only
+  Pairs skewed = random_pairs(kLarge, 1'000, 50'000, 10);                     // one part holds nearly all
+  for (std::size_t k = 0; k < 100; ++k) skewed[k].first = 0xfffffff0u;
+  expect_sorted_like_std(skewed);
+}
+
 TEST(RadixSortPairs, EdgeCases) {
   expect_sorted_like_std({});
   expect_sorted_like_std({{5, 1}});
