@@ -216,14 +216,17 @@ ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAc
     const std::filesystem::path pairs_file = dir / summary.at("pairs").get<std::string>();
     const std::vector<std::uint32_t> flat = read_u32_records(pairs_file, kPairsMagic, "consistent pairs");
     const std::size_t n = r.index.size();
+    std::vector<TrianglePair> consistent, layers;
     for (std::size_t k = 0; k + 1 < flat.size(); k += 2) {
       if (flat[k] >= n || flat[k + 1] >= n || !(flat[k] < flat[k + 1])) {
         throw InputError(fmt::format("{}: pair {} ({}, {}) is not a pair of the {} triangles", pairs_file.string(),
                                      k / 2, flat[k], flat[k + 1], n));
       }
       const bool one_pass = r.index.acquisition_of(flat[k]) == r.index.acquisition_of(flat[k + 1]);
-      (one_pass ? r.layer_pairs : r.consistent_pairs).emplace_back(flat[k], flat[k + 1]);
+      (one_pass ? layers : consistent).emplace_back(flat[k], flat[k + 1]);
     }
+    r.consistent_pairs = std::move(consistent);
+    r.layer_pairs = std::move(layers);
   } catch (const nlohmann::json::exception& e) {
     throw InputError(fmt::format("{}: {}", (dir / "summary.json").string(), e.what()));
   }

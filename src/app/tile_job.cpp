@@ -118,44 +118,34 @@ std::optional<bool> SettledSelection::selected(std::uint32_t acquisition, std::u
 
 namespace {
 
-bool by_ends(const LabelPair& x, const LabelPair& y) {
-  return std::tie(x.a_acquisition, x.a_index, x.b_acquisition, x.b_index) <
-         std::tie(y.a_acquisition, y.a_index, y.b_acquisition, y.b_index);
-}
-
 /// The consistent pairs and the pairs of layers of one pass with an owned end, as result
-/// pairs (a reader tells the two apart by their acquisitions, the same for both), sorted; the
-/// change step's lists are let go. `owned(g)` and `id(g)` tell a global triangle's role and
-/// (acquisition, index). The list is counted before it is made: a spinning scanner's tile
-/// holds tens of millions of them (16 bytes each), and a list grown by doubling holds up to
-/// twice that while it moves.
+/// pairs; the change step's lists are let go. `owned(g)` and `id(g)` tell a global triangle's
+/// role and (acquisition, index). A tile keeps each acquisition's triangles in input order, so
+/// each list comes out sorted as it was. Its bytes are counted before they are written: a
+/// spinning scanner's tile holds 56 M pairs (0.3 GB as the result holds them), and a list
+/// grown by doubling holds up to twice that while it moves.
 template <class Owned, class Id>
-std::vector<LabelPair> owned_pairs(ChangeResult& change, const Owned& owned, const Id& id) {
-  std::size_t count = 0;
-  for (const auto& pairs : {std::span(change.consistent_pairs), std::span(change.layer_pairs)}) {
-    count += static_cast<std::size_t>(std::count_if(
-        pairs.begin(), pairs.end(), [&](const TrianglePair& p) { return owned(p.first) || owned(p.second); }));
-  }
-  std::vector<LabelPair> out;
-  out.reserve(count);
-  std::size_t layers_from = 0;
-  for (std::vector<TrianglePair>* pairs : {&change.consistent_pairs, &change.layer_pairs}) {
-    layers_from = out.size();
-    for (const auto& [g, h] : *pairs) {
-      if (!owned(g) && !owned(h)) continue;
-      auto x = id(g), y = id(h);
-      if (y < x) std::swap(x, y);
-      out.push_back({x.first, x.second, y.first, y.second});
+LabelPairList owned_pairs(ChangeResult& change, const Owned& owned, const Id& id) {
+  const auto each_owned = [&](const auto& visit) {
+    LabelPair previous{};
+    for (const PackedPairs* pairs : {&change.consistent_pairs, &change.layer_pairs}) {
+      for (const auto& [g, h] : *pairs) {
+        if (!owned(g) && !owned(h)) continue;
+        auto x = id(g), y = id(h);
+        if (y < x) std::swap(x, y);
+        const LabelPair p{x.first, x.second, y.first, y.second};
+        visit(previous, p);
+        previous = p;
+      }
     }
-    *pairs = {};
-  }
-  // Each list comes sorted (a tile keeps each acquisition's triangles in input order): merged,
-  // not sorted again (sorting them was 4 % of a spinning scanner's tile).
-  const auto middle = out.begin() + static_cast<std::ptrdiff_t>(layers_from);
-  if (std::is_sorted(out.begin(), middle, by_ends) && std::is_sorted(middle, out.end(), by_ends)) {
-    std::inplace_merge(out.begin(), middle, out.end(), by_ends);
-  }
-  sort_unless_sorted(out.begin(), out.end(), by_ends);
+  };
+  std::size_t bytes = 0;
+  each_owned([&](const LabelPair& previous, const LabelPair& p) { bytes += LabelPairList::bytes_after(previous, p); });
+  LabelPairList out;
+  out.reserve(bytes);
+  each_owned([&](const LabelPair&, const LabelPair& p) { out.push_back(p); });
+  change.consistent_pairs = {};
+  change.layer_pairs = {};
   return out;
 }
 
@@ -181,6 +171,9 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   r.settled_fingerprint = settled_fingerprint(pieces, settled);
   ChangeResult change = detect_changes({meshes, dates, uses}, config.change);
   r.seconds_detect = clock.restart();
+  // The change step's lists were made in pieces (per block, then sorted) that the mosaic's
+  // arrays do not fit into: what it freed goes back once the tile holds half the budget.
+  if (resident_bytes() > config.run.memory / 2) release_freed_memory();
   r.change = change.stats;
   std::vector<std::uint8_t> forced(change.index.size(), 0);
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
@@ -199,7 +192,8 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   // scanner's tile) in pieces the result's pair list, made next, does not fit: handed back when
   // that list would take the process past the budget (such a tile alone peaked at 2.58 GB
   // without this, 2.13 GB with it).
-  const std::uint64_t pair_bytes = (change.consistent_pairs.size() + change.layer_pairs.size()) * sizeof(LabelPair);
+  const std::uint64_t pair_bytes =
+      (change.consistent_pairs.size() + change.layer_pairs.size()) * LabelPairList::kBytesPerPair;
   if (resident_bytes() + pair_bytes > config.run.memory) release_freed_memory();
 
   const auto owned = [&](std::uint32_t g) {
@@ -240,8 +234,8 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
     pieces[a].mesh = Mesh{};
     pieces[a].vertex_ids = {};
   }
-  // A tile keeps each acquisition's triangles in input order, so the labels and the pairs
-  // (from sorted global pairs) come sorted already (sorting them was 1 % of a run).
+  // A tile keeps each acquisition's triangles in input order, so the labels come sorted
+  // already (sorting them was 1 % of a run).
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
   sort_unless_sorted(r.refuted.begin(), r.refuted.end());
   r.pairs = owned_pairs(change, owned, id);

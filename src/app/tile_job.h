@@ -13,6 +13,7 @@
 #include "citymesh/change/detect.h"
 #include "citymesh/config/config.h"
 #include "citymesh/tiler/tiler.h"
+#include "label_pairs.h"
 
 namespace citymesh::app {
 
@@ -30,11 +31,6 @@ static_assert(sizeof(OwnedLabel) == 32);
 
 /// The order of labels in a tile result: by acquisition, then triangle index.
 bool by_triangle(const OwnedLabel& x, const OwnedLabel& y);
-
-/// A consistent pair with at least one owned member, as (acquisition, index) twice.
-struct LabelPair {
-  std::uint32_t a_acquisition = 0, a_index = 0, b_acquisition = 0, b_index = 0;
-};
 
 /// The mosaic's decisions on triangles that earlier-phase neighbours own: the tile keeps
 /// them for its halo copies of those triangles (see process_tile).
@@ -64,7 +60,9 @@ struct RefutedCopy {
 struct TileResult {
   TileKey key;
   std::vector<OwnedLabel> labels;  ///< every owned triangle, by (acquisition, index)
-  std::vector<LabelPair> pairs;    ///< sorted
+  /// The consistent pairs with an owned member, sorted, then the pairs of layers of one pass
+  /// with one, sorted (a reader tells the two apart by their acquisitions).
+  LabelPairList pairs;
   /// Copies refuted by this tile's owned triangles, sorted. A conflict between an owned triangle
   /// T and the empty space of a triangle U is found in T's owner tile (U's empty space meets T,
   /// so it crosses that tile or its halo, and the tiler copied U there): every tile counts the

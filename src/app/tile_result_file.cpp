@@ -86,8 +86,8 @@ constexpr std::size_t kVarintsPerLabel = 5;
 /// The fields of a record stored as varints, each a delta against the previous record's.
 template <class Record, std::size_t N>
 using DeltaFields = std::array<std::uint32_t Record::*, N>;
-constexpr DeltaFields<LabelPair, 4> kPairFields{&LabelPair::a_acquisition, &LabelPair::a_index,
-                                                &LabelPair::b_acquisition, &LabelPair::b_index};
+/// Varints per pair (LabelPairList): its four fields.
+constexpr std::size_t kVarintsPerPair = 4;
 constexpr DeltaFields<RefutedCopy, 2> kRefutedFields{&RefutedCopy::acquisition, &RefutedCopy::index};
 
 /// Records (sorted: the deltas stay small) as deltas against the previous record.
@@ -199,8 +199,7 @@ class ChecksummedFile {
 }  // namespace
 
 void write_tile_result(const std::filesystem::path& file, const TileResult& r, ResultDigests digests) {
-  const VarintWriter labels = encode_labels(r.labels), pairs = encode_deltas<LabelPair>(r.pairs, kPairFields),
-                     refuted = encode_deltas<RefutedCopy>(r.refuted, kRefutedFields);
+  const VarintWriter labels = encode_labels(r.labels), refuted = encode_deltas<RefutedCopy>(r.refuted, kRefutedFields);
   ResultHeader h{};
   std::memcpy(h.magic, kMagic, sizeof kMagic);
   h.fingerprint = digests.result;
@@ -214,7 +213,7 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, R
   h.seconds_detect = r.seconds_detect;
   h.seconds_mosaic = r.seconds_mosaic;
   h.label_bytes = labels.bytes().size();
-  h.pair_bytes = pairs.bytes().size();
+  h.pair_bytes = r.pairs.bytes().size();
   h.change = figures_of(r.change);
   h.refuted = r.refuted.size();
   h.refuted_bytes = refuted.bytes().size();
@@ -226,7 +225,7 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, R
   ChecksummedFile out(file);
   out.write_raw(h);
   out.write(labels.bytes());
-  out.write(pairs.bytes());
+  out.write(r.pairs.bytes());
   out.write(refuted.bytes());
   for (const TilePiece& p : r.selected) {
     const std::string block = p.triangle_count() == 0 ? std::string() : encode_tile_block(p);
@@ -296,7 +295,7 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   // the digest says the tile has none of the others.
   if (h.acquisitions > body / sizeof(std::uint64_t) || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
       h.refuted_bytes > body - h.label_bytes - h.pair_bytes || h.labels > h.label_bytes / kVarintsPerLabel ||
-      h.pairs > h.pair_bytes / kPairFields.size() || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
+      h.pairs > h.pair_bytes / kVarintsPerPair || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
   }
   if (!pieces_fit(bytes, header_bytes + h.label_bytes + h.pair_bytes + h.refuted_bytes, h.acquisitions,
@@ -326,8 +325,11 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   std::size_t at = checked->header_bytes;
   if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
   at += h.label_bytes;
-  if (sections.pairs && !decode_deltas(bytes.substr(at, h.pair_bytes), h.pairs, kPairFields, r.pairs)) {
-    return stale(file, "damaged pairs");
+  if (sections.pairs) {
+    std::optional<LabelPairList> pairs =
+        LabelPairList::from_bytes(std::string(bytes.substr(at, h.pair_bytes)), h.pairs);
+    if (!pairs) return stale(file, "damaged pairs");
+    r.pairs = std::move(*pairs);
   }
   at += h.pair_bytes;
   if (!decode_deltas(bytes.substr(at, h.refuted_bytes), h.refuted, kRefutedFields, r.refuted)) {

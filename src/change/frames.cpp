@@ -176,7 +176,7 @@ TriangleFrames prepare_triangles(const ChangeInput& input, const ChangeParams& p
   return f;
 }
 
-PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs) {
+PartnerBits partner_bits(const TriangleFrames& frames, const PackedPairs& pairs) {
   PartnerBits p;
   p.words = (frames.acquisitions() + 63) / 64;
   p.bits.assign(frames.size() * p.words, 0);

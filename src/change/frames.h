@@ -122,7 +122,7 @@ struct PartnerBits {
     return false;
   }
 };
-PartnerBits partner_bits(const TriangleFrames& frames, std::span<const TrianglePair> pairs);
+PartnerBits partner_bits(const TriangleFrames& frames, const PackedPairs& pairs);
 
 struct ConflictFlags {
   std::vector<std::uint8_t> conflicting;  ///< per global triangle

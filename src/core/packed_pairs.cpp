@@ -62,8 +62,9 @@ PackedPairs::PackedPairs(std::vector<Pair> pairs) : size_(pairs.size()) {
   bytes_.reserve(total);
   for (std::size_t c = 0; c < chunks.size(); ++c) {
     const std::uint64_t base = bytes_.size();
-    for (std::size_t b = c * kBlocksPerChunk; b < std::min(blocks, (c + 1) * kBlocksPerChunk); ++b)
+    for (std::size_t b = c * kBlocksPerChunk; b < std::min(blocks, (c + 1) * kBlocksPerChunk); ++b) {
       block_at_[b] += base;
+    }
     bytes_.insert(bytes_.end(), chunks[c].begin(), chunks[c].end());
     std::string().swap(chunks[c]);
   }

@@ -36,10 +36,10 @@ std::vector<std::uint8_t> covered_by_partners(const MosaicInput& input, const st
     const std::uint32_t a = index.acquisition_of(g);
     return input.meshes[a].corners(g - index.offsets[a]);
   };
-  const std::span<const TrianglePair> pairs(change.consistent_pairs);
-  parallel_for_blocks(pairs.size(), 1 << 14, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t k = begin; k < end; ++k) {
-      for (const auto& [candidate, partner] : {pairs[k], TrianglePair{pairs[k].second, pairs[k].first}}) {
+  const PackedPairs& pairs = change.consistent_pairs;
+  parallel_for_blocks(pairs.block_count(), 4, [&](std::size_t begin, std::size_t end) {
+    for (auto k = pairs.block_begin(begin), stop = pairs.block_begin(end); k != stop; ++k) {
+      for (const auto& [candidate, partner] : {*k, TrianglePair{k->second, k->first}}) {
         if (change.kept[candidate] == 0 || selected[candidate] != 0 || selected[partner] == 0) continue;
         // Flags are only raised: any order of raising gives the same result.
         std::atomic_ref<std::uint8_t> flag(covered[candidate]);
@@ -184,11 +184,11 @@ bool centroid_on(const MosaicInput& input, std::uint32_t g, std::uint32_t u, dou
 }  // namespace
 
 std::uint64_t keep_one_layer(const MosaicInput& input, std::size_t base, std::span<std::uint8_t> selected) {
-  const std::span<const TrianglePair> layers(input.change->layer_pairs);
+  const PackedPairs& layers = input.change->layer_pairs;
   const auto is_forced = [&](std::size_t g) { return !input.forced.empty() && input.forced[g] != 0; };
-  const auto first = std::lower_bound(layers.begin(), layers.end(), TrianglePair{static_cast<std::uint32_t>(base), 0});
   std::uint64_t dropped = 0;
-  for (auto it = first; it != layers.end() && it->first < base + selected.size(); ++it) {
+  for (auto it = layers.lower_bound(static_cast<std::uint32_t>(base));
+       it != layers.end() && it->first < base + selected.size(); ++it) {
     const auto [g, u] = *it;
     if (selected[g - base] == 0 || selected[u - base] == 0) continue;
     // The later one goes (in a pass's file order, a later turn), so that the earlier layer

@@ -163,7 +163,9 @@ struct DetectFixture {
       result.kept.insert(result.kept.end(), p.kept.begin(), p.kept.end());
       result.refutes.insert(result.refutes.end(), p.refutes.begin(), p.refutes.end());
     }
-    for (std::uint32_t t = 0; t + 700 < result.state.size(); t += 7) result.consistent_pairs.push_back({t, t + 700});
+    std::vector<TrianglePair> pairs;
+    for (std::uint32_t t = 0; t + 700 < result.state.size(); t += 7) pairs.push_back({t, t + 700});
+    result.consistent_pairs = std::move(pairs);
   }
 };
 

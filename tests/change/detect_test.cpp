@@ -123,7 +123,7 @@ TEST(Consistency, PairsEqualBruteForceOnNoisyOverlappingPatches) {
     }
   }
   ASSERT_GT(expected.size(), 500u);
-  EXPECT_EQ(r.consistent_pairs, expected);
+  EXPECT_EQ(r.consistent_pairs.unpacked(), expected);
 }
 
 /// Two turns of a spinning scanner over the same ground in one acquisition: every pair of
@@ -166,7 +166,7 @@ TEST(Consistency, LayerPairsOfOnePassEqualBruteForceAndLeaveTheLabelsAlone) {
   }
   ASSERT_GT(expected.size(), 300u);
   EXPECT_EQ(across_turns, expected.size());  // no pair within one turn
-  EXPECT_EQ(r.layer_pairs, expected);
+  EXPECT_EQ(r.layer_pairs.unpacked(), expected);
   EXPECT_TRUE(r.consistent_pairs.empty());
   for (std::size_t g = 0; g < r.state.size(); ++g) {
     EXPECT_EQ(r.state[g], TriangleState::single) << g;
@@ -407,7 +407,7 @@ std::vector<Mesh> simulated_street(std::vector<TimePoint>& dates) {
 }
 
 void expect_same(const ChangeResult& a, const ChangeResult& b) {
-  EXPECT_EQ(a.consistent_pairs, b.consistent_pairs);
+  EXPECT_EQ(a.consistent_pairs.unpacked(), b.consistent_pairs.unpacked());
   EXPECT_EQ(a.state, b.state);
   EXPECT_EQ(a.kept, b.kept);
   EXPECT_EQ(a.refutes, b.refutes);
@@ -467,7 +467,7 @@ TEST(TriangleUses, ContextTrianglesRaiseNoRefutesAndTwoHalvesAddUpToTheWhole) {
   }
   const ChangeResult a = detect_changes({meshes, dates, left}, {}), b = detect_changes({meshes, dates, right}, {});
   for (const ChangeResult* half : {&a, &b}) {
-    EXPECT_EQ(half->consistent_pairs, whole.consistent_pairs);
+    EXPECT_EQ(half->consistent_pairs.unpacked(), whole.consistent_pairs.unpacked());
     EXPECT_EQ(half->state, whole.state);
     EXPECT_EQ(half->kept, whole.kept);
     EXPECT_NE(half->refutes, whole.refutes);  // each half misses the other's refutations

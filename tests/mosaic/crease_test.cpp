@@ -79,17 +79,19 @@ TEST(CreaseWeight, MovesTheSeamOffTheCorner) {
   ChangeResult change;
   change.index.offsets = {0, n0, n0 + n1};
   change.kept.assign(n0 + n1, 1);
+  std::vector<TrianglePair> pairs;
   for (int j = 0; j < 10; ++j) {
     for (int i = 0; i < 2; ++i) {
       for (int fine = 2 * i + 6; fine <= 2 * i + 7; ++fine) {
         for (std::uint32_t s = 0; s < 2; ++s) {
           for (std::uint32_t t = 0; t < 2; ++t) {
-            change.consistent_pairs.emplace_back(first_triangle(12, i, j) + s, n0 + first_triangle(10, fine, j) + t);
+            pairs.emplace_back(first_triangle(12, i, j) + s, n0 + first_triangle(10, fine, j) + t);
           }
         }
       }
     }
   }
+  change.consistent_pairs = std::move(pairs);
   // Along row j the foot is the edge between the first triangle of ground cell 1 and the
   // second of wall cell 2: a seam runs along it when exactly one of them is kept.
   const auto seams_along_foot = [&](const MosaicSelection& s) {

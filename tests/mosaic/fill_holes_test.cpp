@@ -15,6 +15,13 @@ Mesh grid(float x0, int nx, int ny, float step, float z) {
   return test::placed_grid(nx, ny, [=](int i, int j) { return Vec3f{x0 + float(i) * step, float(j) * step, z}; });
 }
 
+/// (t, offset + t) for t < count: the triangles of two like grids paired one to one.
+std::vector<TrianglePair> ladder_pairs(std::uint32_t count) {
+  std::vector<TrianglePair> pairs;
+  for (std::uint32_t t = 0; t < count; ++t) pairs.emplace_back(t, count + t);
+  return pairs;
+}
+
 TEST(FillHoles, AddsNewestTrianglesWhereNothingSelectedIsNear) {
   // Acquisition 0 (selected) covers x in [0, 1]; 1 (newest) and 2 (oldest) both cover
   // [0, 2] more coarsely. The fill must take 1's triangles beyond the reach of 0 and none of 2.
@@ -60,11 +67,13 @@ TEST(FillHoles, ConsistentPairsOnlySpareTheSearchAndNeverChangeWhatIsAdded) {
   start[210] = start[300] = 1;
   std::vector<std::uint8_t> without = start;
   const std::uint64_t added = fill_holes({meshes, dates, &change, 0.1, {}}, without).added;
+  std::vector<TrianglePair> pairs;
   for (std::uint32_t g = 0; g < 328; ++g) {
     for (std::uint32_t u = g + 1; u < 328; ++u) {
-      if (change.index.acquisition_of(g) != change.index.acquisition_of(u)) change.consistent_pairs.emplace_back(g, u);
+      if (change.index.acquisition_of(g) != change.index.acquisition_of(u)) pairs.emplace_back(g, u);
     }
   }
+  change.consistent_pairs = std::move(pairs);
   std::vector<std::uint8_t> with = start;
   EXPECT_EQ(fill_holes({meshes, dates, &change, 0.1, {}}, with).added, added);
   EXPECT_EQ(with, without);
@@ -93,7 +102,7 @@ TEST(ForcedTriangles, AreSelectedAndTheRestAdaptsToThem) {
   ChangeResult change;
   change.index.offsets = {0, 32, 64};
   change.kept.assign(64, 1);
-  for (std::uint32_t t = 0; t < 32; ++t) change.consistent_pairs.emplace_back(t, 32 + t);
+  change.consistent_pairs = ladder_pairs(32);
   MosaicParams params;
   params.fill_holes = false;
   // Free, one grid wins whole; the other one's left half is then forced.

@@ -32,7 +32,9 @@ struct TwoTurns {
   TwoTurns() {
     change.index.offsets = {0, 64};
     change.kept.assign(64, 1);
-    for (std::uint32_t t = 0; t < 32; ++t) change.layer_pairs.emplace_back(t, 32 + t);
+    std::vector<TrianglePair> pairs;
+    for (std::uint32_t t = 0; t < 32; ++t) pairs.emplace_back(t, 32 + t);
+    change.layer_pairs = std::move(pairs);
   }
 };
 
@@ -102,7 +104,7 @@ TEST(OneLayerPerPass, WithoutLayerPairsBothTurnsStay) {
   // The same mesh with no layer pairs listed (as before they were found): both sheets are
   // kept, which is what the pairs are there to prevent.
   TwoTurns f;
-  f.change.layer_pairs.clear();
+  f.change.layer_pairs = {};
   MosaicParams params;
   params.fill_holes = false;
   const MosaicSelection s = select_mosaic({f.meshes, f.dates, &f.change, 0.1, {}}, params);

@@ -13,6 +13,7 @@
 
 #include "citymesh/change/change_params.h"
 #include "citymesh/core/mesh.h"
+#include "citymesh/core/packed_pairs.h"
 #include "citymesh/core/time.h"
 
 namespace citymesh {
@@ -93,11 +94,12 @@ struct ChangeResult {
   std::vector<std::uint8_t> kept;         ///< survives the time series (not conflicting; sustainable or
                                           ///< kept by the unconfirmed policy)
   std::vector<std::uint8_t> refutes;      ///< its empty space made an older labelled triangle conflict
-  std::vector<TrianglePair> consistent_pairs;
+  /// Sorted, first < second; packed (2.3 bytes a pair on a spinning street instead of 8).
+  PackedPairs consistent_pairs;
   /// Overlapping triangles of one acquisition that share no corner (sorted, first < second):
   /// two layers of one pass, such as the overlapping turns of a spinning scanner meshed one
   /// by one. They take no part in the labels; the mosaic keeps at most one of each pair.
-  std::vector<TrianglePair> layer_pairs;
+  PackedPairs layer_pairs;
   ChangeStats stats;
 };
 
