@@ -175,8 +175,8 @@ void warn_tiles_over_budget(const Config& config, const TileStore& store, const 
   const TileContents& largest = store.tiles[over.front()];
   log::warn(
       "{} of {} tiles are estimated above the memory budget of {} (largest: tile {}, {} triangles with its "
-      "halo, ~{} MiB); each runs alone and may pass the budget: use a smaller [tiling] tile_size or a larger "
-      "--memory",
+      "halo, ~{} MiB); each runs alone, its mosaic solving with the least memory, and may pass the budget: use a "
+      "smaller [tiling] tile_size or a larger --memory",
       over.size(), tiles.size(), format_byte_size(config.run.memory), largest.key.name(), largest.total(),
       tile_memory_estimate(largest) >> 20);
 }

@@ -135,10 +135,16 @@ struct Mover {
                              GroupMoveStats& stats) {
     auto [interior, border] = split_by_slab(index, all, open, slab, static_cast<std::uint32_t>(to_local.size()));
     std::vector<SolveOutcome> outcomes(interior.size() + 1);
-    parallel_for_blocks(interior.size(), 1, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t s = begin; s < end; ++s)
+    const auto solve_slabs = [&](std::size_t begin, std::size_t end) {
+      for (std::size_t s = begin; s < end; ++s) {
         outcomes[s] = solve_subset(e, index, interior[s], group, k, x, to_local[s]);
-    });
+      }
+    };
+    if (params.slabs_at_once) {
+      parallel_for_blocks(interior.size(), 1, solve_slabs);
+    } else {
+      solve_slabs(0, interior.size());
+    }
     outcomes.back() = solve_subset(e, index, grow_region(index, std::move(border), open, params.border_hops, mark),
                                    group, k, x, to_local[0]);
     stats.solves += outcomes.size();

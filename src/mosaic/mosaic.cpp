@@ -263,6 +263,7 @@ MosaicSelection select_mosaic(const MosaicInput& input, const MosaicParams& para
     moves.coordinate = e.coordinate;
     moves.slabs = slab_count(x.size());
     moves.later_sweep_hops = static_cast<std::uint32_t>(std::max(0, params.later_sweep_reach));
+    moves.slabs_at_once = !input.least_memory;
     out.stats.moves = improve_by_group_moves(e.energy, group, x, moves);
   }
   out.stats.seconds_solve = clock.restart();

@@ -233,7 +233,7 @@ ThreadRuns on_one_and_two_threads(const BinaryEnergy& e, std::span<const std::ui
   return out;
 }
 
-TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThreadCount) {
+TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThreadCountOrOnSolvingThemInTurn) {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 20; ++trial) {
     const auto [e, group, coordinate] = street_energy(rng, 600);
@@ -244,6 +244,11 @@ TEST(GroupMoves, SlabsSolvedInParallelNeverRaiseTheEnergyAndDoNotDependOnTheThre
     params.slabs = 4;
     params.border_hops = 2;
     const ThreadRuns split = on_one_and_two_threads(e, group, params);
+    GroupMoveParams one_by_one = params;
+    one_by_one.slabs_at_once = false;
+    std::vector<std::int8_t> in_turn(e.size(), 0);
+    improve_by_group_moves(e, group, in_turn, one_by_one);
+    EXPECT_EQ(in_turn, split.x[0]) << "trial " << trial;  // slabs in turn: the same labels
     ASSERT_GT(split.stats.solves, split.stats.moves);  // slabs and borders, not one cut per move
     ASSERT_LE(e.evaluate(split.x[0]), 0.0);            // never above the empty start
     // Holding the borders fixed costs little against one cut per move.

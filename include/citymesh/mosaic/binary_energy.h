@@ -207,6 +207,9 @@ struct GroupMoveParams {
   /// term that costs disagreement joining variables of different labels): the first sweep
   /// has placed the pieces, later ones mostly move their edges. 0: everywhere, every sweep.
   std::uint32_t later_sweep_hops = 0;
+  /// Solves the slab interiors at the same time (false: one after another, with one
+  /// max-flow graph alive instead of one per slab; the same result).
+  bool slabs_at_once = true;
 };
 
 struct GroupMoveStats {

@@ -25,6 +25,9 @@ struct MosaicInput {
   /// Per global triangle, 1 when it must be selected (a decision already taken elsewhere: a
   /// neighbouring tile's); empty: none. Forced triangles must be kept.
   std::span<const std::uint8_t> forced;
+  /// Solve with the least memory: the group moves' slabs one after another (GroupMoveParams::
+  /// slabs_at_once), for a tile that runs alone past the budget. The same selection.
+  bool least_memory = false;
 };
 
 struct MosaicStats {
