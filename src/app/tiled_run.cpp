@@ -195,9 +195,10 @@ class FinalOutput {
 };
 
 /// What reading a tile's result holds at most, per byte of its file: the file, its decoded
-/// sections, and its pairs as the assembly files them (a spinning street's largest result,
-/// a 291 MB file, took the final pass from 0.05 to 1.66 GB read alone: 5.5 bytes a byte).
-constexpr std::uint64_t kResultReadBytesPerFileByte = 6;
+/// sections (the pairs stay as the file holds them), and a million pairs at a time as the
+/// assembly files them (a spinning street's largest result, a 291 MB file, took the final
+/// pass from 0.05 to 0.69 GB read alone: 2.2 bytes a byte; 5.5 while the pairs were decoded).
+constexpr std::uint64_t kResultReadBytesPerFileByte = 3;
 
 /// Per tile, what reading its result is estimated to hold (0 when the file is missing: the
 /// read then reports it).
