@@ -401,9 +401,8 @@ std::vector<TilePiece> read_tile(const TileStore& store, TileKey key) {
   const Vec3d origin = TileGrid(store.grid).corner(key);
   std::vector<TilePiece> pieces(store.triangles.size());
   for (TilePiece& p : pieces) p.mesh.origin = origin;
-  const auto tile = std::lower_bound(store.tiles.begin(), store.tiles.end(), key,
-                                     [](const TileContents& t, TileKey k) { return t.key < k; });
-  if (tile == store.tiles.end() || tile->key != key) return pieces;  // the store holds nothing of it
+  const TileContents* tile = store.find(key);
+  if (tile == nullptr) return pieces;  // the store holds nothing of it
   for (std::uint32_t a = 0; a < pieces.size(); ++a) {
     if (tile->blocks[a].empty()) continue;
     pieces[a] = read_tile_piece(acquisition_blocks_path(store.dir, a), tile->blocks[a], origin, a, key.name());

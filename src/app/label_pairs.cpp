@@ -19,27 +19,12 @@ std::uint64_t stored(std::uint32_t value, std::uint32_t previous) {
   return zigzag(std::uint64_t{value} - std::uint64_t{previous});
 }
 
-std::size_t varint_bytes(std::uint64_t v) {
-  std::size_t n = 1;
-  for (; v >= 0x80; v >>= 7) ++n;
-  return n;
-}
-
-/// A varint of bytes known good (checked by from_bytes or written by push_back).
-std::uint64_t read_varint(const char*& at) {
-  std::uint64_t v = 0;
-  for (unsigned shift = 0;; shift += 7) {
-    const auto byte = static_cast<std::uint8_t>(*at++);
-    v |= std::uint64_t{byte & 0x7fu} << shift;
-    if (byte < 0x80) return v;
-  }
-}
-
 }  // namespace
 
 void LabelPairList::DeltaReader::read(LabelPair& pair, std::size_t /*k*/) {
   for (const auto field : kFields) {
-    pair.*field = static_cast<std::uint32_t>(std::uint64_t{pair.*field} + unzigzag(read_varint(at_)));
+    pair.*field =
+        static_cast<std::uint32_t>(std::uint64_t{pair.*field} + unzigzag(read_trusted_varint<std::uint64_t>(at_)));
   }
 }
 
@@ -61,20 +46,12 @@ std::optional<LabelPairList> LabelPairList::from_bytes(std::string bytes, std::s
 
 std::size_t LabelPairList::bytes_after(const LabelPair& previous, const LabelPair& p) {
   std::size_t n = 0;
-  for (const auto field : kFields) n += varint_bytes(stored(p.*field, previous.*field));
+  for (const auto field : kFields) n += varint_size(stored(p.*field, previous.*field));
   return n;
 }
 
 void LabelPairList::push_back(const LabelPair& p) {
-  for (const auto field : kFields) {
-    for (std::uint64_t v = stored(p.*field, last_.*field);; v >>= 7) {
-      if (v < 0x80) {
-        bytes_.push_back(static_cast<char>(v));
-        break;
-      }
-      bytes_.push_back(static_cast<char>(v | 0x80));
-    }
-  }
+  for (const auto field : kFields) append_varint(bytes_, stored(p.*field, last_.*field));
   last_ = p;
   ++size_;
 }

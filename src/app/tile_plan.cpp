@@ -21,9 +21,7 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
     for (std::int32_t dj = -1; dj <= 1; ++dj) {
       const TileKey n{key.i + di, key.j + dj};
       if (tile_phase(n) >= tile_phase(key)) continue;
-      const auto it = std::lower_bound(store.tiles.begin(), store.tiles.end(), n,
-                                       [](const TileContents& t, TileKey x) { return t.key < x; });
-      if (it != store.tiles.end() && it->key == n) after.push_back(static_cast<std::size_t>(it - store.tiles.begin()));
+      if (const TileContents* t = store.find(n)) after.push_back(static_cast<std::size_t>(t - store.tiles.data()));
     }
   }
   std::sort(after.begin(), after.end());

@@ -7,18 +7,11 @@
 
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/radix_sort.h"
+#include "citymesh/core/varint.h"
 
 namespace citymesh {
 
 namespace {
-
-void put_varint(std::string& out, std::uint32_t v) {
-  while (v >= 0x80) {
-    out.push_back(static_cast<char>(v | 0x80));
-    v >>= 7;
-  }
-  out.push_back(static_cast<char>(v));
-}
 
 /// One block's pairs (sorted) as PackedPairs lays them out, appended to `out`.
 void pack_block(std::span<const PackedPairs::Pair> pairs, std::string& out) {
@@ -26,11 +19,11 @@ void pack_block(std::span<const PackedPairs::Pair> pairs, std::string& out) {
   for (std::size_t k = 0; k < pairs.size();) {
     std::size_t end = k + 1;
     while (end < pairs.size() && pairs[end].first == pairs[k].first) ++end;
-    put_varint(out, pairs[k].first - first);
-    put_varint(out, static_cast<std::uint32_t>(end - k - 1));
+    append_varint(out, pairs[k].first - first);
+    append_varint(out, static_cast<std::uint32_t>(end - k - 1));
     const std::uint32_t d = pairs[k].second - run_second;  // modulo 2^32, read as signed
-    put_varint(out, d << 1 ^ static_cast<std::uint32_t>(static_cast<std::int32_t>(d) >> 31));
-    for (std::size_t j = k + 1; j < end; ++j) put_varint(out, pairs[j].second - pairs[j - 1].second);
+    append_varint(out, d << 1 ^ static_cast<std::uint32_t>(static_cast<std::int32_t>(d) >> 31));
+    for (std::size_t j = k + 1; j < end; ++j) append_varint(out, pairs[j].second - pairs[j - 1].second);
     first = pairs[k].first;
     run_second = pairs[k].second;
     k = end;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "citymesh/core/decoding_iterator.h"
+#include "citymesh/core/varint.h"
 
 namespace citymesh {
 
@@ -34,26 +35,18 @@ class PackedPairs {
     void read(Pair& pair, std::size_t k) {
       if (left_in_run_ > 0) {
         --left_in_run_;
-        pair.second += varint();
+        pair.second += read_trusted_varint<std::uint32_t>(at_);
         return;
       }
       if (k % kBlock == 0) pair.first = run_second_ = 0;  // a block starts afresh
-      pair.first += varint();
-      left_in_run_ = varint();
-      const std::uint32_t z = varint();
+      pair.first += read_trusted_varint<std::uint32_t>(at_);
+      left_in_run_ = read_trusted_varint<std::uint32_t>(at_);
+      const auto z = read_trusted_varint<std::uint32_t>(at_);
       run_second_ += (z >> 1) ^ (0u - (z & 1u));
       pair.second = run_second_;
     }
 
    private:
-    std::uint32_t varint() {
-      std::uint32_t v = 0;
-      for (unsigned shift = 0;; shift += 7) {
-        const std::uint8_t byte = *at_++;
-        v |= std::uint32_t{byte & 0x7fu} << shift;
-        if (byte < 0x80) return v;
-      }
-    }
     const std::uint8_t* at_ = nullptr;
     std::uint32_t left_in_run_ = 0;  ///< pairs of the current run still to come
     std::uint32_t run_second_ = 0;   ///< the current run's first `second`

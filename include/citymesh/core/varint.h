@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 #include <type_traits>
 
@@ -22,6 +23,33 @@ constexpr std::uint64_t zigzag(std::uint64_t d) {
 }
 /// The inverse of zigzag.
 constexpr std::uint64_t unzigzag(std::uint64_t z) { return (z >> 1) ^ (~(z & 1) + 1); }
+
+/// The bytes VarintWriter::put() takes for `v`.
+constexpr std::size_t varint_size(std::uint64_t v) {
+  std::size_t n = 1;
+  for (; v >= 0x80; v >>= 7) ++n;
+  return n;
+}
+
+/// Appends `v` as VarintWriter::put() writes it, to a list that grows (its size counted
+/// beforehand with varint_size, or not known).
+inline void append_varint(std::string& out, std::uint64_t v) {
+  for (; v >= 0x80; v >>= 7) out.push_back(static_cast<char>(v | 0x80));
+  out.push_back(static_cast<char>(v));
+}
+
+/// Reads a varint from bytes known to hold one (written by this process, or checked with
+/// VarintReader first), without bounds checks: for lists decoded on hot paths.
+template <class Unsigned, class Byte>
+Unsigned read_trusted_varint(const Byte*& at) {
+  static_assert(std::is_unsigned_v<Unsigned> && sizeof(Byte) == 1);
+  Unsigned v = 0;
+  for (unsigned shift = 0;; shift += 7) {
+    const auto byte = static_cast<std::uint8_t>(*at++);
+    v |= static_cast<Unsigned>(byte & 0x7fu) << shift;
+    if (byte < 0x80) return v;
+  }
+}
 
 /// Writes varints into a buffer sized beforehand: `room` must be at least the bytes every
 /// value to come can take (see max_varint_bytes), so that no write checks the capacity. The

@@ -5,6 +5,7 @@
 // them.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -55,6 +56,13 @@ struct TileStore {
   std::vector<TileContents> tiles;       ///< tiles owning at least one triangle, in key order
   TilingStats stats;
   std::string fingerprint;  ///< what the caller says the store was made from
+
+  /// Tile `key`'s contents (by bisection over the sorted tiles); null when it owns nothing.
+  [[nodiscard]] const TileContents* find(TileKey key) const {
+    const auto it =
+        std::lower_bound(tiles.begin(), tiles.end(), key, [](const TileContents& t, TileKey k) { return t.key < k; });
+    return it != tiles.end() && it->key == key ? &*it : nullptr;
+  }
 };
 
 /// What one acquisition holds in one tile.
