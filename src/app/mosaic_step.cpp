@@ -43,7 +43,9 @@ StitchParams stitch_params(const Config& config) {
           .weld = kWeldInThresholds * config.change.distance_threshold,
           .clip = config.mosaic.clip_overlaps ? config.mosaic.clip_reach * config.change.distance_threshold : 0.0,
           .clip_angle = config.mosaic.clip_angle,
-          .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0};
+          .gap = config.mosaic.close_gaps ? config.mosaic.gap_width * config.change.distance_threshold : 0.0,
+          .join_own_pieces = config.mosaic.stitch_own_pieces,
+          .own_clip = config.mosaic.clip_overlaps ? config.change.distance_threshold : 0.0};
 }
 
 namespace {

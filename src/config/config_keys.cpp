@@ -244,6 +244,13 @@ std::vector<KeyDef> make_keys() {
   keys.push_back(real_key(mosaic, "stitch_reach",
       "stitching joins boundaries of pieces from different sources closer than this times distance_threshold",
       [](auto& c) -> auto& { return c.mosaic.stitch_reach; }, 0.1, 100));
+  keys.push_back(bool_key(
+      mosaic, "stitch_own_pieces",
+      "stitching also joins the pieces of one pass that share no vertex (the turns of a spinning scanner, "
+      "meshed one by one); where two lie within distance_threshold of each other, clipping cuts back the "
+      "later one in the pass's file "
+      "(fewer cracks and layers, more holes: see docs/mosaic.md)",
+      [](auto& c) -> auto& { return c.mosaic.stitch_own_pieces; }));
   keys.push_back(bool_key(mosaic, "fill_holes",
       "after the energy mosaic, add back kept triangles with nothing selected within distance_threshold (newest first), "
       "unless another pass saw through them (in its empty space, more than distance_threshold and at most 1 m in front of it)",

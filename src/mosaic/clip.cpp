@@ -13,6 +13,7 @@
 #include "citymesh/core/geometry.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/mosaic/proximity.h"
+#include "internal.h"
 
 namespace citymesh::mosaic_detail {
 
@@ -25,21 +26,29 @@ Vec3d unit_or_zero(const Vec3d& v) {
   return n > 0 ? v / n : Vec3d{};
 }
 
-/// Per vertex: its source (every vertex belongs to one, stitching not having started; -1
-/// when unused) and its normal (area-weighted over its triangles).
+/// What a vertex belongs to, for the cover: the source, piece and earliest source triangle
+/// (in the source's file) of its last triangle's piece at it.
+struct VertexOwner {
+  std::int32_t source = kNoSource, piece = kNoSource, first = INT32_MAX;
+};
+
+/// Per vertex: its owner (every vertex belongs to one, stitching not having started; no
+/// source when unused) and its normal (area-weighted over its triangles).
 struct VertexFrames {
-  std::vector<std::int32_t> source;
+  std::vector<VertexOwner> owner;
   std::vector<Vec3f> normal;
 };
 
-VertexFrames vertex_frames(const MergedMesh& merged) {
+VertexFrames vertex_frames(const MergedMesh& merged, std::span<const std::int32_t> pieces) {
   const Mesh& m = merged.mesh;
-  VertexFrames f{std::vector<std::int32_t>(m.vertex_count(), kNoSource), std::vector<Vec3f>(m.vertex_count())};
+  VertexFrames f{std::vector<VertexOwner>(m.vertex_count()), std::vector<Vec3f>(m.vertex_count())};
   for (std::size_t t = 0; t < m.triangle_count(); ++t) {
     const TriangleCorners c = m.corners(t);
     const Vec3f n(cross(c[1] - c[0], c[2] - c[0]));
     for (const std::uint32_t v : m.triangles[t]) {
-      f.source[v] = merged.source_acq[t];
+      VertexOwner& o = f.owner[v];
+      if (o.piece != pieces[t]) o = {merged.source_acq[t], pieces[t], INT32_MAX};
+      o.first = std::min(o.first, merged.source_triangle[t]);
       f.normal[v] += n;
     }
   }
@@ -63,14 +72,18 @@ std::vector<std::uint64_t> source_precedence(const MergedMesh& merged, std::span
   return precedence;
 }
 
-/// "Does the surface of a source of higher precedence lie over p?" for a point of source
-/// `source` with normal `n`.
+/// "Does the surface of a source of higher precedence (or of an earlier piece of the same
+/// source, within own_tolerance) lie over p?" for a point of `owner` with normal `n`.
 class Cover {
  public:
-  Cover(const MergedMesh& merged, const ClipParams& params, std::span<const std::uint64_t> sizes)
-      : merged_(merged), near_(merged.mesh, params.tolerance), params_(params),
+  Cover(const MergedMesh& merged, const ClipParams& params, std::span<const std::uint64_t> sizes,
+        std::span<const std::int32_t> pieces)
+      : merged_(merged),
+        near_(merged.mesh, params.tolerance),
+        params_(params),
         min_cos_(std::cos(params.max_angle_deg * std::numbers::pi / 180.0)),
-        precedence_(source_precedence(merged, sizes)) {
+        precedence_(source_precedence(merged, sizes)),
+        pieces_(pieces) {
     normal_.resize(merged.mesh.triangle_count());
     parallel_for_blocks(normal_.size(), 16384, [&](std::size_t begin, std::size_t end) {
       for (std::size_t t = begin; t < end; ++t) {
@@ -80,12 +93,16 @@ class Cover {
     });
   }
 
-  [[nodiscard]] bool over(const Vec3d& p, std::int32_t source, const Vec3d& n) const {
-    if (source < 0) return false;
-    const std::uint64_t own = precedence_[static_cast<std::size_t>(source)];
+  [[nodiscard]] bool over(const Vec3d& p, const VertexOwner& owner, const Vec3d& n) const {
+    if (owner.source < 0) return false;
+    const std::uint64_t own = precedence_[static_cast<std::size_t>(owner.source)];
     return near_.any_over(p, params_.tolerance, [&](std::uint32_t u) {
       const std::int32_t other = merged_.source_acq[u];
-      return other >= 0 && precedence_[static_cast<std::size_t>(other)] > own && dot(Vec3d(normal_[u]), n) >= min_cos_;
+      if (other < 0 || dot(Vec3d(normal_[u]), n) < min_cos_) return false;
+      if (other != owner.source) return precedence_[static_cast<std::size_t>(other)] > own;
+      // An earlier piece of the point's own source, within the tolerance for its own.
+      return pieces_[u] != owner.piece && merged_.source_triangle[u] < owner.first &&
+             lies_over(p, merged_.mesh.corners(u), params_.own_tolerance);
     });
   }
 
@@ -95,7 +112,8 @@ class Cover {
   const ClipParams& params_;
   double min_cos_;
   std::vector<std::uint64_t> precedence_;
-  std::vector<Vec3f> normal_;  ///< per triangle, unit
+  std::span<const std::int32_t> pieces_;  ///< per triangle: its piece, or its source (no own tolerance)
+  std::vector<Vec3f> normal_;             ///< per triangle, unit
 };
 
 std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
@@ -111,7 +129,7 @@ double cut_fraction(const Mesh& m, const Cover& cover, const VertexFrames& f, st
   double lo = 0, hi = 1;
   for (int i = 0; i < kBisections; ++i) {
     const double mid = 0.5 * (lo + hi);
-    (cover.over(pc + (pu - pc) * mid, f.source[c], n) ? lo : hi) = mid;
+    (cover.over(pc + (pu - pc) * mid, f.owner[c], n) ? lo : hi) = mid;
   }
   return std::clamp(0.5 * (lo + hi), params.min_edge_fraction, 1.0 - params.min_edge_fraction);
 }
@@ -256,8 +274,10 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
   std::vector<std::uint8_t> covered(m.vertex_count(), 0);
   std::vector<Cut> cuts;
   {
-    const VertexFrames frames = vertex_frames(merged);
-    const Cover cover(merged, params, around.source_sizes);
+    // Without a tolerance for its own, each source is one piece: never covered by itself.
+    const std::vector<std::int32_t> pieces = params.own_tolerance > 0 ? source_pieces(merged) : merged.source_acq;
+    const VertexFrames frames = vertex_frames(merged, pieces);
+    const Cover cover(merged, params, around.source_sizes, pieces);
     const std::span<const std::uint8_t> roles = around.vertex_roles;
     parallel_for_blocks(m.vertex_count(), 4096, [&](std::size_t begin, std::size_t end) {
       for (std::size_t v = begin; v < end; ++v) {
@@ -265,7 +285,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
         // vertex may be: the free triangles around it are cut now, the later part's own
         // triangles (whole, all_corners_frozen) when their turn comes, at the same place.
         if (role_of(roles, static_cast<std::uint32_t>(v)) == VertexRole::done) continue;
-        covered[v] = cover.over(Vec3d(m.positions[v]), frames.source[v], Vec3d(frames.normal[v])) ? 1 : 0;
+        covered[v] = cover.over(Vec3d(m.positions[v]), frames.owner[v], Vec3d(frames.normal[v])) ? 1 : 0;
       }
     });
     if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {};

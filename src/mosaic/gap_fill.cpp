@@ -82,7 +82,8 @@ Loop trace_loop(const MeshTopology& topo, const Successors& next, const Directed
   }
 }
 
-/// True when the loop is small enough and runs along more than one source.
+/// True when the loop is small enough and runs along more than one source (or piece, with own
+/// pieces apart).
 bool is_seam_gap(const MeshTopology& topo, const Loop& loop, const Vec3d& newell, const GapFillParams& params) {
   double perimeter = 0;
   for (std::size_t i = 0; i < loop.vertices.size(); ++i) {
@@ -90,9 +91,9 @@ bool is_seam_gap(const MeshTopology& topo, const Loop& loop, const Vec3d& newell
   }
   const double area = 0.5 * norm(newell);
   if (perimeter > params.max_perimeter || 2 * area > params.max_width * perimeter) return false;
-  const std::int32_t first = topo.merged().source_acq[loop.triangles.front()];
+  const std::int32_t first = topo.piece(loop.triangles.front());
   return std::any_of(loop.triangles.begin(), loop.triangles.end(),
-                     [&](std::uint32_t t) { return topo.merged().source_acq[t] != first; });
+                     [&](std::uint32_t t) { return topo.piece(t) != first; });
 }
 
 /// Ear clipping of `polygon` (counter-clockwise about `axis`), shortest diagonal first;

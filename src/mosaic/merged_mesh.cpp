@@ -1,6 +1,10 @@
 // SPDX-License-Identifier: MIT
 #include "citymesh/mosaic/merged_mesh.h"
 
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
 namespace citymesh {
 
 namespace {
@@ -59,6 +63,47 @@ std::vector<std::uint64_t> source_sizes(const MergedMesh& m) {
     ++sizes[static_cast<std::size_t>(s)];
   }
   return sizes;
+}
+
+std::vector<std::int32_t> source_pieces(const MergedMesh& m) {
+  const std::size_t n = m.mesh.triangle_count();
+  // Union-find over the triangles; a root is always its set's smallest index, so that the
+  // names do not depend on the order of the unions.
+  std::vector<std::uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0U);
+  const auto find = [&](std::uint32_t t) {
+    while (parent[t] != t) t = parent[t] = parent[parent[t]];
+    return t;
+  };
+  const auto unite = [&](std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  };
+  std::vector<std::uint32_t> first_at(m.mesh.vertex_count(), UINT32_MAX);  ///< first sourced triangle at v
+  // (vertex, source) -> a triangle, for the few vertices that several sources share (a seam
+  // stitched before, in a pass part by part).
+  std::unordered_map<std::uint64_t, std::uint32_t> shared;
+  for (std::uint32_t t = 0; t < n; ++t) {
+    const std::int32_t s = m.source_acq[t];
+    if (s < 0) continue;
+    for (const std::uint32_t v : m.mesh.triangles[t]) {
+      const std::uint32_t u = first_at[v];
+      if (u == UINT32_MAX) {
+        first_at[v] = t;
+      } else if (m.source_acq[u] == s) {
+        unite(u, t);
+      } else {
+        const auto [it, added] = shared.try_emplace((std::uint64_t{v} << 32) | static_cast<std::uint32_t>(s), t);
+        if (!added) unite(it->second, t);
+      }
+    }
+  }
+  std::vector<std::int32_t> piece(n, kNoSource);
+  for (std::uint32_t t = 0; t < n; ++t) {
+    if (m.source_acq[t] >= 0) piece[t] = static_cast<std::int32_t>(find(t));
+  }
+  return piece;
 }
 
 }  // namespace citymesh

@@ -8,9 +8,10 @@
 
 namespace citymesh::mosaic_detail {
 
-MeshTopology::MeshTopology(MergedMesh& merged, const StitchSurroundings& around)
+MeshTopology::MeshTopology(MergedMesh& merged, const StitchSurroundings& around, bool own_pieces_apart)
     : merged_(merged),
       around_(around),
+      pieces_(own_pieces_apart ? source_pieces(merged) : merged.source_acq),
       offsets_(merged.mesh.vertex_count() + 1, 0),
       edited_(merged.mesh.vertex_count(), UINT32_MAX) {
   const auto& triangles = merged.mesh.triangles;
@@ -48,7 +49,9 @@ std::vector<std::uint32_t>& MeshTopology::edit(std::uint32_t v) {
   return edits_[edited_[v]];
 }
 
-void MeshTopology::add_triangle(std::uint32_t t) {
+void MeshTopology::add_triangle(std::uint32_t t, std::int32_t piece) {
+  if (pieces_.size() <= t) pieces_.resize(t + 1, kNoSource);
+  pieces_[t] = piece;
   for (const std::uint32_t v : triangle(t)) edit(v).push_back(t);
 }
 
@@ -82,9 +85,9 @@ bool MeshTopology::edges_free(std::span<const Triangle> tris, std::span<const st
   });
 }
 
-std::int32_t MeshTopology::source_of_vertex(std::uint32_t v) const {
+std::int32_t MeshTopology::piece_of_vertex(std::uint32_t v) const {
   const std::span<const std::uint32_t> around = triangles_of(v);
-  return around.empty() ? kNoSource : merged_.source_acq[around.front()];
+  return around.empty() ? kNoSource : piece(around.front());
 }
 
 double MeshTopology::boundary_length() const { return edges_length(merged_.mesh, boundary_edges()); }

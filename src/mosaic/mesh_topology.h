@@ -25,8 +25,9 @@ struct DirectedEdge {
 class MeshTopology {
  public:
   /// `around`: the vertices' roles and where the part's own triangles start (its source sizes
-  /// are not read); the caller keeps its arrays alive.
-  explicit MeshTopology(MergedMesh& merged, const StitchSurroundings& around = {});
+  /// are not read); the caller keeps its arrays alive. `own_pieces_apart`: the pieces of one
+  /// source (source_pieces()) count as different sides of a seam, as two sources do.
+  explicit MeshTopology(MergedMesh& merged, const StitchSurroundings& around = {}, bool own_pieces_apart = false);
 
   [[nodiscard]] MergedMesh& merged() const { return merged_; }
   [[nodiscard]] const Triangle& triangle(std::uint32_t t) const { return merged_.mesh.triangles[t]; }
@@ -54,8 +55,12 @@ class MeshTopology {
   [[nodiscard]] std::span<const std::uint32_t> triangles_of(std::uint32_t v) const;
   /// v's list, to change (copied out of the packed lists on its first change).
   std::vector<std::uint32_t>& edit(std::uint32_t v);
-  /// Registers triangle t (already in the mesh) with its vertices.
-  void add_triangle(std::uint32_t t);
+  /// Registers triangle t (already in the mesh) with its vertices; `piece`: its side of the
+  /// seams (that of the triangle it was split from; kNoSource for a stitch triangle).
+  void add_triangle(std::uint32_t t, std::int32_t piece = kNoSource);
+  /// Which side of a seam triangle t is on: its source, or with own pieces apart its piece
+  /// (source_pieces()); kNoSource for a stitch triangle.
+  [[nodiscard]] std::int32_t piece(std::uint32_t t) const { return pieces_[t]; }
 
   /// The triangle using the directed edge from -> to (the first one if several do).
   [[nodiscard]] std::optional<std::uint32_t> triangle_with(std::uint32_t from, std::uint32_t to) const;
@@ -63,8 +68,8 @@ class MeshTopology {
   /// True when no directed edge of `tris` is used by a triangle other than those in
   /// `replaced` (about to be overwritten by `tris`), nor twice among `tris`.
   [[nodiscard]] bool edges_free(std::span<const Triangle> tris, std::span<const std::uint32_t> replaced) const;
-  /// The source of the first triangle around v, kNoSource for none.
-  [[nodiscard]] std::int32_t source_of_vertex(std::uint32_t v) const;
+  /// The piece of the first triangle around v, kNoSource for none.
+  [[nodiscard]] std::int32_t piece_of_vertex(std::uint32_t v) const;
 
   /// The edges used by exactly one triangle, sorted as boundary_edges() sorts them (which
   /// gives the same list, from the lists around each vertex instead of a sort of every edge).
@@ -78,6 +83,7 @@ class MeshTopology {
  private:
   MergedMesh& merged_;
   StitchSurroundings around_;
+  std::vector<std::int32_t> pieces_;             ///< per triangle: piece()
   std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
   std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
   std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows

@@ -77,7 +77,13 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   return true;
 }
 
-/// For each of `vertices`, the others within the tolerance that belong to another source,
+/// The source of the first triangle around v, kNoSource for none.
+std::int32_t source_of_vertex(const MeshTopology& topo, std::uint32_t v) {
+  const std::span<const std::uint32_t> around = topo.triangles_of(v);
+  return around.empty() ? kNoSource : topo.merged().source_acq[around.front()];
+}
+
+/// For each of `vertices`, the others within the tolerance that belong to another piece,
 /// in index order. The searches run on the pool: nothing moves before the merges.
 std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
                                                        const std::vector<std::uint32_t>& vertices,
@@ -89,11 +95,11 @@ std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
     for (std::size_t i = begin; i < end; ++i) {
       if (!topo.joinable(vertices[i])) continue;  // its own part snaps it
       tree.radius_search(points[i], static_cast<float>(tolerance), near);
-      const std::int32_t source = topo.source_of_vertex(vertices[i]);
+      const std::int32_t piece = topo.piece_of_vertex(vertices[i]);
       for (const std::uint32_t j : near) {
         // Two frozen vertices stay two: neither may move.
         const bool both_frozen = topo.frozen(vertices[i]) && topo.frozen(vertices[j]);
-        if (topo.source_of_vertex(vertices[j]) != source && !both_frozen && topo.joinable(vertices[j])) {
+        if (topo.piece_of_vertex(vertices[j]) != piece && !both_frozen && topo.joinable(vertices[j])) {
           partners[i].push_back(j);
         }
       }
@@ -102,7 +108,8 @@ std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
   return partners;
 }
 
-/// Stage 1: boundary vertices of different sources within the tolerance become one.
+/// Stage 1: boundary vertices of different pieces (MeshTopology::piece()) within the tolerance
+/// become one.
 void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<std::uint32_t> vertices = vertices_of(topo.boundary_half_edges());
   std::vector<Vec3f> points;
@@ -115,15 +122,19 @@ void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats
     if (done[i] != 0) continue;
     const std::uint32_t v = vertices[i];
     std::uint32_t best = UINT32_MAX;
-    double best_d2 = tolerance * tolerance;
-    for (const std::uint32_t j : partners[i]) {
-      if (done[j] != 0) continue;
-      const Vec3d d = topo.position(vertices[j]) - topo.position(v);
-      // partners are in index order: on equal distances the smaller index stays.
-      if (best == UINT32_MAX ? dot(d, d) <= best_d2 : dot(d, d) < best_d2) {
-        best = j;
-        best_d2 = dot(d, d);
+    // Another source's vertex first; failing one, another piece of v's own source.
+    for (const bool own_source : {false, true}) {
+      double best_d2 = tolerance * tolerance;
+      for (const std::uint32_t j : partners[i]) {
+        if (done[j] != 0 || (source_of_vertex(topo, vertices[j]) == source_of_vertex(topo, v)) != own_source) continue;
+        const Vec3d d = topo.position(vertices[j]) - topo.position(v);
+        // partners are in index order: on equal distances the smaller index stays.
+        if (best == UINT32_MAX ? dot(d, d) <= best_d2 : dot(d, d) < best_d2) {
+          best = j;
+          best_d2 = dot(d, d);
+        }
       }
+      if (best != UINT32_MAX) break;
     }
     if (best == UINT32_MAX) continue;
     if (try_merge(topo, v, vertices[best])) {
@@ -143,13 +154,13 @@ struct Insertion {
   auto operator<=>(const Insertion&) const = default;
 };
 
-/// True when a triangle around v comes from `source`.
-bool touches_source(const MeshTopology& topo, std::uint32_t v, std::int32_t source) {
+/// True when a triangle around v is of `piece` (MeshTopology::piece()).
+bool touches_piece(const MeshTopology& topo, std::uint32_t v, std::int32_t piece) {
   const std::span<const std::uint32_t> around = topo.triangles_of(v);
-  return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return topo.merged().source_acq[t] == source; });
+  return std::any_of(around.begin(), around.end(), [&](std::uint32_t t) { return topo.piece(t) == piece; });
 }
 
-/// The nearest boundary edge (of `tree`, over `edges`) of another source passing within the
+/// The nearest boundary edge (of `tree`, over `edges`) of another piece passing within the
 /// tolerance of boundary vertex v, where v projects well inside the edge; edge SIZE_MAX when
 /// there is none.
 Insertion nearest_insertion(const MeshTopology& topo, std::span<const DirectedEdge> edges, const BoxTree& tree,
@@ -162,7 +173,7 @@ Insertion nearest_insertion(const MeshTopology& topo, std::span<const DirectedEd
   double best_d2 = tolerance * tolerance;
   for (const std::uint32_t h : hits) {
     const DirectedEdge& e = edges[h];
-    if (e.from == v || e.to == v || touches_source(topo, v, topo.merged().source_acq[e.triangle]) ||
+    if (e.from == v || e.to == v || touches_piece(topo, v, topo.piece(e.triangle)) ||
         topo.frozen_triangle(e.triangle)) {
       continue;
     }
@@ -214,7 +225,7 @@ bool try_move(MeshTopology& topo, std::uint32_t v, const Vec3d& q) {
   return true;
 }
 
-/// Stage 2: boundary edges are split at the boundary vertices of other sources lying on them.
+/// Stage 2: boundary edges are split at the boundary vertices of other pieces lying on them.
 void split_edges_at_vertices(MeshTopology& topo, double tolerance, SnapStats& stats) {
   const std::vector<DirectedEdge> edges = topo.boundary_half_edges();
   const std::vector<Insertion> insertions = find_insertions(topo, edges, tolerance);
@@ -272,7 +283,7 @@ Split split_fan(MeshTopology& topo, std::uint32_t from, std::uint32_t to, const 
       m.source_acq.push_back(m.source_acq[t]);
       m.source_triangle.push_back(m.source_triangle[t]);
     }
-    if (i > 0) topo.add_triangle(slot);
+    if (i > 0) topo.add_triangle(slot, topo.piece(t));
   }
   // Triangle t now spans from, the first inserted vertex and the apex.
   topo.edit(chain[1]).push_back(t);

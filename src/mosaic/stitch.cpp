@@ -61,17 +61,19 @@ struct StitchContext {
   const StitchParams& params;
   mosaic_detail::MeshTopology& topo;  ///< the mesh, and which directed edges are in use
   Boundary boundary;
-  std::unordered_map<std::uint32_t, std::uint32_t> partner;  ///< boundary vertex -> matched vertex of another source
+  std::unordered_map<std::uint32_t, std::uint32_t> partner;   ///< boundary vertex -> matched vertex of another piece
   std::unordered_set<std::uint32_t> consumed;                 ///< boundary half-edges (by their start) joined
   StitchStats stats;
 
   [[nodiscard]] MergedMesh& merged() const { return topo.merged(); }
-  [[nodiscard]] std::int32_t source(std::uint32_t v) const {
-    return merged().source_acq[boundary.triangle_of.at(v)];
-  }
+  [[nodiscard]] std::int32_t source(std::uint32_t v) const { return merged().source_acq[boundary.triangle_of.at(v)]; }
+  /// The side of the seams boundary vertex v is on (MeshTopology::piece()).
+  [[nodiscard]] std::int32_t piece(std::uint32_t v) const { return topo.piece(boundary.triangle_of.at(v)); }
 };
 
-/// For every boundary vertex, the nearest boundary vertex of another source within reach.
+/// For every boundary vertex, the nearest boundary vertex of another source within reach, or
+/// failing one, of another piece of its own source (a seam between sources is not left open
+/// for a join within one pass).
 void match_vertices(StitchContext& c) {
   const Mesh& m = c.merged().mesh;
   std::vector<Vec3f> points;
@@ -82,20 +84,23 @@ void match_vertices(StitchContext& c) {
     const std::uint32_t v = c.boundary.vertices[i];
     if (!c.topo.joinable(v)) continue;  // its own part joins it
     tree.radius_search(points[i], static_cast<float>(c.params.reach), near);
-    double best = c.params.reach * c.params.reach;
-    for (const std::uint32_t j : near) {
-      const std::uint32_t w = c.boundary.vertices[j];
-      if (c.source(w) == c.source(v) || !c.topo.joinable(w)) continue;
-      const Vec3d d = position(m, w) - position(m, v);
-      if (dot(d, d) <= best) {
-        best = dot(d, d);
-        c.partner[v] = w;
+    for (const bool own_source : {false, true}) {
+      double best = c.params.reach * c.params.reach;
+      for (const std::uint32_t j : near) {
+        const std::uint32_t w = c.boundary.vertices[j];
+        if (c.piece(w) == c.piece(v) || (c.source(w) == c.source(v)) != own_source || !c.topo.joinable(w)) continue;
+        const Vec3d d = position(m, w) - position(m, v);
+        if (dot(d, d) <= best) {
+          best = dot(d, d);
+          c.partner[v] = w;
+        }
       }
+      if (c.partner.contains(v)) break;
     }
   }
 }
 
-/// The matched vertex of another source, UINT32_MAX for none (or when v starts no boundary
+/// The matched vertex of another piece, UINT32_MAX for none (or when v starts no boundary
 /// half-edge, at a pinched vertex).
 std::uint32_t partner_of(const StitchContext& c, std::uint32_t v) {
   const auto it = c.partner.find(v);
@@ -164,7 +169,7 @@ void zip(StitchContext& c, const std::vector<std::uint32_t>& a, const std::vecto
 }
 
 /// Walks one boundary loop from `start`: runs of consecutive vertices facing the same other
-/// source, along half-edges not joined yet, are zipped to that source's facing run.
+/// piece, along half-edges not joined yet, are zipped to that piece's facing run.
 void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_set<std::uint32_t>& visited) {
   std::vector<std::uint32_t> run;
   std::int32_t facing = kNoSource;
@@ -181,7 +186,7 @@ void stitch_loop(StitchContext& c, std::uint32_t start, std::unordered_set<std::
   for (;;) {
     visited.insert(v);
     const std::uint32_t p = partner_of(c, v);
-    const std::int32_t q = p == UINT32_MAX ? kNoSource : c.source(p);
+    const std::int32_t q = p == UINT32_MAX ? kNoSource : c.piece(p);
     if (!run.empty() && (q != facing || c.consumed.contains(run.back()))) flush();
     if (q != kNoSource) {
       facing = q;
@@ -248,16 +253,21 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
-  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around);
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around, params.join_own_pieces);
   const double before = unclipped->boundary_length();
   phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
   if (params.clip > 0) {
     unclipped.reset();
-    clipped = mosaic_detail::clip_overlaps(merged, {.tolerance = params.clip, .max_angle_deg = params.clip_angle}, around);
+    clipped = mosaic_detail::clip_overlaps(merged,
+                                           {.tolerance = params.clip,
+                                            .max_angle_deg = params.clip_angle,
+                                            .own_tolerance = params.join_own_pieces ? params.own_clip : 0.0},
+                                           around);
   }
   phase_done("clipped");
-  mosaic_detail::MeshTopology& topo = unclipped ? *unclipped : unclipped.emplace(merged, around);
+  mosaic_detail::MeshTopology& topo =
+      unclipped ? *unclipped : unclipped.emplace(merged, around, params.join_own_pieces);
   const mosaic_detail::SnapStats snapped = mosaic_detail::snap_boundaries(topo, params.snap);
   phase_done("snapped");
   StitchContext c{params, topo, find_boundary(topo), {}, {}, {}};

@@ -113,7 +113,7 @@ TEST(MeshTopology, EdgesFreeIgnoresTheTrianglesReplacedAndRefusesRepeats) {
   EXPECT_FALSE(topo.edges_free(twice, both));
   const std::vector<Triangle> once{{1, 3, 0}};
   EXPECT_TRUE(topo.edges_free(once, both));
-  EXPECT_EQ(topo.source_of_vertex(3), 0);
+  EXPECT_EQ(topo.piece_of_vertex(3), 0);
 }
 
 }  // namespace

@@ -33,4 +33,11 @@ void shrink_to_fit(MergedMesh& m);
 /// Per source acquisition, its triangles in `m` (stitch triangles not counted).
 std::vector<std::uint64_t> source_sizes(const MergedMesh& m);
 
+/// Per triangle, the piece it belongs to: the triangles of one source joined through shared
+/// vertices, named by the smallest triangle index among them (kNoSource for stitch
+/// triangles). A pass meshed turn by turn (a spinning scanner) comes as many pieces of one
+/// source that share no vertex; a profiler's pass as one sheet, cut only where other sources
+/// took over.
+std::vector<std::int32_t> source_pieces(const MergedMesh& m);
+
 }  // namespace citymesh

@@ -1,7 +1,8 @@
 // SPDX-License-Identifier: MIT
 // Stitching (paper §IV): the selected triangles form pieces, one source each; where the
-// boundaries of pieces from different sources face each other, strips of new triangles join
-// them (zippering), and vertices closer than a small tolerance are merged.
+// boundaries of pieces from different sources (or different pieces of one source) face each
+// other, strips of new triangles join them (zippering), and vertices closer than a small
+// tolerance are merged.
 #pragma once
 
 #include <cstddef>
@@ -24,6 +25,15 @@ struct StitchParams {
   /// metres: small holes left between pieces of several sources, up to this wide (and 20
   /// times this around), are triangulated last; 0: off
   double gap = 0.0;
+  /// Whether the pieces of one source that share no vertex (source_pieces(): the turns of a
+  /// spinning scanner, meshed one by one) are stitched to each other as pieces of different
+  /// sources are, after those (a boundary vertex is joined to another source's first). Off:
+  /// only pieces of different sources are joined.
+  bool join_own_pieces = false;
+  /// Metres, with join_own_pieces: where two pieces of one source lie within this of each
+  /// other (normals within clip_angle), clipping cuts back the one later in the source's file
+  /// (the later turn); 0: they are not clipped.
+  double own_clip = 0.0;
 };
 
 struct StitchStats {
@@ -87,7 +97,8 @@ struct StitchSurroundings {
   [[nodiscard]] bool told_own(std::size_t t) const { return first_own_triangle && t >= *first_own_triangle; }
 };
 
-/// Closes the seams between pieces of different sources of `mesh`. With `clip` > 0, the parts
+/// Closes the seams between pieces of different sources of `mesh` (and, with `join_own_pieces`,
+/// between the pieces of one source that share no vertex). With `clip` > 0, the parts
 /// of pieces lying over a larger source's surface are first cut away (Turk and Levoy's
 /// clipping), so that a piece's boundary no longer runs across another's interior. Boundaries lying within
 /// `snap` of each other are first made to share vertices (nearby boundary vertices merged at
