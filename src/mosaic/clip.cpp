@@ -72,6 +72,8 @@ std::vector<std::uint64_t> source_precedence(const MergedMesh& merged, std::span
   return precedence;
 }
 
+enum class Coverage : std::uint8_t { none, other_source, own_piece };
+
 /// "Does the surface of a source of higher precedence (or of an earlier piece of the same
 /// source, within own_tolerance) lie over p?" for a point of `owner` with normal `n`.
 class Cover {
@@ -93,17 +95,25 @@ class Cover {
     });
   }
 
-  [[nodiscard]] bool over(const Vec3d& p, const VertexOwner& owner, const Vec3d& n) const {
-    if (owner.source < 0) return false;
+  /// Whether p is covered, and by what: another source's surface is looked for first.
+  [[nodiscard]] Coverage coverage(const Vec3d& p, const VertexOwner& owner, const Vec3d& n) const {
+    if (owner.source < 0) return Coverage::none;
     const std::uint64_t own = precedence_[static_cast<std::size_t>(owner.source)];
-    return near_.any_over(p, params_.tolerance, [&](std::uint32_t u) {
+    bool by_own_piece = false;
+    const bool by_other_source = near_.any_over(p, params_.tolerance, [&](std::uint32_t u) {
       const std::int32_t other = merged_.source_acq[u];
       if (other < 0 || dot(Vec3d(normal_[u]), n) < min_cos_) return false;
       if (other != owner.source) return precedence_[static_cast<std::size_t>(other)] > own;
-      // An earlier piece of the point's own source, within the tolerance for its own.
-      return pieces_[u] != owner.piece && merged_.source_triangle[u] < owner.first &&
-             lies_over(p, merged_.mesh.corners(u), params_.own_tolerance);
+      // An earlier piece of the point's own source, within the tolerance for its own: noted,
+      // and the search goes on for another source.
+      by_own_piece = by_own_piece || (pieces_[u] != owner.piece && merged_.source_triangle[u] < owner.first &&
+                                      lies_over(p, merged_.mesh.corners(u), params_.own_tolerance));
+      return false;
     });
+    return by_other_source ? Coverage::other_source : by_own_piece ? Coverage::own_piece : Coverage::none;
+  }
+  [[nodiscard]] bool over(const Vec3d& p, const VertexOwner& owner, const Vec3d& n) const {
+    return coverage(p, owner, n) != Coverage::none;
   }
 
  private:
@@ -134,22 +144,47 @@ double cut_fraction(const Mesh& m, const Cover& cover, const VertexFrames& f, st
   return std::clamp(0.5 * (lo + hi), params.min_edge_fraction, 1.0 - params.min_edge_fraction);
 }
 
+/// Appends a vertex whose every per-vertex attribute is mix(get), get(v) giving the
+/// attribute's value at vertex v (a Vec3d for positions, a double otherwise).
+template <class Mix>
+std::uint32_t append_mixed(Mesh& m, Mix mix) {
+  const auto v = static_cast<std::uint32_t>(m.positions.size());
+  const auto position = mix([&](std::uint32_t i) { return Vec3d(m.positions[i]); });
+  m.positions.push_back(Vec3f(position));
+  if (!m.sensor_positions.empty()) {
+    const auto sensor = mix([&](std::uint32_t i) { return Vec3d(m.sensor_positions[i]); });
+    m.sensor_positions.push_back(Vec3f(sensor));
+  }
+  if (!m.times.empty()) {
+    const double time = mix([&](std::uint32_t i) { return m.times[i]; });
+    m.times.push_back(time);
+  }
+  if (!m.intensities.empty()) {
+    const double intensity = mix([&](std::uint32_t i) { return double(m.intensities[i]); });
+    m.intensities.push_back(static_cast<float>(intensity));
+  }
+  if (!m.colors.empty()) {
+    const auto channel = [&](std::uint8_t Rgb8::*c) {
+      return static_cast<std::uint8_t>(std::lround(mix([&](std::uint32_t i) { return double(m.colors[i].*c); })));
+    };
+    const Rgb8 color{channel(&Rgb8::r), channel(&Rgb8::g), channel(&Rgb8::b)};
+    m.colors.push_back(color);
+  }
+  return v;
+}
+
 /// Appends the point a fraction s of the way from vertex a to vertex b, with every per-vertex
 /// attribute interpolated.
 std::uint32_t append_between(Mesh& m, std::uint32_t a, std::uint32_t b, double s) {
-  const auto lerp = [s](double x, double y) { return x + (y - x) * s; };
-  const auto lerp3 = [&](const Vec3f& x, const Vec3f& y) { return Vec3f(Vec3d(x) + (Vec3d(y) - Vec3d(x)) * s); };
-  const auto v = static_cast<std::uint32_t>(m.positions.size());
-  m.positions.push_back(lerp3(m.positions[a], m.positions[b]));
-  if (!m.sensor_positions.empty()) m.sensor_positions.push_back(lerp3(m.sensor_positions[a], m.sensor_positions[b]));
-  if (!m.times.empty()) m.times.push_back(lerp(m.times[a], m.times[b]));
-  if (!m.intensities.empty()) m.intensities.push_back(static_cast<float>(lerp(m.intensities[a], m.intensities[b])));
-  if (!m.colors.empty()) {
-    const auto channel = [&](std::uint8_t x, std::uint8_t y) { return static_cast<std::uint8_t>(std::lround(lerp(x, y))); };
-    const Rgb8 ca = m.colors[a], cb = m.colors[b];
-    m.colors.push_back({channel(ca.r, cb.r), channel(ca.g, cb.g), channel(ca.b, cb.b)});
-  }
-  return v;
+  return append_mixed(m, [&](auto get) {
+    const auto x = get(a);
+    return x + (get(b) - x) * s;
+  });
+}
+
+/// Appends the centroid of triangle `tri`, with every per-vertex attribute averaged.
+std::uint32_t append_centroid(Mesh& m, const Triangle& tri) {
+  return append_mixed(m, [&](auto get) { return (get(tri[0]) + get(tri[1]) + get(tri[2])) / 3.0; });
 }
 
 /// A cut: the edge from covered vertex c to uncovered vertex u leaves the cover at `fraction`.
@@ -267,10 +302,72 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
   return stats;
 }
 
+/// Triangles whose three corners are covered, one of them by an earlier piece of its own
+/// source only, but whose centroid is not: that piece has a hole there (a later turn's triangle spanning what the
+/// earlier turn lacks, its corners over the earlier turn around the hole). Free triangles only, in index order.
+std::vector<std::uint32_t> open_in_the_middle(const MergedMesh& merged, const ClipParams& params,
+                                              const StitchSurroundings& around) {
+  const Mesh& m = merged.mesh;
+  const std::vector<std::int32_t> pieces = source_pieces(merged);
+  const VertexFrames frames = vertex_frames(merged, pieces);
+  const Cover cover(merged, params, around.source_sizes, pieces);
+  std::vector<Coverage> coverage(m.vertex_count(), Coverage::none);
+  parallel_for_blocks(m.vertex_count(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t v = begin; v < end; ++v) {
+      if (role_of(around.vertex_roles, static_cast<std::uint32_t>(v)) != VertexRole::free) continue;
+      coverage[v] = cover.coverage(Vec3d(m.positions[v]), frames.owner[v], Vec3d(frames.normal[v]));
+    }
+  });
+  std::vector<std::uint8_t> open(m.triangle_count(), 0);
+  parallel_for_blocks(m.triangle_count(), 4096, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t t = begin; t < end; ++t) {
+      const Triangle& tri = m.triangles[t];
+      const auto is = [&](Coverage c) {
+        return coverage[tri[0]] == c || coverage[tri[1]] == c || coverage[tri[2]] == c;
+      };
+      if (is(Coverage::none) || !is(Coverage::own_piece)) continue;
+      const TriangleCorners c = m.corners(t);
+      const VertexOwner owner{merged.source_acq[t], pieces[t], merged.source_triangle[t]};
+      open[t] = cover.over((c[0] + c[1] + c[2]) / 3.0, owner, unit_or_zero(cross(c[1] - c[0], c[2] - c[0]))) ? 0 : 1;
+    }
+  });
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t t = 0; t < open.size(); ++t) {
+    if (open[t] != 0) out.push_back(t);
+  }
+  return out;
+}
+
+/// Splits each of `triangles` into three about its centroid (the first part in its place,
+/// the other two appended, all keeping its provenance). Its edges stay as they are, so the
+/// mesh stays conforming; clipping then cuts the parts back along the spokes, and what stays
+/// is the part about the centroid, over the hole, rather than nothing (the hole opened) or
+/// the whole triangle (lying over the piece around the hole).
+void split_about_centroids(MergedMesh& merged, std::span<const std::uint32_t> triangles) {
+  Mesh& m = merged.mesh;
+  for (const std::uint32_t t : triangles) {
+    const Triangle tri = m.triangles[t];
+    const std::uint32_t centre = append_centroid(m, tri);
+    m.triangles[t] = {centre, tri[0], tri[1]};
+    for (const Triangle& part : {Triangle{centre, tri[1], tri[2]}, Triangle{centre, tri[2], tri[0]}}) {
+      m.triangles.push_back(part);
+      m.triangle_ids.push_back(m.triangle_ids[t]);
+      merged.source_acq.push_back(merged.source_acq[t]);
+      merged.source_triangle.push_back(merged.source_triangle[t]);
+    }
+  }
+}
+
 }  // namespace
 
 ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const StitchSurroundings& around) {
   Mesh& m = merged.mesh;
+  std::uint64_t split = 0;
+  if (params.own_tolerance > 0) {
+    const std::vector<std::uint32_t> open = open_in_the_middle(merged, params, around);
+    split_about_centroids(merged, open);
+    split = open.size();
+  }
   std::vector<std::uint8_t> covered(m.vertex_count(), 0);
   std::vector<Cut> cuts;
   {
@@ -288,7 +385,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
         covered[v] = cover.over(Vec3d(m.positions[v]), frames.owner[v], Vec3d(frames.normal[v])) ? 1 : 0;
       }
     });
-    if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {};
+    if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {.triangles_split = split};
     cuts = find_cuts(m, cover, frames, covered, params, roles);
   }  // the index and the normals go before the triangles are rebuilt (a city's peak memory)
   const std::size_t before = m.vertex_count();
@@ -296,6 +393,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
   covered.resize(m.vertex_count(), 0);  // the cuts are where the cover ends: uncovered
   ClipStats stats = replace_covered(merged, covered, vertex_of, around);
   stats.vertices_added = m.vertex_count() - before;
+  stats.triangles_split = split;
   return stats;
 }
 

@@ -29,6 +29,9 @@ struct ClipStats {
   std::uint64_t triangles_removed = 0;  ///< covered whole
   std::uint64_t triangles_cut = 0;      ///< covered in part: replaced by their uncovered part
   std::uint64_t vertices_added = 0;     ///< where cuts cross edges
+  /// With an own tolerance: triangles whose corners an earlier piece of their own source
+  /// covers but whose centroid it does not, split about their centroid first.
+  std::uint64_t triangles_split = 0;
 };
 
 /// A vertex of source s is covered when it lies within `tolerance` of a triangle of a source

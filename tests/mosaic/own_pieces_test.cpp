@@ -195,5 +195,45 @@ TEST(GapFill, ClosesAHoleBetweenTwoPiecesOfOneSourceButNotAHoleInsideOne) {
   EXPECT_NEAR(h.open_boundary_after, 4.4, 1e-4);
 }
 
+TEST(Clip, ALaterTurnsTriangleSpanningAnEarlierTurnsHoleKeepsThePartOverTheHole) {
+  // The earlier turn lacks the cells of [0.4, 0.6]^2; a later turn's single large triangle,
+  // 2 cm under it, spans that hole with its corners over the earlier turn. Removed whole (its
+  // corners are covered), it would open the hole; kept whole, it would double the earlier
+  // turn around it. Split about its centroid and cut back along the spokes, what stays lies
+  // over the hole.
+  MergedMesh m;
+  add_grid(m, 0, 0, 10, 10, 0.1f, 0);
+  for (const float x : {0.4f, 0.5f}) {
+    for (const float y : {0.4f, 0.5f}) drop_cell(m, x, y);
+  }
+  const std::size_t earlier = m.mesh.triangle_count();
+  const auto base = static_cast<std::uint32_t>(m.mesh.positions.size());
+  for (const Vec3f p : {Vec3f{0.2f, 0.25f, -0.02f}, Vec3f{0.85f, 0.3f, -0.02f}, Vec3f{0.45f, 0.85f, -0.02f}}) {
+    m.mesh.positions.push_back(p);
+  }
+  m.mesh.triangles.push_back({base, base + 1, base + 2});
+  m.mesh.triangle_ids.push_back({});
+  m.source_acq.push_back(0);
+  m.source_triangle.push_back(1000);  // later in the pass's file
+  MergedMesh unsplit = m;
+  const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.2, .own_tolerance = 0.1});
+  EXPECT_EQ(s.triangles_split, 1u);
+  EXPECT_NEAR(area_from(m, 0, 1000), 1.0 - 0.04, 1e-5);  // the earlier turn stays whole
+  const double kept = area_from(m, 1000, 1001);
+  EXPECT_GT(kept, 0.01);  // at least a quarter of the hole's 0.04 m2
+  EXPECT_LT(kept, 0.06);  // the triangle was 0.19 m2
+  for (std::size_t t = earlier; t < m.mesh.triangle_count(); ++t) {
+    const TriangleCorners c = m.mesh.corners(t);
+    const Vec3d mid = (c[0] + c[1] + c[2]) / 3.0;
+    EXPECT_TRUE(mid.x > 0.35 && mid.x < 0.65 && mid.y > 0.35 && mid.y < 0.65)
+        << "part " << t << " lies beside the hole";
+  }
+  EXPECT_EQ(repeated_directed_edges(m.mesh), 0u);
+  EXPECT_EQ(non_manifold_edges(m.mesh), 0u);
+  // Without a tolerance for its own, nothing is split or cut.
+  const mosaic_detail::ClipStats off = mosaic_detail::clip_overlaps(unsplit, {.tolerance = 0.2});
+  EXPECT_EQ(off.triangles_split + off.triangles_removed + off.triangles_cut, 0u);
+}
+
 }  // namespace
 }  // namespace citymesh

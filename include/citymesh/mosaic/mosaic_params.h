@@ -59,9 +59,9 @@ struct MosaicParams {
   /// scanner's turns, meshed one by one, leave slits and overlaps of half a triangle where one
   /// turn's piece ends and the next takes over (StitchParams::join_own_pieces), and clipping
   /// cuts the later turn back where the earlier lies within the distance threshold. Off by
-  /// default: on the 30 m spinning street it takes the open boundary from 27.5 to ~9 km and
-  /// the layered ratio from 5.2 to ~1.3 %, but the hole ratio from 0.96 to ~1.7 %
-  /// (docs/mosaic.md, "Stitching the turns of one pass").
+  /// default: on the 30 m spinning street it takes the open boundary from 27.5 to 12.4 km and
+  /// the layered ratio from 5.2 to 2.0 %, but the hole ratio from 0.96 to 1.39 % (the zipper
+  /// refuses most joins between turns; docs/mosaic.md, "Stitching the turns of one pass").
   bool stitch_own_pieces = false;
   /// After the energy mosaic, kept triangles with nothing selected within the distance
   /// threshold are added back (newest acquisition first), unless another pass saw through
