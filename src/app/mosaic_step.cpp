@@ -82,7 +82,7 @@ void check_seam_pass(const Config& config) {
 /// Prints the stitching's line and returns its figures for the summary.
 nlohmann::json report_stitching(const StitchStats& s, const BlockStitchStats* blocks) {
   std::cout << fmt::format(
-      "stitching: {} triangles clipped and {} removed under other sources, {} strips and {} gaps closed with {} "
+      "stitching: {} triangles clipped and {} removed under other surfaces, {} strips and {} gaps closed with {} "
       "triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
       s.triangles_clipped, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added, s.open_boundary_before,

@@ -303,8 +303,9 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
 }
 
 /// Triangles whose three corners are covered, one of them by an earlier piece of its own
-/// source only, but whose centroid is not: that piece has a hole there (a later turn's triangle spanning what the
-/// earlier turn lacks, its corners over the earlier turn around the hole). Free triangles only, in index order.
+/// source only, but whose centroid is not: that piece has a hole there (a later turn's
+/// triangle spanning what the earlier turn lacks, its corners over the earlier turn around
+/// the hole). Free triangles only, in index order.
 std::vector<std::uint32_t> open_in_the_middle(const MergedMesh& merged, const ClipParams& params,
                                               const StitchSurroundings& around) {
   const Mesh& m = merged.mesh;

@@ -39,14 +39,19 @@ struct ClipStats {
 /// inside it. Precedence: more triangles in the mosaic (the small pieces yield to the large
 /// ones), on a tie the later acquisition; with an own tolerance, a vertex is also covered by
 /// another piece of its own source lying within that tolerance, whose triangle comes before
-/// every triangle of the vertex's piece at the vertex in the source's file. Triangles with every corner covered are
-/// removed; triangles with one or two are replaced by their uncovered part, cut where each edge leaves the cover (found
-/// by bisection along the edge, so that the two triangles sharing an edge cut it at the same new vertex and the mesh
-/// stays conforming). The parts keep their triangle's provenance and orientation. New vertices interpolate every
-/// per-vertex attribute. Sources never share vertices here (stitching has not started). Deterministic: triangles keep
-/// their order, each replaced in place by its parts. With `around`: vertices of output stitched before (done) are never
-/// covered, triangles whose corners are all done or later stay whole (the free triangles around a covered later vertex
-/// are cut), and precedence counts each source's triangles in the whole output.
+/// every triangle of the vertex's piece at the vertex in the source's file (and a free
+/// triangle whose corners are covered so, but not its centroid, is first split about its
+/// centroid, so that its part over the earlier piece's hole stays).
+/// Triangles with every corner covered are removed; triangles with one or two are replaced
+/// by their uncovered part, cut where each edge leaves the cover (found by bisection along
+/// the edge, so that the two triangles sharing an edge cut it at the same new vertex and the
+/// mesh stays conforming). The parts keep their triangle's provenance and orientation. New
+/// vertices interpolate every per-vertex attribute. Sources never share vertices here
+/// (stitching has not started). Deterministic: triangles keep their order, each replaced in
+/// place by its parts (split triangles' other parts appended). With `around`: vertices of
+/// output stitched before (done) are never covered, triangles whose corners are all done or
+/// later stay whole (the free triangles around a covered later vertex are cut), and
+/// precedence counts each source's triangles in the whole output.
 ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const StitchSurroundings& around = {});
 
 }  // namespace citymesh::mosaic_detail
