@@ -7,16 +7,18 @@
 # (read, detect, mosaic), the mosaic's md5 (the same bytes on any thread count and across
 # speed-only changes) and `citymesh eval`'s mosaic scores (the layered ratio among them).
 # Usage: tools/bench/spinning.sh [work folder (default /tmp/citymesh-spinning)] [length in
-# metres (default 30, at least 30)]
+# metres (default 30, at least 30)] [more `citymesh run` arguments, e.g.
+# --set mosaic.stitch_own_pieces=true]
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 dir="${1:-/tmp/citymesh-spinning}"
 length="${2:-30}"
+shift $(( $# < 2 ? $# : 2 ))
 bin="$PWD/build/release/citymesh"
 [ -f "$dir/config.toml" ] || "$bin" simulate --out "$dir" --scanner spinning --length "$length" >/dev/null
 cd "$dir"
 rm -rf work out
-/usr/bin/time -v "$bin" run config.toml --no-pictures 2>time.log | tail -1
+/usr/bin/time -v "$bin" run config.toml --no-pictures "$@" 2>time.log | tail -1
 grep -E "Elapsed|Maximum resident" time.log | sed 's/^\s*/  /'
 grep -E "^warning: the tiles took" time.log | cut -c1-100 || true
 python3 - <<'PY'
