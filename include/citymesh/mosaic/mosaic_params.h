@@ -61,7 +61,7 @@ struct MosaicParams {
   /// cuts the later turn back where the earlier lies within the distance threshold. Off by
   /// default: on the 30 m spinning street it takes the open boundary from 27.5 to 12.4 km and
   /// the layered ratio from 5.2 to 2.0 %, but the hole ratio from 0.96 to 1.39 % (the zipper
-  /// refuses most joins between turns; docs/mosaic.md, "Stitching the turns of one pass").
+  /// refuses many joins between turns; docs/mosaic.md, "Stitching the turns of one pass").
   bool stitch_own_pieces = false;
   /// After the energy mosaic, kept triangles with nothing selected within the distance
   /// threshold are added back (newest acquisition first), unless another pass saw through
