@@ -71,7 +71,7 @@ std::vector<std::size_t> tiles_over_budget(const TileStore& store, const std::ve
                                            std::uint64_t budget) {
   std::vector<std::size_t> over;
   for (const std::size_t k : tiles) {
-    if (tile_memory_estimate(store.tiles[k]) > budget) over.push_back(k);
+    if (tile_over_budget(store.tiles[k], budget)) over.push_back(k);
   }
   std::stable_sort(over.begin(), over.end(),
                    [&](std::size_t a, std::size_t b) { return store.tiles[a].total() > store.tiles[b].total(); });

@@ -48,6 +48,11 @@ inline constexpr std::uint64_t kBytesPerTileTriangle = 900;
 
 /// The estimated peak bytes of `tile` while it is processed: what the memory budget counts.
 std::uint64_t tile_memory_estimate(const TileContents& tile);
+/// Whether `tile` is estimated above `budget`: such a tile runs alone, and its mosaic solves
+/// with the least memory.
+inline bool tile_over_budget(const TileContents& tile, std::uint64_t budget) {
+  return tile_memory_estimate(tile) > budget;
+}
 
 /// The tiles among `tiles` (indices into store.tiles) whose estimate alone exceeds `budget`,
 /// largest first: each runs alone and may take the process past the budget.

@@ -373,7 +373,10 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
   std::vector<Cut> cuts;
   {
     // Without a tolerance for its own, each source is one piece: never covered by itself.
-    const std::vector<std::int32_t> pieces = params.own_tolerance > 0 ? source_pieces(merged) : merged.source_acq;
+    const std::vector<std::int32_t> own_pieces =
+        params.own_tolerance > 0 ? source_pieces(merged) : std::vector<std::int32_t>{};
+    const std::span<const std::int32_t> pieces =
+        params.own_tolerance > 0 ? std::span(own_pieces) : std::span(merged.source_acq);
     const VertexFrames frames = vertex_frames(merged, pieces);
     const Cover cover(merged, params, around.source_sizes, pieces);
     const std::span<const std::uint8_t> roles = around.vertex_roles;

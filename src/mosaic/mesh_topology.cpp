@@ -11,7 +11,8 @@ namespace citymesh::mosaic_detail {
 MeshTopology::MeshTopology(MergedMesh& merged, const StitchSurroundings& around, bool own_pieces_apart)
     : merged_(merged),
       around_(around),
-      pieces_(own_pieces_apart ? source_pieces(merged) : merged.source_acq),
+      own_pieces_apart_(own_pieces_apart),
+      pieces_(own_pieces_apart ? source_pieces(merged) : std::vector<std::int32_t>{}),
       offsets_(merged.mesh.vertex_count() + 1, 0),
       edited_(merged.mesh.vertex_count(), UINT32_MAX) {
   const auto& triangles = merged.mesh.triangles;
@@ -50,8 +51,10 @@ std::vector<std::uint32_t>& MeshTopology::edit(std::uint32_t v) {
 }
 
 void MeshTopology::add_triangle(std::uint32_t t, std::int32_t piece) {
-  if (pieces_.size() <= t) pieces_.resize(t + 1, kNoSource);
-  pieces_[t] = piece;
+  if (own_pieces_apart()) {
+    if (pieces_.size() <= t) pieces_.resize(t + 1, kNoSource);
+    pieces_[t] = piece;
+  }
   for (const std::uint32_t v : triangle(t)) edit(v).push_back(t);
 }
 
@@ -83,6 +86,11 @@ bool MeshTopology::edges_free(std::span<const Triangle> tris, std::span<const st
     }
     return false;
   });
+}
+
+std::int32_t MeshTopology::source_of_vertex(std::uint32_t v) const {
+  const std::span<const std::uint32_t> around = triangles_of(v);
+  return around.empty() ? kNoSource : merged_.source_acq[around.front()];
 }
 
 std::int32_t MeshTopology::piece_of_vertex(std::uint32_t v) const {

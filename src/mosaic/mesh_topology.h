@@ -60,7 +60,11 @@ class MeshTopology {
   void add_triangle(std::uint32_t t, std::int32_t piece = kNoSource);
   /// Which side of a seam triangle t is on: its source, or with own pieces apart its piece
   /// (source_pieces()); kNoSource for a stitch triangle.
-  [[nodiscard]] std::int32_t piece(std::uint32_t t) const { return pieces_[t]; }
+  [[nodiscard]] std::int32_t piece(std::uint32_t t) const {
+    return own_pieces_apart() ? pieces_[t] : merged_.source_acq[t];
+  }
+  /// Whether the pieces of one source are different sides of a seam (else each source is one).
+  [[nodiscard]] bool own_pieces_apart() const { return own_pieces_apart_; }
 
   /// The triangle using the directed edge from -> to (the first one if several do).
   [[nodiscard]] std::optional<std::uint32_t> triangle_with(std::uint32_t from, std::uint32_t to) const;
@@ -68,6 +72,8 @@ class MeshTopology {
   /// True when no directed edge of `tris` is used by a triangle other than those in
   /// `replaced` (about to be overwritten by `tris`), nor twice among `tris`.
   [[nodiscard]] bool edges_free(std::span<const Triangle> tris, std::span<const std::uint32_t> replaced) const;
+  /// The source of the first triangle around v, kNoSource for none.
+  [[nodiscard]] std::int32_t source_of_vertex(std::uint32_t v) const;
   /// The piece of the first triangle around v, kNoSource for none.
   [[nodiscard]] std::int32_t piece_of_vertex(std::uint32_t v) const;
 
@@ -83,7 +89,8 @@ class MeshTopology {
  private:
   MergedMesh& merged_;
   StitchSurroundings around_;
-  std::vector<std::int32_t> pieces_;             ///< per triangle: piece()
+  bool own_pieces_apart_;
+  std::vector<std::int32_t> pieces_;             ///< per triangle: piece() (empty unless own pieces apart)
   std::vector<std::uint32_t> offsets_, packed_;  ///< the lists of the mesh as given, compressed rows
   std::vector<std::uint32_t> edited_;            ///< per vertex: its list in `edits_`, or UINT32_MAX
   std::deque<std::vector<std::uint32_t>> edits_;  ///< a deque: references stay valid as it grows

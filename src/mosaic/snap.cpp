@@ -77,12 +77,6 @@ bool try_merge(MeshTopology& topo, std::uint32_t v, std::uint32_t w) {
   return true;
 }
 
-/// The source of the first triangle around v, kNoSource for none.
-std::int32_t source_of_vertex(const MeshTopology& topo, std::uint32_t v) {
-  const std::span<const std::uint32_t> around = topo.triangles_of(v);
-  return around.empty() ? kNoSource : topo.merged().source_acq[around.front()];
-}
-
 /// For each of `vertices`, the others within the tolerance that belong to another piece,
 /// in index order. The searches run on the pool: nothing moves before the merges.
 std::vector<std::vector<std::uint32_t>> close_partners(const MeshTopology& topo,
@@ -122,19 +116,21 @@ void merge_close_vertices(MeshTopology& topo, double tolerance, SnapStats& stats
     if (done[i] != 0) continue;
     const std::uint32_t v = vertices[i];
     std::uint32_t best = UINT32_MAX;
-    // Another source's vertex first; failing one, another piece of v's own source.
-    for (const bool own_source : {false, true}) {
-      double best_d2 = tolerance * tolerance;
-      for (const std::uint32_t j : partners[i]) {
-        if (done[j] != 0 || (source_of_vertex(topo, vertices[j]) == source_of_vertex(topo, v)) != own_source) continue;
-        const Vec3d d = topo.position(vertices[j]) - topo.position(v);
-        // partners are in index order: on equal distances the smaller index stays.
-        if (best == UINT32_MAX ? dot(d, d) <= best_d2 : dot(d, d) < best_d2) {
-          best = j;
-          best_d2 = dot(d, d);
-        }
+    bool best_own_source = true;
+    double best_d2 = tolerance * tolerance;
+    const std::int32_t source = topo.source_of_vertex(v);
+    for (const std::uint32_t j : partners[i]) {
+      const Vec3d d = topo.position(vertices[j]) - topo.position(v);
+      if (done[j] != 0 || dot(d, d) > tolerance * tolerance) continue;
+      // Another source's vertex before another piece of v's own source; then the nearer, and
+      // on equal distances the smaller index (partners are in index order).
+      const bool own_source = topo.own_pieces_apart() && topo.source_of_vertex(vertices[j]) == source;
+      if (best == UINT32_MAX || own_source < best_own_source ||
+          (own_source == best_own_source && dot(d, d) < best_d2)) {
+        best = j;
+        best_own_source = own_source;
+        best_d2 = dot(d, d);
       }
-      if (best != UINT32_MAX) break;
     }
     if (best == UINT32_MAX) continue;
     if (try_merge(topo, v, vertices[best])) {

@@ -66,7 +66,6 @@ struct StitchContext {
   StitchStats stats;
 
   [[nodiscard]] MergedMesh& merged() const { return topo.merged(); }
-  [[nodiscard]] std::int32_t source(std::uint32_t v) const { return merged().source_acq[boundary.triangle_of.at(v)]; }
   /// The side of the seams boundary vertex v is on (MeshTopology::piece()).
   [[nodiscard]] std::int32_t piece(std::uint32_t v) const { return topo.piece(boundary.triangle_of.at(v)); }
 };
@@ -84,18 +83,24 @@ void match_vertices(StitchContext& c) {
     const std::uint32_t v = c.boundary.vertices[i];
     if (!c.topo.joinable(v)) continue;  // its own part joins it
     tree.radius_search(points[i], static_cast<float>(c.params.reach), near);
-    for (const bool own_source : {false, true}) {
-      double best = c.params.reach * c.params.reach;
-      for (const std::uint32_t j : near) {
-        const std::uint32_t w = c.boundary.vertices[j];
-        if (c.piece(w) == c.piece(v) || (c.source(w) == c.source(v)) != own_source || !c.topo.joinable(w)) continue;
-        const Vec3d d = position(m, w) - position(m, v);
-        if (dot(d, d) <= best) {
-          best = dot(d, d);
-          c.partner[v] = w;
-        }
+    const std::uint32_t tv = c.boundary.triangle_of.at(v);
+    bool found = false, best_own_source = true;
+    double best = c.params.reach * c.params.reach;
+    for (const std::uint32_t j : near) {
+      const std::uint32_t w = c.boundary.vertices[j];
+      const std::uint32_t tw = c.boundary.triangle_of.at(w);
+      const Vec3d d = position(m, w) - position(m, v);
+      if (c.topo.piece(tw) == c.topo.piece(tv) || !c.topo.joinable(w) || dot(d, d) > c.params.reach * c.params.reach) {
+        continue;
       }
-      if (c.partner.contains(v)) break;
+      // Another source before another piece of v's own; then the nearer (the later on a tie).
+      const bool own_source = c.topo.own_pieces_apart() && c.merged().source_acq[tw] == c.merged().source_acq[tv];
+      if (!found || own_source < best_own_source || (own_source == best_own_source && dot(d, d) <= best)) {
+        found = true;
+        best_own_source = own_source;
+        best = dot(d, d);
+        c.partner[v] = w;
+      }
     }
   }
 }
@@ -253,7 +258,9 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   };
   // The unstitched boundary is measured before clipping changes it; the topology is built
   // again only when clipping changed the triangles.
-  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around, params.join_own_pieces);
+  // (Its pieces are found only when it is kept: the boundary's length does not need them.)
+  std::optional<mosaic_detail::MeshTopology> unclipped(std::in_place, merged, around,
+                                                       params.join_own_pieces && !(params.clip > 0));
   const double before = unclipped->boundary_length();
   phase_done("topology and boundary");
   mosaic_detail::ClipStats clipped;
