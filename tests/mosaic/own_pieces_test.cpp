@@ -7,6 +7,8 @@
 #include <algorithm>
 #include <queue>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "citymesh/mosaic/merged_mesh.h"
 #include "citymesh/mosaic/stitch.h"
@@ -99,6 +101,95 @@ TEST(Stitch, JoinsTwoPiecesOfOneSourceThatShareNoVertex) {
   const StitchStats off = stitch(apart, {.snap = 0.02, .reach = 0.2, .weld = 0.005});
   EXPECT_EQ(off.triangles_added, 0u);
   EXPECT_NEAR(off.open_boundary_after, before, 1e-9);
+}
+
+using TriangleRange = std::pair<std::int32_t, std::int32_t>;  ///< source triangles [first, second)
+
+/// The vertices of the triangles whose source triangle lies in `range`.
+std::set<std::uint32_t> vertices_of(const MergedMesh& m, TriangleRange range) {
+  std::set<std::uint32_t> out;
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_triangle[t] >= range.first && m.source_triangle[t] < range.second) {
+      out.insert(m.mesh.triangles[t].begin(), m.mesh.triangles[t].end());
+    }
+  }
+  return out;
+}
+
+/// Vertices used by triangles of both ranges.
+std::size_t shared_vertices(const MergedMesh& m, TriangleRange a, TriangleRange b) {
+  const std::set<std::uint32_t> of_a = vertices_of(m, a), of_b = vertices_of(m, b);
+  return static_cast<std::size_t>(
+      std::count_if(of_a.begin(), of_a.end(), [&](std::uint32_t v) { return of_b.contains(v); }));
+}
+
+/// Whether the triangles of ranges `a` and `b` are joined after stitching: they share a
+/// vertex, or a stitch triangle uses a vertex of each.
+bool joined(const MergedMesh& m, TriangleRange a, TriangleRange b) {
+  if (shared_vertices(m, a, b) > 0) return true;
+  const std::set<std::uint32_t> of_a = vertices_of(m, a), of_b = vertices_of(m, b);
+  for (std::size_t t = 0; t < m.mesh.triangle_count(); ++t) {
+    if (m.source_acq[t] != kNoSource) continue;
+    const Triangle& tri = m.mesh.triangles[t];
+    const auto uses = [&](const std::set<std::uint32_t>& of) {
+      return std::any_of(tri.begin(), tri.end(), [&](std::uint32_t v) { return of.contains(v); });
+    };
+    if (uses(of_a) && uses(of_b)) return true;
+  }
+  return false;
+}
+
+TEST(Stitch, ZipsATurnToAnotherSourceBeforeANearerTurnOfItsOwnPass) {
+  // Turn A (source 0, 1 m x 1 m); source C 10 cm beyond A's side x = 1 (source triangles
+  // 200..343); turn B (344..443) lying 4 cm over C, its side 5.7 cm from A's (4 cm beyond, 4
+  // cm up). The nearest is A's own pass's other turn, but a seam between passes comes first.
+  const StitchParams params{.snap = 0.01, .reach = 0.2, .weld = 0.005, .join_own_pieces = true};
+  const auto scene = [](std::int32_t b_source) {
+    MergedMesh m;
+    add_grid(m, 0, 0, 10, 10, 0.1f, 0);
+    add_grid(m, 1.1f, 0, 8, 9, 0.11f, 1);
+    add_grid(m, 1.04f, 0, 5, 10, 0.1f, b_source, 0.04f);
+    return m;
+  };
+  constexpr TriangleRange a{0, 200}, c{200, 344}, b{344, 444};
+  MergedMesh own = scene(0);
+  const StitchStats s = stitch(own, params);
+  EXPECT_GE(s.strips, 1u);
+  EXPECT_TRUE(joined(own, a, c));
+  EXPECT_FALSE(joined(own, a, b));
+  // Control: when B is a third source, the nearer one (B) is the partner.
+  MergedMesh other = scene(2);
+  stitch(other, params);
+  EXPECT_TRUE(joined(other, a, b));
+  EXPECT_FALSE(joined(other, a, c));
+}
+
+TEST(Stitch, SnapsATurnToAnotherSourceBeforeANearerTurnOfItsOwnPass) {
+  // Turn A (source 0, 1 m x 1 m); source C 1.9 cm beyond A's side x = 1 (source triangles
+  // 200..359); turn B (source triangles 360..419) over A's strip y in [0.2, 0.8], its side
+  // 1.5 cm from A's (1.2 cm in, 0.9 cm up). B is nearer, C within the snap tolerance too:
+  // the 11 vertices of A's side become C's. B's side is then 2.3 cm from them: left alone.
+  const StitchParams params{.snap = 0.02, .reach = 0.02, .weld = 0.001, .join_own_pieces = true};
+  const auto scene = [](std::int32_t b_source) {
+    MergedMesh m;
+    add_grid(m, 0, 0, 10, 10, 0.1f, 0);
+    add_grid(m, 1.019f, 0, 8, 10, 0.1f, 1);
+    add_grid(m, 0.488f, 0.2f, 5, 6, 0.1f, b_source, 0.009f);
+    return m;
+  };
+  constexpr TriangleRange a{0, 200}, c{200, 360}, b{360, 420};
+  MergedMesh own = scene(0);
+  const StitchStats s = stitch(own, params);
+  EXPECT_EQ(s.vertices_snapped, 11u);
+  EXPECT_EQ(shared_vertices(own, a, c), 11u);
+  EXPECT_EQ(shared_vertices(own, a, b), 0u);
+  // Control: when B is a third source, the nearer one (B) is preferred. It takes every other
+  // vertex of the 7 it faces (y = 0.2, 0.4, 0.6, 0.8: two neighbours merged would give A's and
+  // B's sides, running the same way, one directed edge, a fold); C takes the other 7.
+  MergedMesh other = scene(2);
+  stitch(other, params);
+  EXPECT_EQ(shared_vertices(other, a, b), 4u);
+  EXPECT_EQ(shared_vertices(other, a, c), 7u);
 }
 
 /// Area of the triangles whose source triangle lies in [first, last).
