@@ -81,16 +81,20 @@ void check_seam_pass(const Config& config) {
 
 /// Prints the stitching's line and returns its figures for the summary.
 nlohmann::json report_stitching(const StitchStats& s, const BlockStitchStats* blocks) {
+  // The centroid splits happen only when a pass's own turns are clipped: said only then.
+  const std::string split =
+      s.triangles_split > 0 ? fmt::format(" ({} split over an earlier turn's hole first)", s.triangles_split) : "";
   std::cout << fmt::format(
-      "stitching: {} triangles clipped and {} removed under other surfaces, {} strips and {} gaps closed with {} "
+      "stitching: {} triangles clipped{} and {} removed under other surfaces, {} strips and {} gaps closed with {} "
       "triangles, open boundary "
       "{:.1f} m -> {:.1f} m\n",
-      s.triangles_clipped, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added, s.open_boundary_before,
-      s.open_boundary_after);
+      s.triangles_clipped, split, s.triangles_uncovered, s.strips, s.gaps_filled, s.triangles_added,
+      s.open_boundary_before, s.open_boundary_after);
   nlohmann::json report{{"open_boundary_before_m", s.open_boundary_before},
                         {"open_boundary_after_m", s.open_boundary_after},
                         {"triangles_clipped", s.triangles_clipped},
                         {"triangles_uncovered", s.triangles_uncovered},
+                        {"triangles_split", s.triangles_split},
                         {"strips", s.strips},
                         {"gaps_filled", s.gaps_filled},
                         {"triangles_added", s.triangles_added},

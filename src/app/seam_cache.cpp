@@ -16,7 +16,8 @@ namespace citymesh::app {
 
 namespace {
 
-constexpr std::string_view kCacheMagic = "CMSTCH02";  // 02: new vertices named by their part's rank
+// 02: new vertices named by their part's rank; 03: ten counts (the centroid splits)
+constexpr std::string_view kCacheMagic = "CMSTCH03";
 constexpr std::string_view kCacheSuffix = ".part";
 
 /// Part keys as [level, x, y] rows.
@@ -43,7 +44,7 @@ nlohmann::json outcome_json(const PartOutcome& o) {
   const StitchStats& s = o.stats;
   return {{"counts",
            {s.vertices_snapped, s.edges_split, s.triangles_uncovered, s.triangles_clipped, s.strips, s.triangles_added,
-            s.vertices_welded, s.gaps_filled, s.rejected}},
+            s.vertices_welded, s.gaps_filled, s.rejected, s.triangles_split}},
           {"box", box_bits(o.box)},
           {"cut_triangles", o.cut_triangles},
           {"digest", o.digest},
@@ -54,11 +55,11 @@ nlohmann::json outcome_json(const PartOutcome& o) {
 PartOutcome outcome_from(const nlohmann::json& j) {
   PartOutcome o;
   const auto counts = j.at("counts").get<std::vector<std::uint64_t>>();
-  if (counts.size() != 9) throw ProcessingError("a seam part's outcome: counts missing");
+  if (counts.size() != 10) throw ProcessingError("a seam part's outcome: counts missing");
   StitchStats& s = o.stats;
   s.vertices_snapped = counts[0], s.edges_split = counts[1], s.triangles_uncovered = counts[2];
   s.triangles_clipped = counts[3], s.strips = counts[4], s.triangles_added = counts[5];
-  s.vertices_welded = counts[6], s.gaps_filled = counts[7], s.rejected = counts[8];
+  s.vertices_welded = counts[6], s.gaps_filled = counts[7], s.rejected = counts[8], s.triangles_split = counts[9];
   o.box = box_from_bits(j.at("box"));
   o.cut_triangles = j.at("cut_triangles").get<std::size_t>();
   o.digest = j.at("digest").get<std::uint64_t>();

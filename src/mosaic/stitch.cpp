@@ -281,6 +281,7 @@ StitchStats stitch(MergedMesh& merged, const StitchParams& params, const StitchS
   c.stats.open_boundary_before = before;
   c.stats.triangles_uncovered = clipped.triangles_removed;
   c.stats.triangles_clipped = clipped.triangles_cut;
+  c.stats.triangles_split = clipped.triangles_split;
   c.stats.vertices_snapped = snapped.vertices_merged;
   c.stats.edges_split = snapped.edges_split;
   c.stats.rejected = snapped.rejected;

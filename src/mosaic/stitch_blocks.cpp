@@ -155,6 +155,7 @@ void add_counts(StitchStats& total, const StitchStats& s) {
   total.edges_split += s.edges_split;
   total.triangles_uncovered += s.triangles_uncovered;
   total.triangles_clipped += s.triangles_clipped;
+  total.triangles_split += s.triangles_split;
   total.strips += s.strips;
   total.triangles_added += s.triangles_added;
   total.vertices_welded += s.vertices_welded;

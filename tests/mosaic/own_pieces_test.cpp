@@ -307,6 +307,7 @@ TEST(Clip, ALaterTurnsTriangleSpanningAnEarlierTurnsHoleKeepsThePartOverTheHole)
   m.source_acq.push_back(0);
   m.source_triangle.push_back(1000);  // later in the pass's file
   MergedMesh unsplit = m;
+  MergedMesh stitched = m;
   const mosaic_detail::ClipStats s = mosaic_detail::clip_overlaps(m, {.tolerance = 0.2, .own_tolerance = 0.1});
   EXPECT_EQ(s.triangles_split, 1u);
   EXPECT_NEAR(area_from(m, 0, 1000), 1.0 - 0.04, 1e-5);  // the earlier turn stays whole
@@ -324,6 +325,9 @@ TEST(Clip, ALaterTurnsTriangleSpanningAnEarlierTurnsHoleKeepsThePartOverTheHole)
   // Without a tolerance for its own, nothing is split or cut.
   const mosaic_detail::ClipStats off = mosaic_detail::clip_overlaps(unsplit, {.tolerance = 0.2});
   EXPECT_EQ(off.triangles_split + off.triangles_removed + off.triangles_cut, 0u);
+  // Stitching reports the split (the run's summary shows it).
+  const StitchStats st = stitch(stitched, {.clip = 0.2, .join_own_pieces = true, .own_clip = 0.1});
+  EXPECT_EQ(st.triangles_split, 1u);
 }
 
 }  // namespace

@@ -42,6 +42,9 @@ struct StitchStats {
   std::uint64_t edges_split = 0;       ///< boundary edges split at vertices of another source
   std::uint64_t triangles_uncovered = 0;  ///< covered whole by a larger source: removed
   std::uint64_t triangles_clipped = 0;    ///< covered in part: cut back to the uncovered part
+  /// A later turn's triangles spanning an earlier turn's hole, split about their centroid
+  /// before clipping (join_own_pieces with own_clip only)
+  std::uint64_t triangles_split = 0;
   std::uint64_t strips = 0, triangles_added = 0, vertices_welded = 0;
   std::uint64_t gaps_filled = 0;  ///< small holes between sources closed (their triangles count in triangles_added)
   /// Snaps and strip triangles refused (a flip, a degenerate triangle or a reused directed edge).
