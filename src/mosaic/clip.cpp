@@ -305,11 +305,10 @@ ClipStats replace_covered(MergedMesh& merged, const std::vector<std::uint8_t>& c
 /// Triangles whose three corners are covered, one of them by an earlier piece of its own
 /// source only, but whose centroid is not: that piece has a hole there (a later turn's
 /// triangle spanning what the earlier turn lacks, its corners over the earlier turn around
-/// the hole). Free triangles only, in index order.
+/// the hole). Free triangles only, in index order. `pieces`: source_pieces(merged).
 std::vector<std::uint32_t> open_in_the_middle(const MergedMesh& merged, const ClipParams& params,
-                                              const StitchSurroundings& around) {
+                                              const StitchSurroundings& around, std::span<const std::int32_t> pieces) {
   const Mesh& m = merged.mesh;
-  const std::vector<std::int32_t> pieces = source_pieces(merged);
   const VertexFrames frames = vertex_frames(merged, pieces);
   const Cover cover(merged, params, around.source_sizes, pieces);
   std::vector<Coverage> coverage(m.vertex_count(), Coverage::none);
@@ -343,8 +342,10 @@ std::vector<std::uint32_t> open_in_the_middle(const MergedMesh& merged, const Cl
 /// the other two appended, all keeping its provenance). Its edges stay as they are, so the
 /// mesh stays conforming; clipping then cuts the parts back along the spokes, and what stays
 /// is the part about the centroid, over the hole, rather than nothing (the hole opened) or
-/// the whole triangle (lying over the piece around the hole).
-void split_about_centroids(MergedMesh& merged, std::span<const std::uint32_t> triangles) {
+/// the whole triangle (lying over the piece around the hole). `pieces` (per triangle) gets
+/// the appended parts' pieces: their triangle's, as they use only its corners and centroid.
+void split_about_centroids(MergedMesh& merged, std::span<const std::uint32_t> triangles,
+                           std::vector<std::int32_t>& pieces) {
   Mesh& m = merged.mesh;
   for (const std::uint32_t t : triangles) {
     const Triangle tri = m.triangles[t];
@@ -355,6 +356,7 @@ void split_about_centroids(MergedMesh& merged, std::span<const std::uint32_t> tr
       m.triangle_ids.push_back(m.triangle_ids[t]);
       merged.source_acq.push_back(merged.source_acq[t]);
       merged.source_triangle.push_back(merged.source_triangle[t]);
+      pieces.push_back(pieces[t]);
     }
   }
 }
@@ -363,18 +365,18 @@ void split_about_centroids(MergedMesh& merged, std::span<const std::uint32_t> tr
 
 ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const StitchSurroundings& around) {
   Mesh& m = merged.mesh;
+  // Without a tolerance for its own, each source is one piece: never covered by itself.
+  std::vector<std::int32_t> own_pieces;
   std::uint64_t split = 0;
   if (params.own_tolerance > 0) {
-    const std::vector<std::uint32_t> open = open_in_the_middle(merged, params, around);
-    split_about_centroids(merged, open);
+    own_pieces = source_pieces(merged);
+    const std::vector<std::uint32_t> open = open_in_the_middle(merged, params, around, own_pieces);
+    split_about_centroids(merged, open, own_pieces);
     split = open.size();
   }
   std::vector<std::uint8_t> covered(m.vertex_count(), 0);
   std::vector<Cut> cuts;
   {
-    // Without a tolerance for its own, each source is one piece: never covered by itself.
-    const std::vector<std::int32_t> own_pieces =
-        params.own_tolerance > 0 ? source_pieces(merged) : std::vector<std::int32_t>{};
     const std::span<const std::int32_t> pieces =
         params.own_tolerance > 0 ? std::span(own_pieces) : std::span(merged.source_acq);
     const VertexFrames frames = vertex_frames(merged, pieces);
@@ -392,6 +394,7 @@ ClipStats clip_overlaps(MergedMesh& merged, const ClipParams& params, const Stit
     if (std::find(covered.begin(), covered.end(), 1) == covered.end()) return {.triangles_split = split};
     cuts = find_cuts(m, cover, frames, covered, params, roles);
   }  // the index and the normals go before the triangles are rebuilt (a city's peak memory)
+  std::vector<std::int32_t>().swap(own_pieces);
   const std::size_t before = m.vertex_count();
   const auto vertex_of = add_cut_vertices(m, cuts);
   covered.resize(m.vertex_count(), 0);  // the cuts are where the cover ends: uncovered
