@@ -3,6 +3,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/io/mesh_io.h"
@@ -57,10 +59,32 @@ LoadedAcquisitions load_acquisitions(const Config& config) {
 }
 
 nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k) {
-  return {{"index", k},
+  return {{"index", config.acquisitions[k].listed},
           {"name", config.acquisitions[k].name},
           {"date", format_iso8601(input.dates[k])},
           {"input", input.acquisitions[k].path.string()}};
+}
+
+std::vector<std::size_t> in_listed_order(const Config& config) {
+  std::vector<std::size_t> order(config.acquisitions.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return config.acquisitions[a].listed < config.acquisitions[b].listed;
+  });
+  return order;
+}
+
+std::vector<std::int32_t> as_listed(std::span<const std::int32_t> source_acq, std::span<const std::int32_t> listed) {
+  std::vector<std::int32_t> out(source_acq.size());
+  for (std::size_t t = 0; t < out.size(); ++t) {
+    const std::int32_t a = source_acq[t];
+    if (a >= 0 && static_cast<std::size_t>(a) >= listed.size()) {
+      throw ProcessingError(
+          fmt::format("outputs: source {} of triangle {} is not among the {} acquisitions", a, t, listed.size()));
+    }
+    out[t] = a < 0 ? a : listed[static_cast<std::size_t>(a)];
+  }
+  return out;
 }
 
 }  // namespace citymesh::app

@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include "citymesh/config/config.h"
@@ -12,7 +13,7 @@
 namespace citymesh::app {
 
 struct LoadedAcquisitions {
-  std::vector<Acquisition> acquisitions;  ///< config order
+  std::vector<Acquisition> acquisitions;  ///< processing order (Config::acquisitions)
   std::vector<Mesh> meshes;               ///< one per acquisition, all with the first one's origin
   std::vector<TimePoint> dates;
 };
@@ -27,8 +28,17 @@ std::vector<std::int32_t> source_faces(const Mesh& acquisition);
 /// given). Throws InputError naming the file.
 Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin);
 
-/// How the summaries describe acquisition k: index, name, date, input file.
+/// How the summaries describe acquisition k (processing order): index (its place in the
+/// config file), name, date, input file.
 nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k);
+
+/// The acquisitions (processing order indices) in the order the config file lists them: the
+/// order of the summaries' lists, whose positions are the outputs' source_acq.
+std::vector<std::size_t> in_listed_order(const Config& config);
+
+/// `source_acq` as the outputs write it: each acquisition by its place in the config file
+/// (`listed`, per acquisition in processing order; Config::listed_indices); kNoSource stays.
+std::vector<std::int32_t> as_listed(std::span<const std::int32_t> source_acq, std::span<const std::int32_t> listed);
 
 /// Reads every acquisition of `config` whole. Throws InputError naming the file, and
 /// ProcessingError when a file has no sensor positions.

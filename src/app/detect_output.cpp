@@ -31,8 +31,9 @@ Rgb8 detect_color(TriangleState state, bool kept, bool refutes) {
 
 namespace {
 
+/// Acquisition k's files, named by its place in the config file.
 std::string file_stem(const Config& config, std::size_t k) {
-  return fmt::format("{}_{}", k, config.acquisitions[k].name);
+  return fmt::format("{}_{}", config.acquisitions[k].listed, config.acquisitions[k].name);
 }
 
 nlohmann::json counts_json(const StateCounts& c) {
@@ -201,7 +202,8 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
   });
   StateCounts totals;
   std::uint64_t triangles = 0;
-  for (AcquisitionOutputs& w : written) {
+  for (const std::size_t k : in_listed_order(config)) {
+    AcquisitionOutputs& w = written[k];
     totals += w.counts;
     triangles += w.entry["triangles"].get<std::uint64_t>();
     summary["acquisitions"].push_back(std::move(w.entry));

@@ -17,7 +17,7 @@ namespace citymesh::app {
 inline constexpr const char* kStateProperty = "state";          ///< uchar: 0 consistent, 1 conflicting, 2 single
 inline constexpr const char* kKeptProperty = "kept";            ///< uchar: survives the time series
 inline constexpr const char* kSourceFaceProperty = "source_face";  ///< int: face index in the input file
-/// The consistent pairs (global triangle ids, config order), as uint32 a0 b0 a1 b1 ... with a < b.
+/// The consistent pairs (global triangle ids, acquisitions by time), as uint32 a0 b0 a1 b1 ... with a < b.
 inline constexpr const char* kPairsFile = "pairs.bin";
 inline constexpr std::string_view kPairsMagic = "CMPAIRS1";
 

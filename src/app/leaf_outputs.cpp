@@ -116,7 +116,8 @@ struct FaceRows {
   Provenance provenance;
 };
 
-FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf) {
+FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, std::size_t leaf,
+                   std::span<const std::int32_t> listed) {
   const KeyedPiece piece = leaves.load(leaf);
   const std::vector<Owner> owners = VertexNumbering::owners(leaves, leaf);
   // Each owning tile's ranks, from its notes (a few tiles: this one and its earlier neighbours).
@@ -128,7 +129,7 @@ FaceRows face_rows(const OutputLeaves& leaves, const VertexNumbering& numbers, s
   for (std::size_t v = 0; v < number.size(); ++v) {
     number[v] = static_cast<std::uint32_t>(numbers.first[owners[v].leaf] + rank.at(owners[v].leaf)[owners[v].index]);
   }
-  FaceRows rows{{}, Provenance(piece)};
+  FaceRows rows{{}, Provenance(piece, listed)};
   for (const Triangle& tri : piece.triangles) rows.triangles.push_back({number[tri[0]], number[tri[1]], number[tri[2]]});
   return rows;
 }
@@ -150,7 +151,8 @@ MeshVertexRows piece_rows(const KeyedPiece& piece, std::string_view owned) {
   return rows;
 }
 
-Provenance::Provenance(const KeyedPiece& piece) : acq(piece.source_acq) {
+Provenance::Provenance(const KeyedPiece& piece, std::span<const std::int32_t> listed)
+    : acq(as_listed(piece.source_acq, listed)) {
   face.reserve(acq.size());
   for (std::size_t t = 0; t < acq.size(); ++t) {
     face.push_back(acq[t] == kNoSource ? kNoSource : static_cast<std::int32_t>(piece.ids[t].face));
@@ -161,7 +163,8 @@ std::vector<PlyColumn> Provenance::columns() const {
   return {{kSourceAcqProperty, std::span<const std::int32_t>(acq)}, {kSourceFaceProperty, std::span<const std::int32_t>(face)}};
 }
 
-void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& leaves) {
+void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& leaves,
+                      std::span<const std::int32_t> listed) {
   const std::vector<OutputLeaf>& all = leaves.leaves();
   const VertexNumbering numbers(leaves);
   if (numbers.vertices > UINT32_MAX) {
@@ -184,7 +187,7 @@ void write_leaves_ply(const std::filesystem::path& path, const OutputLeaves& lea
     const std::size_t count = std::min(kLeavesInFlight, all.size() - begin);
     std::vector<FaceRows> rows(count);
     parallel_for_blocks(count, 1, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) rows[i] = face_rows(leaves, numbers, begin + i);
+      for (std::size_t i = b; i < e; ++i) rows[i] = face_rows(leaves, numbers, begin + i, listed);
     });
     for (const FaceRows& r : rows) {
       out.add_faces({{}, r.triangles, {}, r.provenance.columns(), {}});

@@ -34,7 +34,7 @@ class MosaicCommand final : public Command {
     Stopwatch clock;
     remove_leftovers_of_ended_runs(config);
     const LoadedAcquisitions input = load_acquisitions(config);
-    const ChangeResult change = read_detect_result(config.project.output / "detect", input);
+    const ChangeResult change = read_detect_result(config.project.output / "detect", config, input);
     run_mosaic_step(config, input, change, options_.pictures(), {{"read", clock.seconds()}});
   }
 

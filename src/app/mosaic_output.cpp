@@ -29,10 +29,12 @@ Rgb8 source_color(std::int32_t acquisition) {
 
 namespace {
 
-void write_picture(const std::filesystem::path& path, const MergedMesh& merged, double pixel_size) {
-  RenderLayer layer{&merged.mesh, {}};
-  layer.face_colors.reserve(merged.source_acq.size());
-  for (const std::int32_t a : merged.source_acq) layer.face_colors.push_back(source_color(a));
+/// `source_acq`: as the outputs name the sources (as_listed), which the colours follow.
+void write_picture(const std::filesystem::path& path, const Mesh& mesh, std::span<const std::int32_t> source_acq,
+                   double pixel_size) {
+  RenderLayer layer{&mesh, {}};
+  layer.face_colors.reserve(source_acq.size());
+  for (const std::int32_t a : source_acq) layer.face_colors.push_back(source_color(a));
   ViewParams view;
   view.pixel_size = pixel_size;
   write_png(path, render_orthographic(std::span<const RenderLayer>(&layer, 1), view));
@@ -86,7 +88,7 @@ void write_summary(const Config& config, const LoadedAcquisitions& input, const 
                         {"crease", config.mosaic.crease_weight}};
   summary["crease_angle"] = config.mosaic.crease_angle;
   summary["seen_through_quality"] = config.mosaic.seen_through_quality;
-  for (std::size_t k = 0; k < input.acquisitions.size(); ++k) {
+  for (const std::size_t k : in_listed_order(config)) {
     nlohmann::json entry = acquisition_json(config, input, k);
     entry["triangles_kept"] = k < counts.per_source.size() ? counts.per_source[k] : 0;
     summary["acquisitions"].push_back(std::move(entry));
@@ -120,7 +122,8 @@ void write_summary(const Config& config, const LoadedAcquisitions& input, const 
 }
 
 /// The picture of the output's tiles, drawn one at a time.
-void write_leaves_picture(const std::filesystem::path& path, const OutputLeaves& leaves, double pixel_size) {
+void write_leaves_picture(const std::filesystem::path& path, const OutputLeaves& leaves,
+                          std::span<const std::int32_t> listed, double pixel_size) {
   const Box3d box = leaves.box();
   const Vec3d origin = box.empty() ? Vec3d{} : whole_metre_origin(box.min);
   ViewParams view;
@@ -133,7 +136,7 @@ void write_leaves_picture(const std::filesystem::path& path, const OutputLeaves&
     for (const Vec3d& p : piece.positions) m.positions.push_back(to_local(p, m.origin));
     m.triangles = piece.triangles;
     RenderLayer layer{&m, {}};
-    for (const std::int32_t a : piece.source_acq) layer.face_colors.push_back(source_color(a));
+    for (const std::int32_t a : as_listed(piece.source_acq, listed)) layer.face_colors.push_back(source_color(a));
     canvas.draw(layer);
   }
   write_png(path, canvas.take());
@@ -145,18 +148,20 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                           const MosaicStats& stats, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
   const std::vector<std::int32_t> faces = source_faces(merged);
+  const std::vector<std::int32_t> sources = as_listed(merged.source_acq, config.listed_indices());
   write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
-                 {{kSourceAcqProperty, std::span<const std::int32_t>(merged.source_acq)},
+                 {{kSourceAcqProperty, std::span<const std::int32_t>(sources)},
                   {"source_face", std::span<const std::int32_t>(faces)}});
-  if (params.pictures) write_picture(params.dir / "mosaic.png", merged, params.pixel_size);
+  if (params.pictures) write_picture(params.dir / "mosaic.png", merged.mesh, sources, params.pixel_size);
   write_summary(config, input, counts_of(merged, input.acquisitions.size()), stats, params);
 }
 
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const OutputLeaves& leaves,
                           const MosaicStats& stats, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
-  write_leaves_ply(params.dir / kMosaicFile, leaves);
-  if (params.pictures) write_leaves_picture(params.dir / "mosaic.png", leaves, params.pixel_size);
+  const std::vector<std::int32_t> listed = config.listed_indices();
+  write_leaves_ply(params.dir / kMosaicFile, leaves, listed);
+  if (params.pictures) write_leaves_picture(params.dir / "mosaic.png", leaves, listed, params.pixel_size);
   OutputCounts counts{leaves.per_source(), leaves.stitched(), 0};
   counts.per_source.resize(input.acquisitions.size(), 0);
   for (const OutputLeaf& leaf : leaves.leaves()) counts.triangles += leaf.triangles;

@@ -197,7 +197,8 @@ void run_mosaic_step(const Config& config, const LoadedAcquisitions& input, cons
   write_tileset_outputs(config, merged);
 }
 
-ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAcquisitions& input) {
+ChangeResult read_detect_result(const std::filesystem::path& dir, const Config& config,
+                                const LoadedAcquisitions& input) {
   const nlohmann::json summary = read_json(dir / "summary.json", "run citymesh detect first");
   ChangeResult r;
   r.index.offsets.assign(1, 0);
@@ -210,7 +211,13 @@ ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAc
     }
     for (std::size_t k = 0; k < input.meshes.size(); ++k) {
       if (input.acquisitions[k].withdrawn) continue;  // an empty mesh: no labels written
-      const std::filesystem::path ply = dir / acquisitions[k].at("ply").get<std::string>();
+      const auto& entry = acquisitions.at(config.acquisitions[k].listed);
+      if (entry.at("input").get<std::string>() != input.acquisitions[k].path.string()) {
+        throw InputError(fmt::format("{}: acquisition {} is {}, the config lists {} there (run citymesh detect again)",
+                                     (dir / "summary.json").string(), config.acquisitions[k].listed,
+                                     entry.at("input").get<std::string>(), input.acquisitions[k].path.string()));
+      }
+      const std::filesystem::path ply = dir / entry.at("ply").get<std::string>();
       const FaceTable t = read_face_table(ply, {kKeptProperty});
       if (t.triangles.size() != input.meshes[k].triangle_count()) {
         throw InputError(fmt::format("{}: {} triangles, {} has {} (run citymesh detect again)", ply.string(),

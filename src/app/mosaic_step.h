@@ -58,7 +58,9 @@ nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPa
 
 /// What the mosaic needs of a finished `citymesh detect`: the kept flags (from the labelled
 /// PLYs) and the consistent pairs (pairs.bin). Throws InputError naming the file when the
-/// detect output is missing, unfinished or does not match the acquisitions.
-ChangeResult read_detect_result(const std::filesystem::path& dir, const LoadedAcquisitions& input);
+/// detect output is missing, unfinished or does not match the acquisitions. Its summary lists
+/// them as the config file does (`config`'s listed indices).
+ChangeResult read_detect_result(const std::filesystem::path& dir, const Config& config,
+                                const LoadedAcquisitions& input);
 
 }  // namespace citymesh::app

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <vector>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
@@ -70,6 +71,33 @@ std::size_t acquisition_count(const std::map<std::string, std::string>& keys) {
   return count;
 }
 
+/// Each acquisition of `keys` as "path|time|name", in their order.
+std::vector<std::string> passes_of(const std::map<std::string, std::string>& keys) {
+  std::vector<std::string> out(acquisition_count(keys));
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const std::string a = fmt::format("acquisition[{}]", k);
+    const auto value = [&](const char* key) {
+      const auto it = keys.find(a + key);
+      return it == keys.end() ? std::string() : it->second;
+    };
+    out[k] = value(".path") + "|" + value(".time") + "|" + value(".name");
+  }
+  return out;
+}
+
+/// Whether `now` holds every pass `before` did, with more besides, some of them older than
+/// passes already processed (a pass delivered late). Acquisitions are numbered by time, so
+/// the passes after an older one added are renumbered: input too, as an appended pass is
+/// (the tiles whose passes changed numbers are redone). False for passes appended after all
+/// the others: the keys tell those apart one by one.
+bool passes_inserted(const std::map<std::string, std::string>& before, const std::map<std::string, std::string>& now) {
+  std::vector<std::string> had = passes_of(before), has = passes_of(now);
+  if (has.size() <= had.size() || std::equal(had.begin(), had.end(), has.begin())) return false;
+  std::sort(had.begin(), had.end());
+  std::sort(has.begin(), has.end());
+  return std::includes(has.begin(), has.end(), had.begin(), had.end());
+}
+
 std::string trim(std::string s) {
   const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
   return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
@@ -100,7 +128,9 @@ bool named_before_relative_paths(const std::string& before, const std::string& n
 
 std::map<std::string, std::string> result_keys(const Config& config) {
   std::map<std::string, std::string> keys;
-  std::istringstream in(effective_config_toml(config));
+  // Numbered as every step numbers the acquisitions (by time), so that listing them in
+  // another order resumes the work: the results do not depend on it.
+  std::istringstream in(effective_config_toml(config, TableOrder::processing));
   std::string line, section;
   int acquisition = -1;
   while (std::getline(in, line)) {
@@ -184,7 +214,15 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     }
     std::vector<std::string> changed;
     const std::size_t recorded = acquisition_count(before);
+    const bool added = passes_inserted(before, keys);
+    if (added) {
+      log::info(
+          "{} pass(es) added since the last run, before passes already processed by time: the tiles they "
+          "reach are redone, and those of the later passes (renumbered)",
+          acquisition_count(keys) - recorded);
+    }
     for (const auto& [k, v] : keys) {
+      if (added && acquisition_of_key(k)) continue;
       const auto it = before.find(k);
       // An acquisition appended (a new pass over part of the city) is input, not a config
       // change: the tiles it reaches are processed, the others reused.
@@ -221,6 +259,7 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     for (const auto& [k, v] : before) {
       if (keys.contains(k)) continue;
       const std::optional<std::size_t> a = acquisition_of_key(k);
+      if (added && a) continue;
       if (a && *a < listed && k.ends_with(".withdrawn")) {
         log::info("{} is no longer withdrawn: the tiles it reaches are redone", acquisition_named(keys, k));
         continue;

@@ -118,13 +118,14 @@ nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   std::map<TileKey, std::vector<std::uint32_t>> tiles;
   for (std::size_t t = 0; t < keys.size(); ++t) tiles[keys[t]].push_back(static_cast<std::uint32_t>(t));
   const std::vector<std::int32_t> faces = source_faces(merged);
+  const std::vector<std::int32_t> sources = as_listed(merged.source_acq, config.listed_indices());
   const std::filesystem::path dir = config.project.output / "ply";
   const std::filesystem::path staged = staging_directory(dir);
   std::filesystem::remove_all(staged);
   for (const auto& [key, triangles] : tiles) {
     std::vector<std::int32_t> acq, face;
     for (const std::uint32_t t : triangles) {
-      acq.push_back(merged.source_acq[t]);
+      acq.push_back(sources[t]);
       face.push_back(faces[t]);
     }
     write_mesh_ply(staged / (key.name() + ".ply"), sub_mesh(merged.mesh, triangles),
@@ -146,7 +147,7 @@ nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves)
   for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
     const KeyedPiece piece = leaves.load(l);
     const MeshVertexRows rows = piece_rows(piece);
-    const Provenance provenance(piece);
+    const Provenance provenance(piece, config.listed_indices());
     write_ply(staged / (leaves.leaves()[l].key.name() + ".ply"),
               {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
   }

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <span>
 #include <sstream>
 
 #include "citymesh/core/error.h"
@@ -80,7 +81,9 @@ class Parser {
     // Like the acquisitions' paths: relative to the config file's folder, not to the caller's.
     config_.project.output = (config_.base_dir / config_.project.output).lexically_normal();
     config_.project.work = (config_.base_dir / config_.project.work).lexically_normal();
-    validate();
+    validate();  // its messages name the acquisitions by their place in the file
+    std::stable_sort(config_.acquisitions.begin(), config_.acquisitions.end(),
+                     [](const AcquisitionEntry& a, const AcquisitionEntry& b) { return a.time < b.time; });
     return std::move(config_);
   }
 
@@ -150,6 +153,7 @@ class Parser {
       const std::string label = fmt::format("acquisition[{}]", i);
       if (t == nullptr) context((*list)[i], label).fail("expected an [[acquisition]] table");
       config_.acquisitions.push_back(read_acquisition(*t, label));
+      config_.acquisitions.back().listed = static_cast<std::uint32_t>(i);
     }
   }
 
@@ -251,7 +255,18 @@ class Parser {
   std::vector<std::string> seen_;
 };
 
-std::string render(const Config& c, bool defaults) {
+/// `acquisitions` in the order `order` names.
+std::vector<const AcquisitionEntry*> tables_in(std::span<const AcquisitionEntry> acquisitions, TableOrder order) {
+  std::vector<const AcquisitionEntry*> out;
+  for (const AcquisitionEntry& a : acquisitions) out.push_back(&a);
+  if (order == TableOrder::listed) {
+    std::sort(out.begin(), out.end(),
+              [](const AcquisitionEntry* a, const AcquisitionEntry* b) { return a->listed < b->listed; });
+  }
+  return out;
+}
+
+std::string render(const Config& c, bool defaults, TableOrder order) {
   std::string out;
   if (defaults) {
     out += "# citymesh configuration: every key with its default value and meaning.\n"
@@ -274,17 +289,19 @@ std::string render(const Config& c, bool defaults) {
     }
   }
   if (defaults) {
-    out += "\n# One [[acquisition]] table per pass; its position in the file is its index.\n"
-           "# [[acquisition]]\n"
-           "# path = \"acq_0.ply\"              # (required) PLY mesh with per-vertex sensor position\n"
-           "# time = \"2026-01-05T10:00:00Z\"   # (required) ISO 8601 date-time with zone, or a date\n"
-           "# name = \"january\"                # label in reports (default: the file name)\n"
-           "# withdrawn = true                # a faulty pass: read as empty, no later pass renumbered\n";
+    out +=
+        "\n# One [[acquisition]] table per pass; its position in the file is its index in the outputs.\n"
+        "# Passes are processed by time, whatever order they are listed in.\n"
+        "# [[acquisition]]\n"
+        "# path = \"acq_0.ply\"              # (required) PLY mesh with per-vertex sensor position\n"
+        "# time = \"2026-01-05T10:00:00Z\"   # (required) ISO 8601 date-time with zone, or a date\n"
+        "# name = \"january\"                # label in reports (default: the file name)\n"
+        "# withdrawn = true                # a faulty pass: read as empty, no later pass renumbered\n";
   }
-  for (const AcquisitionEntry& a : c.acquisitions) {
-    out += fmt::format("\n[[acquisition]]\npath = {}\ntime = {}\nname = {}\n", toml_string(a.path.string()),
-                       toml_string(format_iso8601(a.time)), toml_string(a.name));
-    if (a.withdrawn) out += "withdrawn = true\n";
+  for (const AcquisitionEntry* a : tables_in(c.acquisitions, order)) {
+    out += fmt::format("\n[[acquisition]]\npath = {}\ntime = {}\nname = {}\n", toml_string(a->path.string()),
+                       toml_string(format_iso8601(a->time)), toml_string(a->name));
+    if (a->withdrawn) out += "withdrawn = true\n";
   }
   return out;
 }
@@ -302,6 +319,12 @@ std::vector<Acquisition> Config::acquisition_list() const {
         {static_cast<std::uint32_t>(i), acquisitions[i].time, acquisitions[i].path, acquisitions[i].withdrawn});
   }
   return list;
+}
+
+std::vector<std::int32_t> Config::listed_indices() const {
+  std::vector<std::int32_t> out;
+  for (const AcquisitionEntry& a : acquisitions) out.push_back(static_cast<std::int32_t>(a.listed));
+  return out;
 }
 
 PlyReadParams Config::ply_read_params() const {
@@ -324,8 +347,8 @@ Config load_config(const std::filesystem::path& file, const ConfigLoadParams& pa
   return parse_config(text.str(), file, params);
 }
 
-std::string dump_default_config() { return render(Config{}, true); }
+std::string dump_default_config() { return render(Config{}, true, TableOrder::listed); }
 
-std::string effective_config_toml(const Config& config) { return render(config, false); }
+std::string effective_config_toml(const Config& config, TableOrder order) { return render(config, false, order); }
 
 }  // namespace citymesh

@@ -148,6 +148,7 @@ struct DetectFixture {
     for (std::uint32_t k = 0; k < 3; ++k) {
       const TimePoint date(Duration(std::int64_t{86400000} * (k + 1)));
       config.acquisitions.push_back({fmt::format("/data/acq_{}.ply", k), date, fmt::format("epoch {}", k)});
+      config.acquisitions.back().listed = k;
       input.acquisitions.push_back({k, date, config.acquisitions.back().path});
       input.dates.push_back(date);
       input.meshes.push_back(random_mesh(20 + k, 300 + 100 * k));

@@ -72,6 +72,49 @@ TEST(RunState, TheLastAcquisitionsAppendedOrWithdrawnResumeAndOneChangedRemovedO
   EXPECT_NO_THROW(check_run_config(work.path(), keys_of(2), true));
 }
 
+/// `keys` with a pass of `time` inserted at place `at` (numbered by time), the later ones moved
+/// up one.
+Keys with_inserted(const Keys& keys, std::size_t passes, std::size_t at, const std::string& time) {
+  Keys out;
+  for (const auto& [k, v] : keys) {
+    if (!k.starts_with("acquisition[")) out[k] = v;
+  }
+  for (std::size_t k = 0; k <= passes; ++k) {
+    const std::string to = "acquisition[" + std::to_string(k) + "]";
+    if (k == at) {
+      out[to + ".path"] = "/data/late.ply";
+      out[to + ".file"] = "999 bytes, modified 42";
+      out[to + ".time"] = time;
+      continue;
+    }
+    const std::string from = "acquisition[" + std::to_string(k < at ? k : k - 1) + "]";
+    for (const char* key : {".path", ".file", ".time"}) out[to + key] = keys.at(from + key);
+  }
+  return out;
+}
+
+TEST(RunState, APassDeliveredLateResumesThoughTheLaterPassesAreRenumbered) {
+  test::TempDir work;
+  check_run_config(work.path(), keys_of(3), false);
+  // An older pass delivered after the others: processed by time, second.
+  const Keys late = with_inserted(keys_of(3), 3, 1, "2026-01-15T10:00:00Z");
+  EXPECT_NO_THROW(check_run_config(work.path(), late, false));
+  // The same with a setting changed too: refused, for the setting alone.
+  Keys changed = with_inserted(late, 4, 4, "2026-09-01T10:00:00Z");
+  changed["change.distance_threshold"] = "0.2";
+  try {
+    check_run_config(work.path(), changed, false);
+    ADD_FAILURE() << "a setting changed beside a pass delivered late";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("change.distance_threshold"), std::string::npos) << e.what();
+    EXPECT_EQ(std::string(e.what()).find("acquisition["), std::string::npos) << e.what();
+  }
+  // A pass inserted while another one's date changed: not only passes added, refused.
+  Keys redated = with_inserted(late, 4, 0, "2025-12-01T10:00:00Z");
+  redated["acquisition[4].time"] = "2026-04-02T10:00:00Z";
+  EXPECT_THROW(check_run_config(work.path(), redated, false), ConfigError);
+}
+
 TEST(RunState, APassWithdrawnInPlaceOrPutBackResumesAndChangesOnlyItsOwnFingerprint) {
   test::TempDir work;
   check_run_config(work.path(), keys_of(3), false);

@@ -271,7 +271,10 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   const OutputLeaves leaves(dir / "tiles", TileGrid({.tile_size = 1.0, .halo = 0.1, .origin = {0.3, 0.3}}), parts,
                             files);
   EXPECT_GT(leaves.leaves().size(), 12u);
-  write_leaves_ply(dir / "mosaic.ply", leaves);
+  // The config lists the four sources in another order than the one they are processed in:
+  // the PLY names each by its place in the file.
+  const std::vector<std::int32_t> listed{2, 0, 3, 1};
+  write_leaves_ply(dir / "mosaic.ply", leaves, listed);
 
   const FaceTable written = read_face_table(dir / "mosaic.ply", {"source_acq", "source_face"});
   EXPECT_EQ(written.positions.size(), gathered.mesh.vertex_count()) << "each vertex once";
@@ -279,7 +282,9 @@ TEST(SeamParts, TheOutputWrittenTileByTileIsTheGatheredOutputWithEachVertexOnce)
   std::multiset<std::array<double, 10>> expected;
   for (std::size_t p = 0; p < parts.size(); ++p) {
     const auto piece = files.load(p, true);
-    const std::vector<double> sources(piece->source_acq.begin(), piece->source_acq.end());
+    std::vector<double> sources;
+    for (const std::int32_t a : piece->source_acq)
+      sources.push_back(a < 0 ? a : listed.at(static_cast<std::size_t>(a)));
     expected.merge(geometry(piece->positions, piece->triangles, sources));
   }
   EXPECT_EQ(geometry(written.positions, written.triangles, written.extras[0]), expected);

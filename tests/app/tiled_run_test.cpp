@@ -13,6 +13,7 @@
 
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
+#include "face_table.h"
 #include "mesh_parts.h"
 #include "mosaic_ply.h"
 #include "test_support.h"
@@ -453,6 +454,93 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   const auto five_fresh = run("five.toml", "g");
   ASSERT_EQ(five_fresh.exit_code, 0) << five_fresh.err;
   expect_same_outputs(dir / "sim/u", dir / "sim/g", "withdrawing differs from a fresh run");
+}
+
+/// The simulator's config with epoch 2's table moved to the end (a pass delivered late), and
+/// with it left out (the passes before it was delivered). False when the config is not the
+/// simulator's six passes.
+bool write_late_configs(const std::filesystem::path& sim) {
+  const std::string config = test::read_text(sim / "config.toml");
+  const std::size_t path = config.find("path = \"acq_2.ply\"");
+  if (path == std::string::npos) return false;
+  const std::size_t begin = config.rfind("[[acquisition]]", path), end = config.find("[[acquisition]]", path);
+  if (begin == std::string::npos || end == std::string::npos) return false;
+  const std::string rest = config.substr(0, begin) + config.substr(end);
+  test::write_text(sim / "late.toml", rest + "\n" + config.substr(begin, end - begin));
+  test::write_text(sim / "five.toml", rest);
+  return true;
+}
+
+/// The mosaic PLY's rows: positions, then per triangle its corners, source_acq and source_face.
+struct MosaicRows {
+  std::vector<Vec3d> positions;
+  std::vector<Triangle> triangles;
+  std::vector<double> source_acq, source_face;
+};
+
+MosaicRows mosaic_rows(const std::filesystem::path& ply) {
+  app::FaceTable t = app::read_face_table(ply, {"source_acq", "source_face"});
+  return {std::move(t.positions), std::move(t.triangles), std::move(t.extras[0]), std::move(t.extras[1])};
+}
+
+TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceInTheFile) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  ASSERT_TRUE(write_late_configs(dir / "sim"));
+  const auto run = [&](const std::string& file, const std::string& name) {
+    return test::run_citymesh(run_file_args(sim, file, name, "--set tiling.tile_size=10"));
+  };
+  const auto in_order = run("config.toml", "d");
+  ASSERT_EQ(in_order.exit_code, 0) << in_order.err;
+  const auto late = run("late.toml", "l");
+  ASSERT_EQ(late.exit_code, 0) << late.err;
+
+  // Listed at place 5, epoch 2 is processed third as before: the same map to the byte, each
+  // pass named by its place in the file (epochs 3 to 5 move up one).
+  const std::vector<int> listed_at{0, 1, 5, 2, 3, 4};  // per epoch
+  const MosaicRows d = mosaic_rows(dir / "sim/d/mosaic/mosaic.ply"), l = mosaic_rows(dir / "sim/l/mosaic/mosaic.ply");
+  ASSERT_GT(d.triangles.size(), 1000u);
+  EXPECT_TRUE(d.positions == l.positions);
+  EXPECT_TRUE(d.triangles == l.triangles);
+  EXPECT_TRUE(d.source_face == l.source_face);
+  ASSERT_EQ(d.source_acq.size(), l.source_acq.size());
+  std::set<int> epochs;
+  for (std::size_t t = 0; t < d.source_acq.size(); ++t) {
+    const int epoch = static_cast<int>(d.source_acq[t]);
+    ASSERT_EQ(static_cast<int>(l.source_acq[t]), epoch < 0 ? epoch : listed_at.at(static_cast<std::size_t>(epoch)))
+        << "triangle " << t;
+    epochs.insert(epoch);
+  }
+  EXPECT_TRUE(epochs.contains(2) && epochs.contains(5)) << "the moved pass and one renumbered are in the map";
+  // The other results have the same bytes; the labelled PLYs are named by place in the file.
+  std::map<std::string, std::string> expected;
+  for (auto& [name, bytes] : test::result_bytes(dir / "sim/d")) {
+    if (name == "mosaic/mosaic.ply") continue;
+    std::string renamed = name;
+    if (name.starts_with("detect/") && name.ends_with(".ply")) {
+      const int epoch = std::stoi(name.substr(7));
+      renamed = fmt::format("detect/{}{}", listed_at.at(static_cast<std::size_t>(epoch)), name.substr(name.find('_')));
+    }
+    expected[renamed] = std::move(bytes);
+  }
+  std::map<std::string, std::string> got = test::result_bytes(dir / "sim/l");
+  got.erase("mosaic/mosaic.ply");
+  EXPECT_TRUE(got == expected);
+  EXPECT_TRUE(got.contains("detect/5_epoch 2.ply"));
+  const nlohmann::json summary = read_json(dir / "sim/l/mosaic/summary.json");
+  EXPECT_EQ(summary["acquisitions"][5]["name"], "epoch 2");
+  EXPECT_EQ(summary["acquisitions"][5]["index"], 5);
+
+  // Delivered late into a run of the five others, the pass is processed among them by date:
+  // the run resumes (no config change) to the bytes of a fresh run.
+  ASSERT_EQ(run("five.toml", "i").exit_code, 0);
+  const auto inserted = run("late.toml", "i");
+  ASSERT_EQ(inserted.exit_code, 0) << inserted.err;
+  EXPECT_NE(inserted.err.find("1 pass(es) added since the last run, before passes already processed"),
+            std::string::npos)
+      << inserted.err;
+  expect_same_outputs(dir / "sim/i", dir / "sim/l", "a pass delivered late differs from a fresh run");
 }
 
 /// `files` without the change step's labelled outputs (detect/...).

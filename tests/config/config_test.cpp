@@ -40,14 +40,19 @@ class ConfigTest : public ::testing::Test {
 TEST_F(ConfigTest, MinimalFileGetsDefaultsAndResolvesPaths) {
   const Config c = parse(kMinimal);
   ASSERT_EQ(c.acquisitions.size(), 2u);
-  EXPECT_EQ(c.acquisitions[0].path, dir_ / "b.ply");
-  EXPECT_EQ(c.acquisitions[0].name, "b");
-  EXPECT_EQ(c.acquisitions[1].path, dir_ / "sub" / "a.ply");
-  EXPECT_EQ(c.acquisitions[1].name, "january");
-  EXPECT_EQ(c.acquisitions[0].time, parse_iso8601("2026-03-01T08:00:00Z", "t"));
-  EXPECT_EQ(c.acquisitions[1].time, parse_iso8601("2026-01-05T10:00:00Z", "t"));
+  // In processing order, by time: the file lists b (March) before a (January).
+  EXPECT_EQ(c.acquisitions[0].path, dir_ / "sub" / "a.ply");
+  EXPECT_EQ(c.acquisitions[0].name, "january");
+  EXPECT_EQ(c.acquisitions[0].listed, 1u);
+  EXPECT_EQ(c.acquisitions[1].path, dir_ / "b.ply");
+  EXPECT_EQ(c.acquisitions[1].name, "b");
+  EXPECT_EQ(c.acquisitions[1].listed, 0u);
+  EXPECT_EQ(c.acquisitions[0].time, parse_iso8601("2026-01-05T10:00:00Z", "t"));
+  EXPECT_EQ(c.acquisitions[1].time, parse_iso8601("2026-03-01T08:00:00Z", "t"));
   const auto list = c.acquisition_list();
-  EXPECT_EQ(list[1].index, 1u);  // config order, not date order
+  EXPECT_EQ(list[1].index, 1u);
+  EXPECT_EQ(list[1].path, dir_ / "b.ply");
+  EXPECT_EQ(c.listed_indices(), (std::vector<std::int32_t>{1, 0}));
   const Config defaults;
   EXPECT_EQ(c.change.distance_threshold, defaults.change.distance_threshold);
   EXPECT_EQ(c.change.sustainability, std::chrono::days(30));
@@ -142,19 +147,47 @@ TEST_F(ConfigTest, EffectiveConfigIsItselfAValidConfig) {
             effective_config_toml(c).substr(effective_config_toml(c).find('\n')));
 }
 
+TEST_F(ConfigTest, AcquisitionsAreProcessedByTimeTiesInListingOrderAndPrintedAsListed) {
+  test::write_text(dir_ / "c.ply", "");
+  test::write_text(dir_ / "d.ply", "");
+  const Config c = parse(std::string(kMinimal) + R"(
+[[acquisition]]
+path = "c.ply"
+time = 2026-02-01T00:00:00Z
+
+[[acquisition]]
+path = "d.ply"
+time = "2026-03-01T08:00:00Z"
+)");  // d has b's time: neither is newer, and b, listed first, comes first
+  std::vector<std::string> names;
+  for (const AcquisitionEntry& a : c.acquisitions) names.push_back(a.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"january", "c", "b", "d"}));
+  EXPECT_EQ(c.listed_indices(), (std::vector<std::int32_t>{1, 2, 0, 3}));
+  const auto at = [](const std::string& text, const char* file) { return text.find(file); };
+  const std::string listed = effective_config_toml(c), processing = effective_config_toml(c, TableOrder::processing);
+  EXPECT_LT(at(listed, "b.ply"), at(listed, "a.ply"));
+  EXPECT_LT(at(listed, "a.ply"), at(listed, "c.ply"));
+  EXPECT_LT(at(listed, "c.ply"), at(listed, "d.ply"));
+  EXPECT_LT(at(processing, "a.ply"), at(processing, "c.ply"));
+  EXPECT_LT(at(processing, "c.ply"), at(processing, "b.ply"));
+  EXPECT_LT(at(processing, "b.ply"), at(processing, "d.ply"));
+  // Printed as listed, the config reads back to the same places.
+  EXPECT_EQ(parse(listed).listed_indices(), c.listed_indices());
+}
+
 TEST_F(ConfigTest, AWithdrawnAcquisitionKeepsItsPlaceAndNeedsNoFile) {
   std::filesystem::remove(dir_ / "b.ply");
   const std::string withdrawn = std::string(kMinimal).replace(std::string(kMinimal).find("time = \"2026-03"), 0,
                                                               "withdrawn = true\n");
   const Config c = parse(withdrawn);  // b.ply is gone: it is not read
   ASSERT_EQ(c.acquisitions.size(), 2u);
-  EXPECT_TRUE(c.acquisitions[0].withdrawn);
-  EXPECT_FALSE(c.acquisitions[1].withdrawn);
-  EXPECT_TRUE(c.acquisition_list()[0].withdrawn);
-  EXPECT_EQ(c.acquisition_list()[1].index, 1u) << "no later pass renumbered";
+  EXPECT_FALSE(c.acquisitions[0].withdrawn);
+  EXPECT_TRUE(c.acquisitions[1].withdrawn);  // b, in March: still in its place by time
+  EXPECT_TRUE(c.acquisition_list()[1].withdrawn);
+  EXPECT_EQ(c.acquisitions[1].listed, 0u) << "nor renumbered in the outputs";
   // The effective config says so, and parses back to it.
   EXPECT_NE(effective_config_toml(c).find("withdrawn = true"), std::string::npos);
-  EXPECT_TRUE(parse(effective_config_toml(c)).acquisitions[0].withdrawn);
+  EXPECT_TRUE(parse(effective_config_toml(c)).acquisitions[1].withdrawn);
   // A pass listed again (corrected) may name the withdrawn one's file.
   test::write_text(dir_ / "b.ply", "");
   EXPECT_NO_THROW(parse(withdrawn + "\n[[acquisition]]\npath = \"b.ply\"\ntime = 2026-04-01\n"));

@@ -31,7 +31,7 @@ enum class TriangleUse : std::uint8_t {
   empty_space = 2,
 };
 
-/// The meshes of every acquisition, index = acquisition index (config order), all in one local
+/// The meshes of every acquisition, index = acquisition index (a run gives them by time), all in one local
 /// frame (the same origin) and with sensor positions; dates may come in any order.
 struct ChangeInput {
   std::span<const Mesh> meshes;

@@ -41,6 +41,9 @@ struct AcquisitionEntry {
   /// Withdrawn (a pass found faulty): kept in the list so that no later pass is renumbered,
   /// read as an empty mesh; its file need not exist.
   bool withdrawn = false;
+  /// Its table's place among the config file's [[acquisition]] tables (from 0): the index the
+  /// outputs name it by (source_acq, the labelled PLYs' names, the summaries).
+  std::uint32_t listed = 0;
 };
 
 struct TilingParams {
@@ -80,6 +83,10 @@ struct Config {
   std::filesystem::path base_dir;  ///< relative paths resolve against this folder
   ProjectParams project;
   InputParams input;
+  /// In processing order: by time, acquisitions of the same time in listing order. Every step
+  /// numbers them so (tile store, triangle ids, stitching's ties), which makes the result
+  /// independent of the order in which the file lists them; only the outputs' names of them
+  /// follow the listing (`listed`).
   std::vector<AcquisitionEntry> acquisitions;
   ChangeParams change;
   MosaicParams mosaic;
@@ -89,8 +96,10 @@ struct Config {
 
   /// The project CRS with its vertical datum.
   [[nodiscard]] Crs crs() const;
-  /// Acquisitions in config order, indices 0..n-1.
+  /// Acquisitions in processing order, indices 0..n-1.
   [[nodiscard]] std::vector<Acquisition> acquisition_list() const;
+  /// Per acquisition in processing order, its `listed` index: what the outputs call it.
+  [[nodiscard]] std::vector<std::int32_t> listed_indices() const;
   [[nodiscard]] PlyReadParams ply_read_params() const;
 };
 
@@ -112,7 +121,13 @@ Config parse_config(std::string_view text, const std::filesystem::path& source,
 /// Every key with its default and a one-line meaning, as commented TOML (required keys are
 /// shown commented out with an example).
 std::string dump_default_config();
+/// Which order effective_config_toml writes the [[acquisition]] tables in.
+enum class TableOrder {
+  listed,      ///< the file's (what a user reads: the outputs' indices)
+  processing,  ///< Config::acquisitions' (what the work folder's fingerprints follow)
+};
+
 /// The effective configuration as TOML (what a run used).
-std::string effective_config_toml(const Config& config);
+std::string effective_config_toml(const Config& config, TableOrder order = TableOrder::listed);
 
 }  // namespace citymesh
