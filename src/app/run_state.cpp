@@ -85,17 +85,20 @@ std::vector<std::string> passes_of(const std::map<std::string, std::string>& key
   return out;
 }
 
-/// Whether `now` holds every pass `before` did, with more besides, some of them older than
-/// passes already processed (a pass delivered late). Acquisitions are numbered by time, so
-/// the passes after an older one added are renumbered: input too, as an appended pass is
-/// (the tiles whose passes changed numbers are redone). False for passes appended after all
-/// the others: the keys tell those apart one by one.
-bool passes_inserted(const std::map<std::string, std::string>& before, const std::map<std::string, std::string>& now) {
-  std::vector<std::string> had = passes_of(before), has = passes_of(now);
-  if (has.size() <= had.size() || std::equal(had.begin(), had.end(), has.begin())) return false;
-  std::sort(had.begin(), had.end());
-  std::sort(has.begin(), has.end());
-  return std::includes(has.begin(), has.end(), had.begin(), had.end());
+/// Whether one of `before` and `now` holds every pass the other does, and more besides, not
+/// all of them after the others by time: a pass delivered late, older than passes already
+/// processed, or a pass removed before the last. Acquisitions are numbered by time, so the
+/// passes after it are renumbered: input too, as an appended or withdrawn pass is (the tiles
+/// whose passes changed numbers are redone, to the bytes of a fresh run). False for passes
+/// appended or removed after all the others: the keys tell those apart one by one.
+bool passes_added_or_removed(const std::map<std::string, std::string>& before,
+                             const std::map<std::string, std::string>& now) {
+  std::vector<std::string> fewer = passes_of(before), more = passes_of(now);
+  if (fewer.size() > more.size()) std::swap(fewer, more);
+  if (fewer.size() == more.size() || std::equal(fewer.begin(), fewer.end(), more.begin())) return false;
+  std::sort(fewer.begin(), fewer.end());
+  std::sort(more.begin(), more.end());
+  return std::includes(more.begin(), more.end(), fewer.begin(), fewer.end());
 }
 
 std::string trim(std::string s) {
@@ -214,15 +217,20 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     }
     std::vector<std::string> changed;
     const std::size_t recorded = acquisition_count(before);
-    const bool added = passes_inserted(before, keys);
-    if (added) {
+    const bool renumbered = passes_added_or_removed(before, keys);
+    if (const std::size_t now = acquisition_count(keys); renumbered && now > recorded) {
       log::info(
-          "{} pass(es) added since the last run, before passes already processed by time: the tiles they "
-          "reach are redone, and those of the later passes (renumbered)",
-          acquisition_count(keys) - recorded);
+          "{} pass(es) added since the last run, older than passes already processed: the tiles they reach "
+          "are redone, and those of the passes after them by time (renumbered)",
+          now - recorded);
+    } else if (renumbered) {
+      log::info(
+          "{} pass(es) removed since the last run, older than the newest: the tiles they reached are redone, "
+          "and those of the passes after them by time (renumbered)",
+          recorded - now);
     }
     for (const auto& [k, v] : keys) {
-      if (added && acquisition_of_key(k)) continue;
+      if (renumbered && acquisition_of_key(k)) continue;
       const auto it = before.find(k);
       // An acquisition appended (a new pass over part of the city) is input, not a config
       // change: the tiles it reaches are processed, the others reused.
@@ -259,7 +267,7 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     for (const auto& [k, v] : before) {
       if (keys.contains(k)) continue;
       const std::optional<std::size_t> a = acquisition_of_key(k);
-      if (added && a) continue;
+      if (renumbered && a) continue;
       if (a && *a < listed && k.ends_with(".withdrawn")) {
         log::info("{} is no longer withdrawn: the tiles it reaches are redone", acquisition_named(keys, k));
         continue;

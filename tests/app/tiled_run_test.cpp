@@ -537,7 +537,7 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   ASSERT_EQ(run("five.toml", "i").exit_code, 0);
   const auto inserted = run("late.toml", "i");
   ASSERT_EQ(inserted.exit_code, 0) << inserted.err;
-  EXPECT_NE(inserted.err.find("1 pass(es) added since the last run, before passes already processed"),
+  EXPECT_NE(inserted.err.find("1 pass(es) added since the last run, older than passes already processed"),
             std::string::npos)
       << inserted.err;
   expect_same_outputs(dir / "sim/i", dir / "sim/l", "a pass delivered late differs from a fresh run");

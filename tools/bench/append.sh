@@ -7,6 +7,9 @@
 # whether the outputs are the same bytes.
 # Usage: tools/bench/append.sh FOLDER XMIN YMIN XMAX YMAX [threads (default 2)]
 #   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
+# LATE=1: the district's pass is dated one day after the first acquisition (a pass delivered
+#   late, listed last): the run processes it second by time, so the later passes are
+#   renumbered and every tile holding one is redone (session 74).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if [ $# -lt 5 ] || [ ! -f "$1/config.toml" ]; then
@@ -20,7 +23,15 @@ last=$(grep -n '^\[\[acquisition\]\]' "$dir/config.toml" | tail -1 | cut -d: -f1
 last_path=$(tail -n +"$last" "$dir/config.toml" | sed -n 's/^path = "\(.*\)"/\1/p' | head -1)
 head -n $((last - 1)) "$dir/config.toml" >"$dir/append-before.toml"
 cp "$dir/append-before.toml" "$dir/append-after.toml"
-tail -n +"$last" "$dir/config.toml" | sed "s|^path = \".*\"|path = \"append-part.ply\"|" >>"$dir/append-after.toml"
+late_time='&'  # sed: the time line as it is
+if [ "${LATE:-0}" = 1 ]; then
+  first_time=$(sed -n 's/^time = "\(.*\)"/\1/p' "$dir/config.toml" | head -1)
+  late_time=$(python3 -c "import datetime, sys; t = datetime.datetime.fromisoformat(sys.argv[1].replace('Z', '+00:00'))
+print('time = \"' + (t + datetime.timedelta(days=1)).strftime('%Y-%m-%dT%H:%M:%SZ') + '\"')" "$first_time")
+  echo "the district's pass dated one day after the first acquisition: $late_time"
+fi
+tail -n +"$last" "$dir/config.toml" | sed -e "s|^path = \".*\"|path = \"append-part.ply\"|" -e "s|^time = .*|$late_time|" \
+  >>"$dir/append-after.toml"
 build/release/bench/partial_pass "$dir/$last_path" "$dir/append-part.ply" "$2" "$3" "$4" "$5"
 run() {  # config, work/output name
   /usr/bin/time -f "%e s, peak RSS %M kB" "$bin" run "$dir/$1" --no-pictures --threads "$threads" --memory 2GiB \
