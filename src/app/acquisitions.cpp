@@ -68,7 +68,7 @@ nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& 
 std::vector<std::size_t> in_listed_order(const Config& config) {
   std::vector<std::size_t> order(config.acquisitions.size());
   for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return config.acquisitions[a].listed < config.acquisitions[b].listed;
   });
   return order;

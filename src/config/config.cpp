@@ -260,8 +260,8 @@ std::vector<const AcquisitionEntry*> tables_in(std::span<const AcquisitionEntry>
   std::vector<const AcquisitionEntry*> out;
   for (const AcquisitionEntry& a : acquisitions) out.push_back(&a);
   if (order == TableOrder::listed) {
-    std::sort(out.begin(), out.end(),
-              [](const AcquisitionEntry* a, const AcquisitionEntry* b) { return a->listed < b->listed; });
+    std::stable_sort(out.begin(), out.end(),
+                     [](const AcquisitionEntry* a, const AcquisitionEntry* b) { return a->listed < b->listed; });
   }
   return out;
 }
