@@ -168,7 +168,9 @@ class EvalCommand final : public Command {
     const std::map<std::uint32_t, ObjectInfo> catalogue = objects_by_id(truth_);
     std::map<std::uint32_t, ObjectInfo> objects = catalogue;  // areas added up per object
     try {
-      for (const auto& a : summary.at("acquisitions")) {
+      const nlohmann::json& acquisitions = summary.at("acquisitions");
+      for (const std::size_t k : by_date(acquisitions)) {
+        const nlohmann::json& a = acquisitions[k];
         if (a.value("withdrawn", false)) continue;  // no labels to score
         score_acquisition(detect / a.at("ply").get<std::string>(), truth_file(truth_, a), objects);
       }

@@ -64,6 +64,14 @@ const ObjectInfo& object_of(const std::map<std::uint32_t, ObjectInfo>& objects, 
   return find_object(objects, truth, source_face, origin);
 }
 
+std::vector<std::size_t> by_date(const nlohmann::json& acquisitions) {
+  std::vector<std::size_t> order(acquisitions.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  const auto date = [&](std::size_t k) { return acquisitions[k].value("date", std::string()); };
+  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return date(a) < date(b); });
+  return order;
+}
+
 std::filesystem::path truth_file(const std::filesystem::path& truth_dir, const nlohmann::json& acquisition) {
   const std::filesystem::path input = acquisition.at("input").get<std::string>();
   return truth_dir / input.filename().replace_extension(".truth");
@@ -220,7 +228,7 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   // output still covers, and the finest input resolution.
   double static_area = 0, static_covered = 0, static_open = 0, finest_edge = 0;
   UncoveredStatic uncovered;
-  for (std::size_t k = 0; k < acquisitions.size(); ++k) {
+  for (const std::size_t k : by_date(acquisitions)) {
     if (acquisitions[k].value("withdrawn", false)) continue;  // not an input of the run
     const std::filesystem::path ply = output / "detect" / acquisitions[k].at("ply").get<std::string>();
     const FaceTable in = read_face_table(ply, {kSourceFaceProperty, kKeptProperty});

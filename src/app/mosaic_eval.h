@@ -44,6 +44,11 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
                                const nlohmann::json& detect_summary,
                                const std::map<std::uint32_t, ObjectInfo>& objects);
 
+/// The positions of a summary's `acquisitions` by their dates (equal dates in list order):
+/// the order eval adds their areas up in, so that its figures do not depend on the order in
+/// which the config lists the passes.
+std::vector<std::size_t> by_date(const nlohmann::json& acquisitions);
+
 /// The truth file of an acquisition listed in the detect summary.
 std::filesystem::path truth_file(const std::filesystem::path& truth_dir, const nlohmann::json& acquisition);
 

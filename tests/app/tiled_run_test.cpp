@@ -531,6 +531,12 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   const nlohmann::json summary = read_json(dir / "sim/l/mosaic/summary.json");
   EXPECT_EQ(summary["acquisitions"][5]["name"], "epoch 2");
   EXPECT_EQ(summary["acquisitions"][5]["index"], 5);
+  // Scored, the same figures to the byte: eval adds the passes up by date too.
+  for (const char* name : {"d", "l"}) {
+    const auto eval = test::run_citymesh(fmt::format("eval {}/{} --truth {}", sim, name, sim));
+    ASSERT_EQ(eval.exit_code, 0) << eval.err;
+  }
+  EXPECT_EQ(test::read_text(dir / "sim/d/eval.json"), test::read_text(dir / "sim/l/eval.json"));
 
   // Delivered late into a run of the five others, the pass is processed among them by date:
   // the run resumes (no config change) to the bytes of a fresh run.
