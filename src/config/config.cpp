@@ -84,6 +84,7 @@ class Parser {
     validate();  // its messages name the acquisitions by their place in the file
     std::stable_sort(config_.acquisitions.begin(), config_.acquisitions.end(),
                      [](const AcquisitionEntry& a, const AcquisitionEntry& b) { return a.time < b.time; });
+    note_late_tables();
     return std::move(config_);
   }
 
@@ -229,6 +230,28 @@ class Parser {
       fail("every [[acquisition]] is withdrawn: a run needs at least one acquisition");
     }
     for (std::size_t i = 0; i < config_.acquisitions.size(); ++i) check_acquisition(i);
+  }
+
+  /// Says which tables the file lists after newer ones (a pass delivered late), once sorted:
+  /// those processed before their place in the file.
+  void note_late_tables() const {
+    for (std::size_t k = 0; k < config_.acquisitions.size(); ++k) {
+      const AcquisitionEntry& a = config_.acquisitions[k];
+      if (a.listed <= k) continue;
+      log::info(
+          "{}: acquisition[{}] ({}) is listed after newer passes: it is processed {} by time, and the "
+          "outputs name it {} (source_acq)",
+          source_.string(), a.listed, a.name, ordinal(k + 1), a.listed);
+    }
+  }
+
+  static std::string ordinal(std::size_t n) {
+    const char* suffix = n % 100 >= 11 && n % 100 <= 13 ? "th"
+                         : n % 10 == 1                  ? "st"
+                         : n % 10 == 2                  ? "nd"
+                         : n % 10 == 3                  ? "rd"
+                                                        : "th";
+    return fmt::format("{}{}", n, suffix);
   }
 
   void check_acquisition(std::size_t i) const {

@@ -495,6 +495,10 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   ASSERT_EQ(in_order.exit_code, 0) << in_order.err;
   const auto late = run("late.toml", "l");
   ASSERT_EQ(late.exit_code, 0) << late.err;
+  EXPECT_NE(late.err.find("acquisition[5] (epoch 2) is listed after newer passes: it is processed 3rd by time"),
+            std::string::npos)
+      << late.err;
+  EXPECT_EQ(in_order.err.find("is listed after newer passes"), std::string::npos) << in_order.err;
 
   // Listed at place 5, epoch 2 is processed third as before: the same map to the byte, each
   // pass named by its place in the file (epochs 3 to 5 move up one).
