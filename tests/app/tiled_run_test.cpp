@@ -483,6 +483,27 @@ MosaicRows mosaic_rows(const std::filesystem::path& ply) {
   return {std::move(t.positions), std::move(t.triangles), std::move(t.extras[0]), std::move(t.extras[1])};
 }
 
+/// `late`, the mosaic PLY of a config listing the passes in another order than `in_order`'s,
+/// holds the same map: the same rows to the byte, each source_acq renamed as `listed_at` (per
+/// place in `in_order`'s file, the place in `late`'s) says.
+void expect_same_map_renamed(const std::filesystem::path& in_order, const std::filesystem::path& late,
+                             const std::vector<int>& listed_at) {
+  const MosaicRows d = mosaic_rows(in_order), l = mosaic_rows(late);
+  ASSERT_GT(d.triangles.size(), 1000u);
+  EXPECT_TRUE(d.positions == l.positions);
+  EXPECT_TRUE(d.triangles == l.triangles);
+  EXPECT_TRUE(d.source_face == l.source_face);
+  ASSERT_EQ(d.source_acq.size(), l.source_acq.size());
+  std::set<int> places;
+  for (std::size_t t = 0; t < d.source_acq.size(); ++t) {
+    const int place = static_cast<int>(d.source_acq[t]);
+    ASSERT_EQ(static_cast<int>(l.source_acq[t]), place < 0 ? place : listed_at.at(static_cast<std::size_t>(place)))
+        << "triangle " << t;
+    places.insert(place);
+  }
+  EXPECT_GE(places.size(), listed_at.size()) << "every pass in the map (and stitching's -1)";
+}
+
 TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceInTheFile) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
@@ -503,20 +524,7 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   // Listed at place 5, epoch 2 is processed third as before: the same map to the byte, each
   // pass named by its place in the file (epochs 3 to 5 move up one).
   const std::vector<int> listed_at{0, 1, 5, 2, 3, 4};  // per epoch
-  const MosaicRows d = mosaic_rows(dir / "sim/d/mosaic/mosaic.ply"), l = mosaic_rows(dir / "sim/l/mosaic/mosaic.ply");
-  ASSERT_GT(d.triangles.size(), 1000u);
-  EXPECT_TRUE(d.positions == l.positions);
-  EXPECT_TRUE(d.triangles == l.triangles);
-  EXPECT_TRUE(d.source_face == l.source_face);
-  ASSERT_EQ(d.source_acq.size(), l.source_acq.size());
-  std::set<int> epochs;
-  for (std::size_t t = 0; t < d.source_acq.size(); ++t) {
-    const int epoch = static_cast<int>(d.source_acq[t]);
-    ASSERT_EQ(static_cast<int>(l.source_acq[t]), epoch < 0 ? epoch : listed_at.at(static_cast<std::size_t>(epoch)))
-        << "triangle " << t;
-    epochs.insert(epoch);
-  }
-  EXPECT_TRUE(epochs.contains(2) && epochs.contains(5)) << "the moved pass and one renumbered are in the map";
+  expect_same_map_renamed(dir / "sim/d/mosaic/mosaic.ply", dir / "sim/l/mosaic/mosaic.ply", listed_at);
   // The other results have the same bytes; the labelled PLYs are named by place in the file.
   std::map<std::string, std::string> expected;
   for (auto& [name, bytes] : test::result_bytes(dir / "sim/d")) {
@@ -541,6 +549,21 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
     ASSERT_EQ(eval.exit_code, 0) << eval.err;
   }
   EXPECT_EQ(test::read_text(dir / "sim/d/eval.json"), test::read_text(dir / "sim/l/eval.json"));
+
+  // The same without tiles (detect, then mosaic); a mosaic on the labels of another listing
+  // is refused, naming the summary.
+  const auto untiled = [&](const std::string& file, const std::string& name, const char* step) {
+    return test::run_citymesh(fmt::format("{} {}/{} --no-pictures --set project.output={} --set project.work=work-{}",
+                                          step, sim, file, name, name));
+  };
+  for (const auto& [file, name] : {std::pair{"config.toml", "ud"}, std::pair{"late.toml", "ul"}}) {
+    for (const char* step : {"detect", "mosaic"}) ASSERT_EQ(untiled(file, name, step).exit_code, 0) << step;
+  }
+  expect_same_map_renamed(dir / "sim/ud/mosaic/mosaic.ply", dir / "sim/ul/mosaic/mosaic.ply", listed_at);
+  const auto mixed = untiled("late.toml", "ud", "mosaic");
+  EXPECT_NE(mixed.exit_code, 0);
+  EXPECT_NE(mixed.err.find("detect/summary.json: acquisition 2 is"), std::string::npos) << mixed.err;
+  EXPECT_NE(mixed.err.find("run citymesh detect again"), std::string::npos) << mixed.err;
 
   // Delivered late into a run of the five others, the pass is processed among them by date:
   // the run resumes (no config change) to the bytes of a fresh run.
