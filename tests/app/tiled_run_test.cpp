@@ -549,6 +549,13 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
     ASSERT_EQ(eval.exit_code, 0) << eval.err;
   }
   EXPECT_EQ(test::read_text(dir / "sim/d/eval.json"), test::read_text(dir / "sim/l/eval.json"));
+  // The tables reordered in a finished run's config: all its work is reused, the outputs
+  // renamed (they are written again).
+  const auto reordered = run("late.toml", "d");
+  ASSERT_EQ(reordered.exit_code, 0) << reordered.err;
+  const nlohmann::json report = read_json(dir / "sim/d/run.json");
+  EXPECT_EQ(report["reused_tiles"], report["tiles"]);
+  EXPECT_TRUE(test::result_bytes(dir / "sim/d") == test::result_bytes(dir / "sim/l"));
 
   // The same without tiles (detect, then mosaic); a mosaic on the labels of another listing
   // is refused, naming the summary.
@@ -562,7 +569,7 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   expect_same_map_renamed(dir / "sim/ud/mosaic/mosaic.ply", dir / "sim/ul/mosaic/mosaic.ply", listed_at);
   const auto mixed = untiled("late.toml", "ud", "mosaic");
   EXPECT_NE(mixed.exit_code, 0);
-  EXPECT_NE(mixed.err.find("detect/summary.json: acquisition 2 is"), std::string::npos) << mixed.err;
+  EXPECT_NE(mixed.err.find("detect/summary.json: acquisition 5 is"), std::string::npos) << mixed.err;
   EXPECT_NE(mixed.err.find("run citymesh detect again"), std::string::npos) << mixed.err;
 
   // Delivered late into a run of the five others, the pass is processed among them by date:
