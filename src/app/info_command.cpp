@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
 // `citymesh info FILE...`: what a PLY acquisition holds and where it lies on Earth.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <CLI/CLI.hpp>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "acquisitions.h"
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
@@ -140,7 +142,8 @@ class InfoCommand final : public Command {
       params = config.ply_read_params();
       crs = config.crs();
       if (files_.empty()) {
-        for (const auto& a : config.acquisitions) {
+        for (const std::size_t k : in_listed_order(config)) {  // as the file lists them
+          const AcquisitionEntry& a = config.acquisitions[k];
           if (a.withdrawn) {
             log::info("{}: withdrawn, not described", a.path.string());
           } else {
