@@ -3,8 +3,6 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
-
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/io/mesh_io.h"
@@ -63,15 +61,6 @@ nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& 
           {"name", config.acquisitions[k].name},
           {"date", format_iso8601(input.dates[k])},
           {"input", input.acquisitions[k].path.string()}};
-}
-
-std::vector<std::size_t> in_listed_order(const Config& config) {
-  std::vector<std::size_t> order(config.acquisitions.size());
-  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
-  std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return config.acquisitions[a].listed < config.acquisitions[b].listed;
-  });
-  return order;
 }
 
 std::vector<std::int32_t> as_listed(std::span<const std::int32_t> source_acq, std::span<const std::int32_t> listed) {

@@ -32,10 +32,6 @@ Mesh read_acquisition(const Config& config, const Acquisition& a, const std::opt
 /// config file), name, date, input file.
 nlohmann::json acquisition_json(const Config& config, const LoadedAcquisitions& input, std::size_t k);
 
-/// The acquisitions (processing order indices) in the order the config file lists them: the
-/// order of the summaries' lists, whose positions are the outputs' source_acq.
-std::vector<std::size_t> in_listed_order(const Config& config);
-
 /// `source_acq` as the outputs write it: each acquisition by its place in the config file
 /// (`listed`, per acquisition in processing order; Config::listed_indices); kNoSource stays.
 std::vector<std::int32_t> as_listed(std::span<const std::int32_t> source_acq, std::span<const std::int32_t> listed);

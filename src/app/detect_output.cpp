@@ -202,7 +202,7 @@ void write_detect_outputs(const Config& config, const LoadedAcquisitions& descri
   });
   StateCounts totals;
   std::uint64_t triangles = 0;
-  for (const std::size_t k : in_listed_order(config)) {
+  for (const std::size_t k : config.listed_order()) {
     AcquisitionOutputs& w = written[k];
     totals += w.counts;
     triangles += w.entry["triangles"].get<std::uint64_t>();

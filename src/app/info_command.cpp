@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
-#include "acquisitions.h"
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
@@ -142,7 +141,7 @@ class InfoCommand final : public Command {
       params = config.ply_read_params();
       crs = config.crs();
       if (files_.empty()) {
-        for (const std::size_t k : in_listed_order(config)) {  // as the file lists them
+        for (const std::size_t k : config.listed_order()) {  // as the file lists them
           const AcquisitionEntry& a = config.acquisitions[k];
           if (a.withdrawn) {
             log::info("{}: withdrawn, not described", a.path.string());

@@ -88,7 +88,7 @@ void write_summary(const Config& config, const LoadedAcquisitions& input, const 
                         {"crease", config.mosaic.crease_weight}};
   summary["crease_angle"] = config.mosaic.crease_angle;
   summary["seen_through_quality"] = config.mosaic.seen_through_quality;
-  for (const std::size_t k : in_listed_order(config)) {
+  for (const std::size_t k : config.listed_order()) {
     nlohmann::json entry = acquisition_json(config, input, k);
     entry["triangles_kept"] = k < counts.per_source.size() ? counts.per_source[k] : 0;
     summary["acquisitions"].push_back(std::move(entry));

@@ -41,25 +41,17 @@ std::vector<BlockPartKey> key_parts_from(const nlohmann::json& rows) {
 std::filesystem::path seam_cache_folder(const std::filesystem::path& work) { return work / "seam-cache"; }
 
 nlohmann::json outcome_json(const PartOutcome& o) {
-  const StitchStats& s = o.stats;
-  return {{"counts",
-           {s.vertices_snapped, s.edges_split, s.triangles_uncovered, s.triangles_clipped, s.strips, s.triangles_added,
-            s.vertices_welded, s.gaps_filled, s.rejected, s.triangles_split}},
-          {"box", box_bits(o.box)},
-          {"cut_triangles", o.cut_triangles},
-          {"digest", o.digest},
-          {"reused", o.reused},
-          {"key_parts", key_parts_json(o.key_parts)}};
+  std::vector<std::uint64_t> counts;
+  for (const auto count : kStitchCounts) counts.push_back(o.stats.*count);
+  return {{"counts", counts},   {"box", box_bits(o.box)}, {"cut_triangles", o.cut_triangles},
+          {"digest", o.digest}, {"reused", o.reused},     {"key_parts", key_parts_json(o.key_parts)}};
 }
 
 PartOutcome outcome_from(const nlohmann::json& j) {
   PartOutcome o;
   const auto counts = j.at("counts").get<std::vector<std::uint64_t>>();
-  if (counts.size() != 10) throw ProcessingError("a seam part's outcome: counts missing");
-  StitchStats& s = o.stats;
-  s.vertices_snapped = counts[0], s.edges_split = counts[1], s.triangles_uncovered = counts[2];
-  s.triangles_clipped = counts[3], s.strips = counts[4], s.triangles_added = counts[5];
-  s.vertices_welded = counts[6], s.gaps_filled = counts[7], s.rejected = counts[8], s.triangles_split = counts[9];
+  if (counts.size() != kStitchCounts.size()) throw ProcessingError("a seam part's outcome: counts missing");
+  for (std::size_t k = 0; k < counts.size(); ++k) o.stats.*kStitchCounts[k] = counts[k];
   o.box = box_from_bits(j.at("box"));
   o.cut_triangles = j.at("cut_triangles").get<std::size_t>();
   o.digest = j.at("digest").get<std::uint64_t>();

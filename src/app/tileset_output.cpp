@@ -144,10 +144,11 @@ nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves)
   const std::filesystem::path staged = staging_directory(dir);
   std::filesystem::remove_all(staged);
   std::filesystem::create_directories(staged);
+  const std::vector<std::int32_t> listed = config.listed_indices();
   for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
     const KeyedPiece piece = leaves.load(l);
     const MeshVertexRows rows = piece_rows(piece);
-    const Provenance provenance(piece, config.listed_indices());
+    const Provenance provenance(piece, listed);
     write_ply(staged / (leaves.leaves()[l].key.name() + ".ply"),
               {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
   }

@@ -278,13 +278,13 @@ class Parser {
   std::vector<std::string> seen_;
 };
 
-/// `acquisitions` in the order `order` names.
-std::vector<const AcquisitionEntry*> tables_in(std::span<const AcquisitionEntry> acquisitions, TableOrder order) {
+/// `c`'s acquisitions in the order `order` names.
+std::vector<const AcquisitionEntry*> tables_in(const Config& c, TableOrder order) {
   std::vector<const AcquisitionEntry*> out;
-  for (const AcquisitionEntry& a : acquisitions) out.push_back(&a);
   if (order == TableOrder::listed) {
-    std::stable_sort(out.begin(), out.end(),
-                     [](const AcquisitionEntry* a, const AcquisitionEntry* b) { return a->listed < b->listed; });
+    for (const std::size_t k : c.listed_order()) out.push_back(&c.acquisitions[k]);
+  } else {
+    for (const AcquisitionEntry& a : c.acquisitions) out.push_back(&a);
   }
   return out;
 }
@@ -321,7 +321,7 @@ std::string render(const Config& c, bool defaults, TableOrder order) {
         "# name = \"january\"                # label in reports (default: the file name)\n"
         "# withdrawn = true                # a faulty pass: read as empty, no later pass renumbered\n";
   }
-  for (const AcquisitionEntry* a : tables_in(c.acquisitions, order)) {
+  for (const AcquisitionEntry* a : tables_in(c, order)) {
     out += fmt::format("\n[[acquisition]]\npath = {}\ntime = {}\nname = {}\n", toml_string(a->path.string()),
                        toml_string(format_iso8601(a->time)), toml_string(a->name));
     if (a->withdrawn) out += "withdrawn = true\n";
@@ -348,6 +348,15 @@ std::vector<std::int32_t> Config::listed_indices() const {
   std::vector<std::int32_t> out;
   for (const AcquisitionEntry& a : acquisitions) out.push_back(static_cast<std::int32_t>(a.listed));
   return out;
+}
+
+std::vector<std::size_t> Config::listed_order() const {
+  std::vector<std::size_t> order(acquisitions.size());
+  for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+  // Stable: a config built by hand may leave every place 0.
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return acquisitions[a].listed < acquisitions[b].listed; });
+  return order;
 }
 
 PlyReadParams Config::ply_read_params() const {

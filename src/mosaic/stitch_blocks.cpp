@@ -151,16 +151,7 @@ StitchStats stitch_cut(PartCut& cut, const StitchParams& params, std::span<const
 }
 
 void add_counts(StitchStats& total, const StitchStats& s) {
-  total.vertices_snapped += s.vertices_snapped;
-  total.edges_split += s.edges_split;
-  total.triangles_uncovered += s.triangles_uncovered;
-  total.triangles_clipped += s.triangles_clipped;
-  total.triangles_split += s.triangles_split;
-  total.strips += s.strips;
-  total.triangles_added += s.triangles_added;
-  total.vertices_welded += s.vertices_welded;
-  total.gaps_filled += s.gaps_filled;
-  total.rejected += s.rejected;
+  for (const auto count : kStitchCounts) total.*count += s.*count;
 }
 
 /// Adds a part's key to a digest, field by field (the struct has padding).

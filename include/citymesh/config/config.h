@@ -100,6 +100,9 @@ struct Config {
   [[nodiscard]] std::vector<Acquisition> acquisition_list() const;
   /// Per acquisition in processing order, its `listed` index: what the outputs call it.
   [[nodiscard]] std::vector<std::int32_t> listed_indices() const;
+  /// The acquisitions (indices in processing order) in the order the file lists them: the
+  /// order of the printed config and of the summaries' lists.
+  [[nodiscard]] std::vector<std::size_t> listed_order() const;
   [[nodiscard]] PlyReadParams ply_read_params() const;
 };
 

@@ -5,6 +5,7 @@
 // tolerance are merged.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -51,6 +52,14 @@ struct StitchStats {
   std::uint64_t rejected = 0;
   double seconds = 0;
 };
+
+/// StitchStats' counts, which add up over the parts of a seam pass, in the order its cache
+/// stores them (a count added goes last, with a new cache magic).
+inline constexpr std::array kStitchCounts{
+    &StitchStats::vertices_snapped,  &StitchStats::edges_split, &StitchStats::triangles_uncovered,
+    &StitchStats::triangles_clipped, &StitchStats::strips,      &StitchStats::triangles_added,
+    &StitchStats::vertices_welded,   &StitchStats::gaps_filled, &StitchStats::rejected,
+    &StitchStats::triangles_split};
 
 /// A vertex's part in a seam pass over one part of an output, when the output is stitched
 /// part by part (each part's triangles once, with what lies around them).
