@@ -298,6 +298,14 @@ std::uint64_t TileContents::total() const {
   return n;
 }
 
+std::vector<std::uint32_t> TileContents::passes() const {
+  std::vector<std::uint32_t> out;
+  for (std::size_t a = 0; a < triangles.size(); ++a) {
+    if (triangles[a][0] + triangles[a][1] + triangles[a][2] > 0) out.push_back(static_cast<std::uint32_t>(a));
+  }
+  return out;
+}
+
 std::filesystem::path acquisition_tiles_path(const std::filesystem::path& dir, std::uint32_t acquisition) {
   return dir / fmt::format("a{}", acquisition);
 }

@@ -171,11 +171,13 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
   // version says, so it is kept across builds.
   const std::string versions = fmt::format("tile store {}, tile results {}\n", kTileStoreVersion, kTileResultVersion);
   std::string settings = versions + "build " + build_name() + "\n", tiling = versions;
-  std::vector<std::string> own(acquisitions);
+  std::vector<std::string> own(acquisitions), identity(acquisitions);
   for (const auto& [k, v] : keys) {
     const std::string line = k + "=" + v + "\n";
     if (const std::optional<std::size_t> a = acquisition_of_key(k)) {
-      if (*a < acquisitions) own[*a] += line;
+      if (*a >= acquisitions) continue;
+      own[*a] += line;
+      identity[*a] += line.substr(line.find("].") + 2);  // "acquisition[k].path=..." as "path=..."
       continue;
     }
     settings += line;
@@ -189,6 +191,7 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
     f.acquisitions.push_back(hash(tiling + lines));
     store += lines;
   }
+  for (const std::string& lines : identity) f.identities.push_back(hash(lines));
   f.store = hash(store);
   return f;
 }

@@ -18,7 +18,8 @@ inline constexpr const char* kRunConfigFile = "run-config.json";
 /// a change to which triangles the tiler puts where must bump kTileStoreVersion.
 inline constexpr int kTileStoreVersion = 4;   // 2: one folder per acquisition; 3: XXH3 checksums;
                                               // 4: zero-area triangles dropped as whole-mesh reading drops them
-inline constexpr int kTileResultVersion = 4;  // 3: XXH3 checksum; 4: keyed on each tile's own inputs
+inline constexpr int kTileResultVersion = 5;  // 3: XXH3 checksum; 4: keyed on each tile's own inputs;
+                                              // 5: its passes named by identity, not index
 
 /// Hashes of the result-affecting keys, split so that work depending on some acquisitions
 /// only is reused when another acquisition is added or rewritten.
@@ -29,6 +30,10 @@ struct RunFingerprints {
   /// Per acquisition: the keys that change the tile store (input, tiling) and its own keys
   /// (path, file size and time, date...): its tiled folder, and the tile results it is in.
   std::vector<std::uint64_t> acquisitions;
+  /// Per acquisition: its own keys without its index (what `acquisitions` holds but the
+  /// tiling keys and the index). A pass delivered late renumbers the passes after it by time;
+  /// their identities stay, so a tile it does not reach is known to hold the same passes.
+  std::vector<std::uint64_t> identities;
   /// The tile store as a whole (its manifest): the tiling keys and every acquisition's.
   std::uint64_t store = 0;
 };

@@ -101,7 +101,8 @@ bool keep_if_still_right(const std::filesystem::path& file, const TileStore& sto
   const std::optional<ResultOrigin> origin = tile_result_origin(file);
   if (!origin || origin->inputs != digests.inputs) return false;
   if (origin->settled != tile_settled_fingerprint(store, key, settled)) return false;
-  return restamp_tile_result(file, store, *origin, digests.result);
+  const TileContents* tile = store.find(key);
+  return tile != nullptr && restamp_tile_result(file, store, *origin, digests.result, tile->passes());
 }
 
 bool by_triangle(const OwnedLabel& x, const OwnedLabel& y) {
@@ -166,6 +167,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   Stopwatch clock;
   TileResult r;
   r.key = key;
+  if (const TileContents* tile = store.find(key)) r.passes = tile->passes();
   std::vector<TilePiece> pieces = read_tile(store, key);
   std::vector<Mesh> meshes;
   std::vector<TimePoint> dates;

@@ -70,6 +70,9 @@ struct TileResult {
   std::vector<RefutedCopy> refuted;
   /// Per acquisition, the selected owned triangles with their vertices (tile frame).
   std::vector<TilePiece> selected;
+  /// The acquisitions the tile held (TileContents::passes) in the numbering of the ids above:
+  /// what renumber_tile_result maps from when a pass delivered late renumbers them.
+  std::vector<std::uint32_t> passes;
   double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
   std::uint64_t triangles_in_tile = 0;  ///< owned, halo and empty space
   ChangeStats change;                   ///< the change step's figures on the whole tile
@@ -116,13 +119,18 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
 /// Writes the result in `file` again under the digest `result` (atomically), marked kept and
 /// unchanged otherwise; false, leaving it as it is, unless `file` holds a whole result of this
 /// version (checked as resuming does) made from `made_from`'s inputs and settled fingerprint.
+/// `passes`: the tile's acquisitions now (TileContents::passes). When the result names them
+/// by other indices (a pass delivered late renumbered them; the inputs digest names them by
+/// identity, so they are the same passes in the same order), its labels, pairs, refuted
+/// copies and pieces are renumbered: the k-th of its passes becomes passes[k].
 bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, const ResultOrigin& made_from,
-                         std::uint64_t result);
+                         std::uint64_t result, std::span<const std::uint32_t> passes);
 /// Whether the result of tile `key` in `file`, made under another digest, is still right under
-/// `digests`: made from the same inputs and from the same decisions of the earlier-phase
-/// neighbours on the tile's halo (`settled`), all the tile job reads. It is then written
-/// again under digests.result and kept: when a neighbour was redone to the same decisions
-/// along their border, the tile need not be.
+/// `digests`: made from the same inputs (the same passes, perhaps renumbered) and from the
+/// same decisions of the earlier-phase neighbours on the tile's halo (`settled`), all the tile
+/// job reads. It is then written again under digests.result (renumbered) and kept: when a
+/// neighbour was redone to the same decisions along their border, or a pass delivered late
+/// elsewhere renumbered the tile's passes, the tile need not be processed.
 bool keep_if_still_right(const std::filesystem::path& file, const TileStore& store, TileKey key, ResultDigests digests,
                          const SettledSelection& settled);
 /// Which sections of a tile result to decode (the checksum covers the whole file whatever

@@ -28,25 +28,29 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
   return after;
 }
 
-TileDigests tile_digests(const TileStore& store, std::uint64_t settings, std::span<const std::uint64_t> acquisitions) {
+TileDigests tile_digests(const TileStore& store, std::uint64_t settings, std::span<const std::uint64_t> identities) {
   TileDigests digests{std::vector<std::uint64_t>(store.tiles.size()), std::vector<std::uint64_t>(store.tiles.size())};
   // A tile's dependencies are of earlier phases: phase by phase, their digests are known.
   for (int phase = 0; phase < kTilePhases; ++phase) {
     for (std::size_t k = 0; k < store.tiles.size(); ++k) {
       const TileContents& tile = store.tiles[k];
       if (tile_phase(tile.key) != phase) continue;
-      if (tile.triangles.size() > acquisitions.size()) {
+      if (tile.triangles.size() > identities.size()) {
         throw ProcessingError(fmt::format("tile {} holds {} acquisitions, {} are fingerprinted", tile.key.name(),
-                                          tile.triangles.size(), acquisitions.size()));
+                                          tile.triangles.size(), identities.size()));
       }
+      // The inputs name the passes by identity, in their order (by time): the same for a
+      // tile whose passes were renumbered by a pass delivered late elsewhere.
       std::vector<std::uint64_t> words{settings, static_cast<std::uint32_t>(tile.key.i),
                                        static_cast<std::uint32_t>(tile.key.j)};
-      for (std::size_t a = 0; a < tile.triangles.size(); ++a) {
+      const std::vector<std::uint32_t> passes = tile.passes();
+      for (const std::uint32_t a : passes) {
         const auto& counts = tile.triangles[a];
-        if (counts[0] + counts[1] + counts[2] == 0) continue;
-        words.insert(words.end(), {a, acquisitions[a], counts[0], counts[1], counts[2]});
+        words.insert(words.end(), {identities[a], counts[0], counts[1], counts[2]});
       }
       digests.inputs[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
+      // The result holds the passes' indices: under another numbering it is another result.
+      words.insert(words.end(), passes.begin(), passes.end());
       for (const std::size_t d : tile_dependencies(store, k)) words.push_back(digests.result[d]);
       digests.result[k] = fnv1a(words.data(), words.size() * sizeof(std::uint64_t));
     }

@@ -19,20 +19,22 @@ std::vector<std::size_t> tile_dependencies(const TileStore& store, std::size_t k
 
 /// Per store tile, digests of what its result depends on.
 struct TileDigests {
-  /// `inputs` and the digests of its dependencies (whose decisions it keeps): a result is
-  /// reused only under the digest it was written with, so an added or rewritten acquisition
-  /// redoes the tiles it reaches and, along the dependencies, their later-phase neighbours
-  /// are looked at again (kept when the decisions they keep did not change: tile_stage).
+  /// `inputs`, the indices of the acquisitions it holds and the digests of its dependencies
+  /// (whose decisions it keeps): a result is reused only under the digest it was written
+  /// with, so an added or rewritten acquisition redoes the tiles it reaches and, along the
+  /// dependencies, their later-phase neighbours are looked at again (kept when the decisions
+  /// they keep did not change, renumbered when a pass delivered late renumbered theirs:
+  /// tile_stage).
   std::vector<std::uint64_t> result;
   /// The tile's own inputs: `settings` (the run's result-affecting keys), the tile's key and
-  /// the fingerprints of the acquisitions it holds triangles of (`acquisitions[a]`, with the
-  /// tile's counts).
+  /// the identities of the acquisitions it holds triangles of (RunFingerprints::identities,
+  /// with the tile's counts), in their order but not by index.
   std::vector<std::uint64_t> inputs;
 };
 
 /// The digests of every store tile. Throws ProcessingError when the store holds more
-/// acquisitions than `acquisitions` gives.
-TileDigests tile_digests(const TileStore& store, std::uint64_t settings, std::span<const std::uint64_t> acquisitions);
+/// acquisitions than `identities` gives.
+TileDigests tile_digests(const TileStore& store, std::uint64_t settings, std::span<const std::uint64_t> identities);
 
 /// The order in which the work schedule takes ready tiles (higher first), per tile of `tiles`:
 /// largest first (triangles held: big tiles do not end a run alone), but every tile of this

@@ -33,10 +33,11 @@ namespace {
 // results counted refutes differently.
 // Version 08: what the result was made from (the tile's inputs digest, the fingerprint of its
 // neighbours' decisions on its halo) and whether it was kept that way, so that a result is
-// kept when only a neighbour was redone, to the same decisions. Version 07 results (the same
-// but for those three fields, at the end of the header) are still read; they are never kept.
-constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '8'};
-constexpr char kMagic07[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '7'};
+// kept when only a neighbour was redone, to the same decisions.
+// Version 09: the acquisitions the tile held, by index (TileResult::passes), so that a result
+// is renumbered rather than made again when a pass delivered late renumbers them. Older
+// results are processed again (they were under the digest of another build anyway).
+constexpr char kMagic[8] = {'C', 'M', 'R', 'S', 'L', 'T', '0', '9'};
 
 /// ChangeStats as stored, in the order of kChangeCounts and kChangeSeconds.
 struct ChangeFigures {
@@ -70,9 +71,9 @@ struct ResultHeader {
   std::uint64_t refuted, refuted_bytes;                   ///< the third varint section, after the pairs
   std::uint64_t inputs_fingerprint, settled_fingerprint;  ///< ResultOrigin (version 08)
   std::uint64_t kept;                                     ///< 1 when last written by restamp_tile_result (version 08)
+  std::uint64_t passes;  ///< the fourth section, after the refuted copies: 4 bytes each (version 09)
 };
-static_assert(sizeof(ResultHeader) == 224);
-constexpr std::size_t kHeader07Bytes = 200;  ///< a version 07 header: this one's first bytes
+static_assert(sizeof(ResultHeader) == 232);
 
 /// A label's state, flags and notes in one varint (state < 4, flags 0 or 1, notes 8 bits).
 std::uint64_t label_bits(const OwnedLabel& l) {
@@ -196,6 +197,40 @@ class ChecksummedFile {
   BulkChecksum sum_;
 };
 
+/// The sections of a result after its header, in the order the file holds them: labels,
+/// pairs, refuted copies, passes, then `pieces` pieces (each its 8-byte size and its bytes).
+struct ResultSections {
+  std::string_view labels, pairs, refuted;
+  std::span<const std::uint32_t> passes;
+  std::size_t pieces = 0;
+};
+
+/// Writes `h` (its section sizes set from `s`) and the sections; `piece_bytes(a)` gives the
+/// bytes of piece a when they are written, not before: a spinning scanner's tile result is a
+/// 0.3 GB file, and gathering it (grown by doubling) beside the sections took that tile's peak
+/// from 1.9 to 2.5 GB.
+template <class PieceBytes>
+void write_result(const std::filesystem::path& file, ResultHeader h, const ResultSections& s,
+                  const PieceBytes& piece_bytes) {
+  h.label_bytes = s.labels.size();
+  h.pair_bytes = s.pairs.size();
+  h.refuted_bytes = s.refuted.size();
+  h.passes = s.passes.size();
+  h.acquisitions = s.pieces;
+  ChecksummedFile out(file);
+  out.write_raw(h);
+  out.write(s.labels);
+  out.write(s.pairs);
+  out.write(s.refuted);
+  out.write(std::string_view(reinterpret_cast<const char*>(s.passes.data()), s.passes.size_bytes()));
+  for (std::size_t a = 0; a < s.pieces; ++a) {
+    const auto block = piece_bytes(a);
+    out.write_raw(std::uint64_t{block.size()});
+    out.write(block);
+  }
+  out.commit();
+}
+
 }  // namespace
 
 void write_tile_result(const std::filesystem::path& file, const TileResult& r, ResultDigests digests) {
@@ -207,32 +242,19 @@ void write_tile_result(const std::filesystem::path& file, const TileResult& r, R
   h.j = r.key.j;
   h.labels = r.labels.size();
   h.pairs = r.pairs.size();
-  h.acquisitions = r.selected.size();
   h.triangles_in_tile = r.triangles_in_tile;
   h.seconds_read = r.seconds_read;
   h.seconds_detect = r.seconds_detect;
   h.seconds_mosaic = r.seconds_mosaic;
-  h.label_bytes = labels.bytes().size();
-  h.pair_bytes = r.pairs.bytes().size();
   h.change = figures_of(r.change);
   h.refuted = r.refuted.size();
-  h.refuted_bytes = refuted.bytes().size();
   h.inputs_fingerprint = digests.inputs;
   h.settled_fingerprint = r.settled_fingerprint;
-  // Written section by section, not gathered first: a spinning scanner's tile result is a
-  // 0.3 GB file, and gathering it (grown by doubling) beside the sections took that tile's
-  // peak from 1.9 to 2.5 GB.
-  ChecksummedFile out(file);
-  out.write_raw(h);
-  out.write(labels.bytes());
-  out.write(r.pairs.bytes());
-  out.write(refuted.bytes());
-  for (const TilePiece& p : r.selected) {
-    const std::string block = p.triangle_count() == 0 ? std::string() : encode_tile_block(p);
-    out.write_raw(std::uint64_t{block.size()});
-    out.write(block);
-  }
-  out.commit();
+  write_result(file, h, {labels.bytes(), r.pairs.bytes(), refuted.bytes(), r.passes, r.selected.size()},
+               [&](std::size_t a) {
+                 const TilePiece& p = r.selected[a];
+                 return p.triangle_count() == 0 ? std::string() : encode_tile_block(p);
+               });
 }
 
 namespace {
@@ -241,8 +263,36 @@ namespace {
 /// the bytes, for the sections to be decoded.
 struct CheckedResult {
   ResultHeader header{};
-  std::size_t header_bytes = sizeof(ResultHeader);  ///< where the sections start
   std::string bytes;
+
+  [[nodiscard]] std::string_view labels() const { return section(sizeof header, header.label_bytes); }
+  [[nodiscard]] std::string_view pairs() const { return section(pairs_at(), header.pair_bytes); }
+  [[nodiscard]] std::string_view refuted() const { return section(refuted_at(), header.refuted_bytes); }
+  [[nodiscard]] std::vector<std::uint32_t> passes() const {
+    std::vector<std::uint32_t> out(header.passes);
+    std::memcpy(out.data(), bytes.data() + passes_at(), out.size() * sizeof(std::uint32_t));
+    return out;
+  }
+  /// Each piece's bytes (pieces_fit checked their sizes).
+  [[nodiscard]] std::vector<std::string_view> pieces() const {
+    std::vector<std::string_view> out;
+    std::size_t at = pieces_at();
+    for (std::uint64_t a = 0; a < header.acquisitions; ++a) {
+      std::uint64_t size = 0;
+      std::memcpy(&size, bytes.data() + at, sizeof size);
+      out.push_back(section(at + sizeof size, size));
+      at += sizeof size + size;
+    }
+    return out;
+  }
+
+  [[nodiscard]] std::size_t pairs_at() const { return sizeof header + header.label_bytes; }
+  [[nodiscard]] std::size_t refuted_at() const { return pairs_at() + header.pair_bytes; }
+  [[nodiscard]] std::size_t passes_at() const { return refuted_at() + header.refuted_bytes; }
+  [[nodiscard]] std::size_t pieces_at() const { return passes_at() + header.passes * sizeof(std::uint32_t); }
+  [[nodiscard]] std::string_view section(std::size_t at, std::size_t size) const {
+    return std::string_view(bytes).substr(at, size);
+  }
 };
 
 /// Says why a result is not used; nothing, for the reader to return.
@@ -251,16 +301,27 @@ std::nullopt_t stale(const std::filesystem::path& file, std::string_view why) {
   return std::nullopt;
 }
 
+/// Whether `passes` are acquisitions of the result, each once, in increasing order.
+bool passes_fit(std::span<const std::uint32_t> passes, std::uint64_t acquisitions) {
+  for (std::size_t k = 0; k < passes.size(); ++k) {
+    if (passes[k] >= acquisitions || (k > 0 && passes[k] <= passes[k - 1])) return false;
+  }
+  return true;
+}
+
 /// Whether the `acquisitions` pieces from byte `at` (each an 8-byte size and its bytes) end
-/// before the checksum, those from `listed` on (acquisitions withdrawn since) empty.
-bool pieces_fit(std::string_view bytes, std::size_t at, std::uint64_t acquisitions, std::size_t listed) {
+/// before the checksum, only the tile's `passes` with triangles, those from `listed` on
+/// (acquisitions withdrawn since) empty.
+bool pieces_fit(std::string_view bytes, std::size_t at, std::uint64_t acquisitions, std::size_t listed,
+                std::span<const std::uint32_t> passes) {
   const std::size_t end = bytes.size() - sizeof(std::uint64_t);
   for (std::uint64_t a = 0; a < acquisitions; ++a) {
     std::uint64_t size = 0;
     if (end - at < sizeof size) return false;
     std::memcpy(&size, bytes.data() + at, sizeof size);
     at += sizeof size;
-    if (size > end - at || (a >= listed && size > 0)) return false;
+    if (size > end - at) return false;
+    if (size > 0 && (a >= listed || !std::binary_search(passes.begin(), passes.end(), a))) return false;
     at += size;
   }
   return true;
@@ -274,35 +335,34 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   const std::string_view bytes = *read;
   ResultHeader h{};
   std::uint64_t sum = 0;
-  if (bytes.size() < kHeader07Bytes + sizeof sum) return stale(file, "truncated");
+  if (bytes.size() < sizeof kMagic) return stale(file, "truncated");
+  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return older_version(file);
+  if (bytes.size() < sizeof h + sizeof sum) return stale(file, "truncated");
   std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
   if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale(file, "checksum mismatch");
-  std::size_t header_bytes = sizeof h;
-  if (std::memcmp(bytes.data(), kMagic07, sizeof kMagic07) == 0) {
-    header_bytes = kHeader07Bytes;
-  } else if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) {
-    return older_version(file);
-  }
-  if (bytes.size() < header_bytes + sizeof sum) return stale(file, "truncated");
-  std::memcpy(&h, bytes.data(), header_bytes);
+  std::memcpy(&h, bytes.data(), sizeof h);
   // Made from other inputs: another config (--force was given), a rewritten or added
-  // acquisition in this tile, or a dependency redone.
+  // acquisition in this tile, a dependency redone, or its passes renumbered.
   if (digest && h.fingerprint != *digest) return std::nullopt;
-  const std::size_t body = bytes.size() - sizeof sum - header_bytes;
+  const std::size_t body = bytes.size() - sizeof sum - sizeof h;
   // Counts are checked against the section sizes (a varint takes a byte at least, a piece
   // its 8-byte size) before anything is allocated. A result made before acquisitions were
   // appended holds fewer pieces, one made before the last ones were withdrawn more (empty):
   // the digest says the tile has none of the others.
   if (h.acquisitions > body / sizeof(std::uint64_t) || h.label_bytes > body || h.pair_bytes > body - h.label_bytes ||
-      h.refuted_bytes > body - h.label_bytes - h.pair_bytes || h.labels > h.label_bytes / kVarintsPerLabel ||
-      h.pairs > h.pair_bytes / kVarintsPerPair || h.refuted > h.refuted_bytes / kRefutedFields.size()) {
+      h.refuted_bytes > body - h.label_bytes - h.pair_bytes ||
+      h.passes > (body - h.label_bytes - h.pair_bytes - h.refuted_bytes) / sizeof(std::uint32_t) ||
+      h.labels > h.label_bytes / kVarintsPerLabel || h.pairs > h.pair_bytes / kVarintsPerPair ||
+      h.refuted > h.refuted_bytes / kRefutedFields.size()) {
     return stale(file, "counts do not fit");
   }
-  if (!pieces_fit(bytes, header_bytes + h.label_bytes + h.pair_bytes + h.refuted_bytes, h.acquisitions,
-                  store.triangles.size())) {
+  CheckedResult checked{h, std::move(*read)};
+  const std::vector<std::uint32_t> passes = checked.passes();
+  if (!passes_fit(passes, h.acquisitions)) return stale(file, "its list of acquisitions is damaged");
+  if (!pieces_fit(checked.bytes, checked.pieces_at(), h.acquisitions, store.triangles.size(), passes)) {
     return stale(file, "its pieces do not fit, or hold triangles of an acquisition the config no longer lists");
   }
-  return CheckedResult{h, header_bytes, std::move(*read)};
+  return checked;
 }
 
 }  // namespace
@@ -312,8 +372,6 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   const std::optional<CheckedResult> checked = checked_result(file, digest, store);
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
-  const std::string_view bytes = checked->bytes;
-  const std::size_t end = bytes.size() - sizeof(std::uint64_t);  // the checksum follows
   TileResult r;
   r.key = {h.i, h.j};
   r.triangles_in_tile = h.triangles_in_tile;
@@ -322,33 +380,23 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   r.seconds_mosaic = h.seconds_mosaic;
   r.change = stats_of(h.change);
   r.settled_fingerprint = h.settled_fingerprint;
-  std::size_t at = checked->header_bytes;
-  if (!decode_labels(bytes.substr(at, h.label_bytes), h.labels, r.labels)) return stale(file, "damaged labels");
-  at += h.label_bytes;
+  r.passes = checked->passes();
+  if (!decode_labels(checked->labels(), h.labels, r.labels)) return stale(file, "damaged labels");
   if (sections.pairs) {
-    std::optional<LabelPairList> pairs =
-        LabelPairList::from_bytes(std::string(bytes.substr(at, h.pair_bytes)), h.pairs);
+    std::optional<LabelPairList> pairs = LabelPairList::from_bytes(std::string(checked->pairs()), h.pairs);
     if (!pairs) return stale(file, "damaged pairs");
     r.pairs = std::move(*pairs);
   }
-  at += h.pair_bytes;
-  if (!decode_deltas(bytes.substr(at, h.refuted_bytes), h.refuted, kRefutedFields, r.refuted)) {
+  if (!decode_deltas(checked->refuted(), h.refuted, kRefutedFields, r.refuted)) {
     return stale(file, "damaged refuted copies");
   }
-  at += h.refuted_bytes;
   const Vec3d origin = TileGrid(store.grid).corner(r.key);
-  for (std::uint32_t a = 0; a < h.acquisitions; ++a) {
-    std::uint64_t size = 0;
-    if (end - at < sizeof size) return stale(file, "truncated");
-    std::memcpy(&size, bytes.data() + at, sizeof size);
-    at += sizeof size;
-    if (size > end - at) return stale(file, "truncated");
-    if (a >= store.triangles.size()) continue;  // withdrawn since: empty (checked_result)
+  const std::vector<std::string_view> pieces = checked->pieces();
+  for (std::uint32_t a = 0; a < pieces.size() && a < store.triangles.size(); ++a) {  // withdrawn since: empty
     TilePiece piece;
     piece.mesh.origin = origin;
-    if (size > 0) piece = decode_tile_blocks(bytes.substr(at, size), origin, a, file.string());
+    if (!pieces[a].empty()) piece = decode_tile_blocks(pieces[a], origin, a, file.string());
     r.selected.push_back(std::move(piece));
-    at += size;
   }
   while (r.selected.size() < store.triangles.size()) {
     r.selected.emplace_back();
@@ -365,11 +413,8 @@ std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::p
                                                         const TileStore& store) {
   const std::optional<CheckedResult> checked = checked_result(file, digest, store);
   if (!checked) return std::nullopt;
-  const ResultHeader& h = checked->header;
   std::vector<OwnedLabel> labels;
-  if (!decode_labels(std::string_view(checked->bytes).substr(checked->header_bytes, h.label_bytes), h.labels, labels)) {
-    return stale(file, "damaged labels");
-  }
+  if (!decode_labels(checked->labels(), checked->header.labels, labels)) return stale(file, "damaged labels");
   return labels;
 }
 
@@ -383,14 +428,80 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
   return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
 }
 
+namespace {
+
+/// The k-th of `from` as the k-th of `to`; nothing for an acquisition `from` does not hold.
+std::optional<std::uint32_t> renumbered(std::span<const std::uint32_t> from, std::span<const std::uint32_t> to,
+                                        std::uint32_t a) {
+  const auto it = std::lower_bound(from.begin(), from.end(), a);
+  if (it == from.end() || *it != a) return std::nullopt;
+  return to[static_cast<std::size_t>(it - from.begin())];
+}
+
+/// Writes `checked` again with every acquisition index `from[k]` made `to[k]`, under the
+/// digest `result`, marked kept, with `acquisitions` pieces; false when it names an
+/// acquisition `from` does not hold (then nothing is written). Both lists increase, so the
+/// map keeps the order of every sorted list: the file is what processing the tile under the
+/// new numbering writes (but for its timings).
+bool write_renumbered(const std::filesystem::path& file, const CheckedResult& checked,
+                      std::span<const std::uint32_t> from, std::span<const std::uint32_t> to, std::uint64_t result,
+                      std::size_t acquisitions) {
+  const ResultHeader& h = checked.header;
+  std::vector<OwnedLabel> labels;
+  std::vector<RefutedCopy> refuted;
+  const std::optional<LabelPairList> pairs = LabelPairList::from_bytes(std::string(checked.pairs()), h.pairs);
+  if (!pairs || !decode_labels(checked.labels(), h.labels, labels) ||
+      !decode_deltas(checked.refuted(), h.refuted, kRefutedFields, refuted)) {
+    return false;
+  }
+  const auto map = [&](std::uint32_t& a) {
+    const std::optional<std::uint32_t> b = renumbered(from, to, a);
+    if (b) a = *b;
+    return b.has_value();
+  };
+  for (OwnedLabel& l : labels) {
+    if (!map(l.acquisition)) return false;
+  }
+  for (RefutedCopy& c : refuted) {
+    if (!map(c.acquisition)) return false;
+  }
+  LabelPairList mapped;
+  mapped.reserve(pairs->bytes().size());
+  for (LabelPair p : *pairs) {
+    if (!map(p.a_acquisition) || !map(p.b_acquisition)) return false;
+    mapped.push_back(p);
+  }
+  const std::vector<std::string_view> pieces = checked.pieces();
+  std::vector<std::string_view> moved(acquisitions);
+  for (std::size_t k = 0; k < from.size(); ++k) {
+    if (to[k] >= acquisitions) return false;
+    moved[to[k]] = pieces[from[k]];  // passes_fit: from[k] < pieces.size()
+  }
+  ResultHeader renamed = h;
+  renamed.fingerprint = result;
+  renamed.kept = 1;
+  const VarintWriter label_bytes = encode_labels(labels);
+  const VarintWriter refuted_bytes = encode_deltas<RefutedCopy>(refuted, kRefutedFields);
+  write_result(file, renamed, {label_bytes.bytes(), mapped.bytes(), refuted_bytes.bytes(), to, acquisitions},
+               [&](std::size_t a) { return moved[a]; });
+  return true;
+}
+
+}  // namespace
+
 bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, const ResultOrigin& made_from,
-                         std::uint64_t result) {
+                         std::uint64_t result, std::span<const std::uint32_t> passes) {
   std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
-  // Only a whole result of this version (a version 07 header has no room for the kept flag)
-  // made from what the caller was told: the file may have been replaced since it looked.
-  if (!checked || checked->header_bytes != sizeof(ResultHeader)) return false;
+  // Only a whole result made from what the caller was told: the file may have been replaced
+  // since it looked.
+  if (!checked) return false;
   const ResultHeader& h = checked->header;
   if (h.inputs_fingerprint != made_from.inputs || h.settled_fingerprint != made_from.settled) return false;
+  const std::vector<std::uint32_t> held = checked->passes();
+  if (held.size() != passes.size()) return false;
+  if (!std::ranges::equal(held, passes)) {
+    return write_renumbered(file, *checked, held, passes, result, store.triangles.size());
+  }
   std::string& bytes = checked->bytes;
   std::memcpy(bytes.data() + offsetof(ResultHeader, fingerprint), &result, sizeof result);
   const std::uint64_t kept = 1;

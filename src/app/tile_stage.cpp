@@ -267,8 +267,10 @@ TileStageReport process_tiles(const Config& config, const TileStore& store, cons
       const SettledSelection settled = settled_selection(config, store, k, digests.result);
       const ResultDigests own{digests.result[k], digests.inputs[k]};
       if (keep_if_still_right(result_path(config, tile.key), store, tile.key, own, settled)) {
-        log::debug("tile {}: a neighbour was redone to the same decisions on its border: its result is kept",
-                   tile.key.name());
+        log::debug(
+            "tile {}: the same inputs and border decisions (a neighbour was redone to the same, or its passes "
+            "renumbered): its result is kept",
+            tile.key.name());
         kept[item] = true;
       } else {
         const TileResult r = process_tile(store, tile.key, config, settled);

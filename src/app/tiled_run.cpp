@@ -303,7 +303,8 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   report["citymesh"] = {{"version", CITYMESH_VERSION}, {"build", build_name()}};
   report["tiles"] = store.tiles.size();
   report["reused_tiles"] = reused;
-  report["kept_tiles"] = tiles.kept;  // of the reused: kept when a neighbour was redone
+  // Of the reused: kept when a neighbour was redone or a pass delivered late renumbered theirs.
+  report["kept_tiles"] = tiles.kept;
   report["input_triangles"] = assembly.owned();
   report["output_triangles"] = output_triangles;
   report["ranks"] = ranks;
@@ -326,7 +327,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   const std::string rate = reused == 0 ? fmt::format("{:.2f} M triangles/s",
                                                      static_cast<double>(assembly.owned()) / std::max(wall, 1e-9) / 1e6)
                                        : std::string("no rate: tiles reused");
-  const std::string kept = tiles.kept > 0 ? fmt::format(", {} kept after a neighbour was redone", tiles.kept) : "";
+  const std::string kept =
+      tiles.kept > 0 ? fmt::format(", {} of them kept: a neighbour redone, or their passes renumbered", tiles.kept)
+                     : "";
   std::cout << fmt::format(
       "run: {} tiles ({} reused{}), {} input triangles -> {} output triangles in {:.2f} s ({}), {} rank(s), peak "
       "memory {:.0f} MiB (rank 0)\n",
@@ -381,7 +384,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   }
   const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
   const TileStore store = prepare_tile_store(config, fingerprints, cluster, options.subset);
-  const TileDigests digests = tile_digests(store, fingerprints.settings, fingerprints.acquisitions);
+  const TileDigests digests = tile_digests(store, fingerprints.settings, fingerprints.identities);
   // Each stage's arrays differ from the last one's: the memory one freed goes back to the
   // system instead of staying resident under the next one's peak.
   release_freed_memory();
@@ -416,7 +419,7 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     (config.project.work / "tiles").string()));
   }
   const std::vector<std::uint64_t> digests =
-      tile_digests(*store, fingerprints.settings, fingerprints.acquisitions).result;
+      tile_digests(*store, fingerprints.settings, fingerprints.identities).result;
   std::vector<std::string> missing;
   for (std::size_t k = 0; k < store->tiles.size(); ++k) {
     // Whole (the checksum covers every section): decoded once, when the outputs read them.

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -67,6 +68,7 @@ TileResult random_result(std::uint32_t seed, bool scan_order) {
   }
   std::sort(r.refuted.begin(), r.refuted.end());
   r.selected.resize(2);
+  r.passes = {0, 1};
   for (TilePiece& p : r.selected) p.mesh.origin = {651000 + 50 * 13020.0, 6860000 - 50 * 7.0, 0};
   return r;
 }
@@ -186,6 +188,7 @@ TEST(TileResult, AResultMadeBeforeTheLastAcquisitionWasWithdrawnReadsWhenItHolds
   // One that holds a triangle of the withdrawn acquisition is not used (the digest, which
   // counts the tile's triangles of each acquisition, says so first).
   r.selected[2] = one_triangle(2);
+  r.passes = {0, 1, 2};
   write_tile_result(tmp / "piece.bin", r, kDigests);
   EXPECT_FALSE(read_tile_result(tmp / "piece.bin", kFingerprint, two).has_value());
   EXPECT_FALSE(read_tile_labels(tmp / "piece.bin", kFingerprint, two).has_value());
@@ -244,9 +247,9 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   // Not when the file holds a result made from something else than the caller saw.
   ResultOrigin other = *origin;
   ++other.settled;
-  EXPECT_FALSE(restamp_tile_result(tmp / "t.bin", store, other, kFingerprint + 7));
+  EXPECT_FALSE(restamp_tile_result(tmp / "t.bin", store, other, kFingerprint + 7, r.passes));
   EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store)) << "left as it was";
-  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, *origin, kFingerprint + 7));
+  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", store, *origin, kFingerprint + 7, r.passes));
   EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 7, store));
   EXPECT_FALSE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
   const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint + 7, store);
@@ -259,43 +262,95 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   EXPECT_EQ(again->inputs, kDigests.inputs);
   EXPECT_TRUE(again->kept) << "the report tells kept results from processed ones by it";
   // Nothing to write again: no file, or a damaged one (left as it is).
-  EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, *origin, 1));
+  EXPECT_FALSE(restamp_tile_result(tmp / "none.bin", store, *origin, 1, r.passes));
   EXPECT_FALSE(tile_result_origin(tmp / "none.bin").has_value());
   std::string bytes = *read_file_bytes(tmp / "t.bin");
   bytes[300] ^= 1;
   std::ofstream(tmp / "bad.bin", std::ios::binary) << bytes;
   EXPECT_TRUE(tile_result_origin(tmp / "bad.bin").has_value()) << "the header alone is read";
-  EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, *origin, 1)) << "but the whole file is checked";
+  EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, *origin, 1, r.passes)) << "but the whole file is checked";
   EXPECT_EQ(*read_file_bytes(tmp / "bad.bin"), bytes);
 }
 
-TEST(TileResult, AVersion07ResultIsStillReadButNeverKeptAfterANeighbour) {
+TEST(TileResult, AResultOfAnOlderVersionIsProcessedAgain) {
   test::TempDir tmp;
   const TileStore store = two_acquisitions();
-  const TileResult r = random_result(9, true);
-  write_tile_result(tmp / "t.bin", r, kDigests);
-  // Version 07: the same header without its last 24 bytes (what the result was made from).
+  write_tile_result(tmp / "t.bin", random_result(9, true), kDigests);
+  ASSERT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint, store));
   std::string bytes = *read_file_bytes(tmp / "t.bin");
-  bytes.erase(200, 24);
-  bytes[7] = '7';
+  bytes[7] = '8';  // version 08: no list of the tile's acquisitions
   const std::uint64_t sum = bulk_checksum(bytes.data(), bytes.size() - 8);
   std::memcpy(bytes.data() + bytes.size() - 8, &sum, 8);
-  std::ofstream(tmp / "v7.bin", std::ios::binary) << bytes;
-  const std::optional<TileResult> back = read_tile_result(tmp / "v7.bin", kFingerprint, store);
+  std::ofstream(tmp / "v8.bin", std::ios::binary) << bytes;
+  EXPECT_FALSE(tile_result_is_finished(tmp / "v8.bin", kFingerprint, store));
+  EXPECT_FALSE(read_tile_result(tmp / "v8.bin", kFingerprint, store).has_value());
+  EXPECT_FALSE(tile_result_origin(tmp / "v8.bin").has_value());
+}
+
+/// A result of a tile holding acquisitions `passes` (two of them) of `acquisitions`: labels,
+/// pairs and refuted copies of both, sorted as process_tile writes them, and a selected
+/// triangle of each.
+TileResult result_of_two_passes(std::array<std::uint32_t, 2> passes, std::uint32_t acquisitions) {
+  TileResult r = random_result(12, true);  // labels and refuted copies of acquisitions 0 and 1
+  for (OwnedLabel& l : r.labels) l.acquisition = passes[l.acquisition];
+  for (RefutedCopy& c : r.refuted) c.acquisition = passes[c.acquisition];
+  r.pairs = {};
+  for (std::uint32_t k = 0; k < 60; ++k) {  // sorted, the smaller end first
+    r.pairs.push_back({passes[k / 40], k, passes[1], 1000 - k});
+  }
+  r.selected.assign(acquisitions, TilePiece{});
+  for (TilePiece& p : r.selected) p.mesh.origin = one_triangle(0).mesh.origin;
+  for (const std::uint32_t a : passes) r.selected[a] = one_triangle(a);
+  r.passes = {passes.begin(), passes.end()};
+  return r;
+}
+
+TEST(TileResult, AResultWhosePassesWereRenumberedIsWrittenAgainAsProcessingUnderTheNewNumberingWrites) {
+  // Made when the tile held acquisitions 0 and 2 of three; a pass delivered late, older than
+  // both, and another between them make them 1 and 3 of five.
+  test::TempDir tmp;
+  TileStore five = two_acquisitions();
+  five.triangles = {1000, 1000, 1000, 1000, 1000};
+  const TileResult made = result_of_two_passes({0, 2}, 3);
+  write_tile_result(tmp / "t.bin", made, kDigests);
+  const std::optional<ResultOrigin> origin = tile_result_origin(tmp / "t.bin");
+  ASSERT_TRUE(origin.has_value());
+  const std::vector<std::uint32_t> now{1, 3};
+  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", five, *origin, kFingerprint + 1, now));
+  EXPECT_TRUE(tile_result_origin(tmp / "t.bin")->kept);
+  const std::optional<TileResult> back = read_tile_result(tmp / "t.bin", kFingerprint + 1, five);
   ASSERT_TRUE(back.has_value());
-  expect_same_labels(back->labels, r.labels);
-  EXPECT_EQ(back->refuted, r.refuted);
-  EXPECT_TRUE(tile_result_is_finished(tmp / "v7.bin", kFingerprint, store));
-  EXPECT_FALSE(tile_result_origin(tmp / "v7.bin").has_value());
-  // Its header has no room for the kept flag: never written again that way (nor damaged).
-  EXPECT_FALSE(restamp_tile_result(tmp / "v7.bin", store, ResultOrigin{}, kFingerprint + 1));
-  EXPECT_EQ(*read_file_bytes(tmp / "v7.bin"), bytes);
-  // Version 06 is another layout: processed again.
-  bytes[7] = '6';
-  const std::uint64_t sum6 = bulk_checksum(bytes.data(), bytes.size() - 8);
-  std::memcpy(bytes.data() + bytes.size() - 8, &sum6, 8);
-  std::ofstream(tmp / "v6.bin", std::ios::binary) << bytes;
-  EXPECT_FALSE(tile_result_is_finished(tmp / "v6.bin", kFingerprint, store));
+  EXPECT_EQ(back->passes, now);
+  ASSERT_EQ(back->selected.size(), 5u);
+  for (std::uint32_t a = 0; a < 5; ++a) {
+    EXPECT_EQ(back->selected[a].triangle_count(), a == 1 || a == 3 ? 1u : 0u) << a;
+    if (a == 1 || a == 3) {
+      EXPECT_EQ(back->selected[a].mesh.triangle_ids[0].acquisition, a);
+    }
+  }
+  // The file is, to the byte, that of the same tile processed under the new numbering (and
+  // kept under the same digest).
+  write_tile_result(tmp / "fresh.bin", result_of_two_passes({1, 3}, 5), kDigests);
+  ASSERT_TRUE(restamp_tile_result(tmp / "fresh.bin", five, *origin, kFingerprint + 1, now));
+  EXPECT_EQ(*read_file_bytes(tmp / "t.bin"), *read_file_bytes(tmp / "fresh.bin"));
+
+  // Not when the tile holds another number of passes, nor when the result names an
+  // acquisition it did not list: left as it is (the tile is processed again).
+  write_tile_result(tmp / "t.bin", made, kDigests);
+  const std::string bytes = *read_file_bytes(tmp / "t.bin");
+  EXPECT_FALSE(restamp_tile_result(tmp / "t.bin", five, *origin, kFingerprint + 1, std::vector<std::uint32_t>{1}));
+  TileResult stray = made;
+  stray.labels.back().acquisition = 3;  // past the last of its passes, still sorted
+  write_tile_result(tmp / "stray.bin", stray, kDigests);
+  const std::string stray_bytes = *read_file_bytes(tmp / "stray.bin");
+  EXPECT_FALSE(restamp_tile_result(tmp / "stray.bin", five, *origin, kFingerprint + 1, now));
+  EXPECT_EQ(*read_file_bytes(tmp / "stray.bin"), stray_bytes);
+  EXPECT_EQ(*read_file_bytes(tmp / "t.bin"), bytes);
+  // A piece of an acquisition it does not list: not a result of this tile.
+  TileResult unlisted = made;
+  unlisted.selected[1] = one_triangle(1);
+  write_tile_result(tmp / "unlisted.bin", unlisted, kDigests);
+  EXPECT_FALSE(tile_result_is_finished(tmp / "unlisted.bin", kFingerprint, five));
 }
 
 TEST(SettledSelection, AnswersAsAMapOfEveryNeighboursLabels) {

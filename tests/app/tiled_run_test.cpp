@@ -583,6 +583,66 @@ TEST(TiledRun, AcquisitionsListedOutOfDateOrderGiveTheSameMapNamedByTheirPlaceIn
   expect_same_outputs(dir / "sim/i", dir / "sim/l", "a pass delivered late differs from a fresh run");
 }
 
+/// Epoch 2's pass cut to the first `share` of the street (acq_2_part.ply), its table listed
+/// last in late-part.toml after the five others (five.toml, as write_late_configs). False when
+/// the config is not the simulator's six passes.
+bool write_late_part_configs(const std::filesystem::path& sim, double share) {
+  if (!write_late_configs(sim)) return false;
+  std::string late = test::read_text(sim / "late.toml");
+  const std::size_t path = late.find("acq_2.ply");
+  if (path == std::string::npos) return false;
+  late.replace(path, 9, "acq_2_part.ply");
+  test::write_text(sim / "late-part.toml", late);
+  write_mesh_ply(sim / "acq_2_part.ply", test::first_part(read_mesh(sim / "acq_2.ply").mesh, share));
+  return true;
+}
+
+TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedToTheBytesOfAFreshRun) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
+  // Epoch 2 over the first 21 m of the 60 m street, delivered after the run of the five
+  // others: epochs 3 to 5 become 3rd to 5th by time in every tile, but only the tiles of the
+  // first three 10 m columns (and their later-phase neighbours) hold the new pass.
+  ASSERT_TRUE(write_late_part_configs(dir / "sim", 0.35));
+  const auto run = [&](const std::string& file, const std::string& name) {
+    return test::run_citymesh(run_file_args(sim, file, name, "--set tiling.tile_size=10"));
+  };
+  ASSERT_EQ(run("five.toml", "l").exit_code, 0);
+  const auto late = run("late-part.toml", "l");
+  ASSERT_EQ(late.exit_code, 0) << late.err;
+  EXPECT_NE(late.err.find("1 pass(es) added since the last run, older than passes already processed"),
+            std::string::npos)
+      << late.err;
+  const nlohmann::json report = read_json(dir / "sim/l/run.json");
+  const nlohmann::json manifest = read_json(dir / "sim/work-l/tiles/manifest.json");
+  std::set<std::string> reached, renumbered;  // by epoch 2 (now acquisition 2 by time); the others
+  for (const auto& tile : manifest["tiles"]) {
+    const auto& counts = tile["triangles"];
+    const std::string key = fmt::format("{}_{}", tile["i"].get<int>(), tile["j"].get<int>());
+    ASSERT_EQ(counts.size(), 6u);
+    (counts[2][0].get<int>() + counts[2][1].get<int>() + counts[2][2].get<int>() > 0 ? reached : renumbered)
+        .insert(key);
+  }
+  ASSERT_FALSE(reached.empty());
+  ASSERT_FALSE(renumbered.empty());
+  std::set<std::string> processed;
+  for (const auto& entry : report["per_tile"]) {
+    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
+  }
+  for (const std::string& tile : reached) EXPECT_TRUE(processed.contains(tile)) << tile << " is reached";
+  // Every tile holds a renumbered pass, so none is reused as it was; those the new pass does
+  // not reach are kept renumbered, unless a decision on their border changed.
+  EXPECT_EQ(report["reused_tiles"], report["kept_tiles"]);
+  EXPECT_GE(report["kept_tiles"].get<std::size_t>(), renumbered.size() / 2) << late.err;
+  EXPECT_LT(processed.size(), report["tiles"].get<std::size_t>());
+
+  const auto fresh = run("late-part.toml", "f");
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
+  ASSERT_GE(test::result_bytes(dir / "sim/f").size(), 8u);
+  expect_same_outputs(dir / "sim/l", dir / "sim/f", "a pass delivered late differs from a fresh run");
+}
+
 /// `files` without the change step's labelled outputs (detect/...).
 std::map<std::string, std::string> without_labels(std::map<std::string, std::string> files) {
   std::erase_if(files, [](const auto& f) { return f.first.starts_with("detect/"); });

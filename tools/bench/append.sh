@@ -9,7 +9,7 @@
 #   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
 # LATE=1: the district's pass is dated one day after the first acquisition (a pass delivered
 #   late, listed last): the run processes it second by time, so the later passes are
-#   renumbered and every tile holding one is redone (session 74).
+#   renumbered; the tiles it does not reach keep their results, renumbered (session 75).
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 if [ $# -lt 5 ] || [ ! -f "$1/config.toml" ]; then
@@ -43,7 +43,7 @@ same_as() {  # output folder against another: mosaic.ply and 3D Tiles
   cmp -s "$dir/$1/mosaic/mosaic.ply" "$dir/$2/mosaic/mosaic.ply" && diff -rq "$dir/$1/tiles" "$dir/$2/tiles" >/dev/null
 }
 reused() {  # what the last run into out-append reused
-  python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} kept when a neighbour was redone)\")"
+  python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} of them kept: a neighbour redone, or their passes renumbered)\")"
 }
 rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh" "$dir/out-before"
 echo "every acquisition but the last:"

@@ -38,6 +38,8 @@ struct TileContents {
   std::vector<std::vector<ByteRange>> blocks;
   [[nodiscard]] std::uint64_t owned() const;
   [[nodiscard]] std::uint64_t total() const;
+  /// The acquisitions the tile holds triangles of (any role), by index.
+  [[nodiscard]] std::vector<std::uint32_t> passes() const;
 };
 
 struct TilingStats {
