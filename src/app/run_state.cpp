@@ -224,12 +224,13 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     if (const std::size_t now = acquisition_count(keys); renumbered && now > recorded) {
       log::info(
           "{} pass(es) added since the last run, older than passes already processed: the tiles they reach "
-          "are redone, and those of the passes after them by time (renumbered)",
+          "are redone; the passes after them by time are renumbered (tiled again, and the other tiles' results "
+          "renumbered)",
           now - recorded);
     } else if (renumbered) {
       log::info(
-          "{} pass(es) removed since the last run, older than the newest: the tiles they reached are redone, "
-          "and those of the passes after them by time (renumbered)",
+          "{} pass(es) removed since the last run, older than the newest: the tiles they reached are redone; "
+          "the passes after them by time are renumbered (tiled again, and the other tiles' results renumbered)",
           recorded - now);
     }
     for (const auto& [k, v] : keys) {

@@ -4,6 +4,7 @@
 #include <array>
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <span>
@@ -327,9 +328,11 @@ bool pieces_fit(std::string_view bytes, std::size_t at, std::uint64_t acquisitio
   return true;
 }
 
-/// The result in `file` when it is whole and was made under `digest` (any digest: nothing).
+/// The result in `file` when it is whole and was made under `digest` (any digest: nothing),
+/// read under the numbering of a config listing `listed` acquisitions (pieces of those past
+/// it refused; any: as restamp_tile_result reads it, to renumber).
 std::optional<CheckedResult> checked_result(const std::filesystem::path& file, std::optional<std::uint64_t> digest,
-                                            const TileStore& store) {
+                                            std::size_t listed) {
   std::optional<std::string> read = read_file_bytes(file);
   if (!read) return std::nullopt;
   const std::string_view bytes = *read;
@@ -359,7 +362,7 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   CheckedResult checked{h, std::move(*read)};
   const std::vector<std::uint32_t> passes = checked.passes();
   if (!passes_fit(passes, h.acquisitions)) return stale(file, "its list of acquisitions is damaged");
-  if (!pieces_fit(checked.bytes, checked.pieces_at(), h.acquisitions, store.triangles.size(), passes)) {
+  if (!pieces_fit(checked.bytes, checked.pieces_at(), h.acquisitions, listed, passes)) {
     return stale(file, "its pieces do not fit, or hold triangles of an acquisition the config no longer lists");
   }
   return checked;
@@ -369,7 +372,7 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
 
 std::optional<TileResult> read_tile_result(const std::filesystem::path& file, std::uint64_t digest,
                                            const TileStore& store, TileResultSections sections) {
-  const std::optional<CheckedResult> checked = checked_result(file, digest, store);
+  const std::optional<CheckedResult> checked = checked_result(file, digest, store.triangles.size());
   if (!checked) return std::nullopt;
   const ResultHeader& h = checked->header;
   TileResult r;
@@ -406,12 +409,12 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
 }
 
 bool tile_result_is_finished(const std::filesystem::path& file, std::uint64_t digest, const TileStore& store) {
-  return checked_result(file, digest, store).has_value();
+  return checked_result(file, digest, store.triangles.size()).has_value();
 }
 
 std::optional<std::vector<OwnedLabel>> read_tile_labels(const std::filesystem::path& file, std::uint64_t digest,
                                                         const TileStore& store) {
-  const std::optional<CheckedResult> checked = checked_result(file, digest, store);
+  const std::optional<CheckedResult> checked = checked_result(file, digest, store.triangles.size());
   if (!checked) return std::nullopt;
   std::vector<OwnedLabel> labels;
   if (!decode_labels(checked->labels(), checked->header.labels, labels)) return stale(file, "damaged labels");
@@ -491,7 +494,9 @@ bool write_renumbered(const std::filesystem::path& file, const CheckedResult& ch
 
 bool restamp_tile_result(const std::filesystem::path& file, const TileStore& store, const ResultOrigin& made_from,
                          std::uint64_t result, std::span<const std::uint32_t> passes) {
-  std::optional<CheckedResult> checked = checked_result(file, std::nullopt, store);
+  // Any number of acquisitions: a pass removed before the newest moves the later ones' pieces
+  // down (the renumbering below), and pieces lie only at the result's passes (checked).
+  std::optional<CheckedResult> checked = checked_result(file, std::nullopt, SIZE_MAX);
   // Only a whole result made from what the caller was told: the file may have been replaced
   // since it looked.
   if (!checked) return false;

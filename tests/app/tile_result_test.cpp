@@ -333,6 +333,15 @@ TEST(TileResult, AResultWhosePassesWereRenumberedIsWrittenAgainAsProcessingUnder
   write_tile_result(tmp / "fresh.bin", result_of_two_passes({1, 3}, 5), kDigests);
   ASSERT_TRUE(restamp_tile_result(tmp / "fresh.bin", five, *origin, kFingerprint + 1, now));
   EXPECT_EQ(*read_file_bytes(tmp / "t.bin"), *read_file_bytes(tmp / "fresh.bin"));
+  // And back when those two passes are removed again: the numbering it was made under (its
+  // pieces past the three acquisitions listed now move down).
+  TileStore three = five;
+  three.triangles.resize(3);
+  ASSERT_TRUE(restamp_tile_result(tmp / "t.bin", three, *origin, kFingerprint + 2, made.passes));
+  write_tile_result(tmp / "first.bin", made, kDigests);
+  ASSERT_TRUE(restamp_tile_result(tmp / "first.bin", three, *origin, kFingerprint + 2, made.passes));
+  EXPECT_EQ(*read_file_bytes(tmp / "t.bin"), *read_file_bytes(tmp / "first.bin"));
+  EXPECT_TRUE(tile_result_is_finished(tmp / "t.bin", kFingerprint + 2, three));
 
   // Not when the tile holds another number of passes, nor when the result names an
   // acquisition it did not list: left as it is (the tile is processed again).

@@ -609,6 +609,7 @@ TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedT
     return test::run_citymesh(run_file_args(sim, file, name, "--set tiling.tile_size=10"));
   };
   ASSERT_EQ(run("five.toml", "l").exit_code, 0);
+  const auto five = test::result_bytes(dir / "sim/l");
   const auto late = run("late-part.toml", "l");
   ASSERT_EQ(late.exit_code, 0) << late.err;
   EXPECT_NE(late.err.find("1 pass(es) added since the last run, older than passes already processed"),
@@ -641,6 +642,16 @@ TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedT
   ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
   ASSERT_GE(test::result_bytes(dir / "sim/f").size(), 8u);
   expect_same_outputs(dir / "sim/l", dir / "sim/f", "a pass delivered late differs from a fresh run");
+
+  // Removed again (found faulty): the later passes move back down, the tiles it reached are
+  // redone and the others kept, renumbered, to the bytes of the first run.
+  const auto removed = run("five.toml", "l");
+  ASSERT_EQ(removed.exit_code, 0) << removed.err;
+  EXPECT_EQ(removed.err.find("processed again"), std::string::npos) << removed.err;
+  const nlohmann::json after = read_json(dir / "sim/l/run.json");
+  EXPECT_EQ(after["reused_tiles"], after["kept_tiles"]);
+  EXPECT_GE(after["kept_tiles"].get<std::size_t>(), renumbered.size() / 2) << removed.err;
+  EXPECT_TRUE(test::result_bytes(dir / "sim/l") == five) << "removing the late pass differs from the first run";
 }
 
 /// `files` without the change step's labelled outputs (detect/...).
