@@ -71,7 +71,7 @@ struct TileResult {
   /// Per acquisition, the selected owned triangles with their vertices (tile frame).
   std::vector<TilePiece> selected;
   /// The acquisitions the tile held (TileContents::passes) in the numbering of the ids above:
-  /// what renumber_tile_result maps from when a pass delivered late renumbers them.
+  /// what restamp_tile_result maps from when a pass delivered late renumbers them.
   std::vector<std::uint32_t> passes;
   double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
   std::uint64_t triangles_in_tile = 0;  ///< owned, halo and empty space

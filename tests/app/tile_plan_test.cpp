@@ -239,6 +239,33 @@ TEST(TilePlan, AChangedAcquisitionChangesTheDigestsOfTheTilesItReachesAndOfTheir
   EXPECT_THROW((void)tile_digests(store, 7, std::vector<std::uint64_t>{100}), ProcessingError);
 }
 
+TEST(TilePlan, APassInsertedBeforeOthersLeavesTheInputsOfTheTilesItDoesNotReachButNotTheirResults) {
+  std::mt19937 rng(12);
+  TileStore store = random_store(rng, 12, 10);  // acquisition 0 everywhere
+  for (TileContents& t : store.tiles) t.triangles.push_back({1 + rng() % 50, rng() % 9, 0});  // 1 everywhere
+  const TileDigests before = tile_digests(store, 7, std::vector<std::uint64_t>{100, 200});
+  // A pass older than acquisition 1 (delivered late) over the western tiles: it becomes 1,
+  // and the pass that was 1 becomes 2 everywhere.
+  TileStore late = store;
+  for (TileContents& t : late.tiles) {
+    const std::uint64_t owned = t.key.i < 3 ? 1 + rng() % 50 : 0;
+    t.triangles.insert(t.triangles.begin() + 1, {owned, 0, 0});
+  }
+  const TileDigests after = tile_digests(late, 7, std::vector<std::uint64_t>{100, 150, 200});
+  std::size_t same_inputs = 0;
+  for (std::size_t k = 0; k < store.tiles.size(); ++k) {
+    const bool reached = late.tiles[k].triangles[1][0] > 0;
+    EXPECT_EQ(late.tiles[k].passes(),
+              (reached ? std::vector<std::uint32_t>{0, 1, 2} : std::vector<std::uint32_t>{0, 2}));
+    // The same passes in the same order: the same inputs, but another numbering of them.
+    EXPECT_EQ(after.inputs[k] == before.inputs[k], !reached) << store.tiles[k].key.name();
+    EXPECT_NE(after.result[k], before.result[k]) << store.tiles[k].key.name();
+    same_inputs += reached ? 0 : 1;
+  }
+  EXPECT_GT(same_inputs, 0u);
+  EXPECT_LT(same_inputs, store.tiles.size());
+}
+
 TEST(TilePlan, SubsetParsing) {
   const Subset s = Subset::parse("2/8");
   EXPECT_EQ(s.index, 2u);
