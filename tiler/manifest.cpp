@@ -2,10 +2,12 @@
 // The tile store's manifest: written last, so a store without one is unfinished.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "citymesh/core/atomic_file.h"
@@ -169,6 +171,63 @@ std::optional<AcquisitionTiling> publish_acquisition_tiling(const std::filesyste
   }
   replace_directory_atomically(staged, target);
   return std::nullopt;
+}
+
+namespace {
+
+/// The fingerprint the summary in `folder` was made with, when it is of this version (the
+/// rest is checked by read_summary when the folder is used).
+std::optional<std::string> summary_fingerprint(const std::filesystem::path& folder) {
+  std::ifstream in(folder / kSummaryFile);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    if (j.at("version").get<int>() != kSummaryVersion) return std::nullopt;
+    return j.at("fingerprint").get<std::string>();
+  } catch (const nlohmann::json::exception&) {
+    return std::nullopt;
+  }
+}
+
+}  // namespace
+
+std::size_t move_renumbered_tilings(const std::filesystem::path& dir,
+                                    std::span<const std::string> acquisition_fingerprints) {
+  std::map<std::size_t, std::string> held;  // per acquisition folder, its fingerprint
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+    const std::optional<std::size_t> k = acquisition_folder_index(entry.path().filename().string());
+    if (!k) continue;
+    if (std::optional<std::string> f = summary_fingerprint(entry.path())) held.emplace(*k, std::move(*f));
+  }
+  std::vector<std::pair<std::size_t, std::size_t>> moves;  // from folder, to folder
+  for (std::size_t k = 0; k < acquisition_fingerprints.size(); ++k) {
+    const auto own = held.find(k);
+    if (own != held.end() && own->second == acquisition_fingerprints[k]) continue;
+    const auto from = std::find_if(held.begin(), held.end(), [&](const auto& h) {
+      return h.first != k && h.second == acquisition_fingerprints[k];
+    });
+    if (from != held.end()) moves.emplace_back(from->first, k);
+  }
+  if (moves.empty()) return 0;
+  // Every folder is moved aside before any is put in place: a folder may be the source of one
+  // move and the target of another. A run killed between the two leaves them in staging,
+  // which the next run removes (those acquisitions are then tiled again).
+  const std::filesystem::path staging = dir / kStagingFolder;
+  std::filesystem::create_directories(staging, ec);
+  std::vector<std::filesystem::path> aside;
+  for (const auto& [from, to] : moves) {
+    const std::filesystem::path source = acquisition_tiles_path(dir, static_cast<std::uint32_t>(from));
+    aside.push_back(staging / fmt::format("renumbered.a{}.{}", to, process_tag()));
+    if (std::rename(source.c_str(), aside.back().c_str()) != 0) {
+      throw OutputError(
+          fmt::format("{}: cannot move the tiled acquisition aside: {}", source.string(), std::strerror(errno)));
+    }
+  }
+  for (std::size_t m = 0; m < moves.size(); ++m) {
+    replace_directory_atomically(aside[m], acquisition_tiles_path(dir, static_cast<std::uint32_t>(moves[m].second)));
+  }
+  return moves.size();
 }
 
 void prune_tile_store(const std::filesystem::path& dir, std::span<const std::string> acquisition_fingerprints,

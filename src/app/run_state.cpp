@@ -187,11 +187,11 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
   RunFingerprints f;
   f.settings = hash(settings);
   std::string store = tiling;
-  for (const std::string& lines : own) {
+  for (const std::string& lines : own) store += lines;
+  for (const std::string& lines : identity) {
     f.acquisitions.push_back(hash(tiling + lines));
-    store += lines;
+    f.identities.push_back(hash(lines));
   }
-  for (const std::string& lines : identity) f.identities.push_back(hash(lines));
   f.store = hash(store);
   return f;
 }
@@ -224,13 +224,13 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
     if (const std::size_t now = acquisition_count(keys); renumbered && now > recorded) {
       log::info(
           "{} pass(es) added since the last run, older than passes already processed: the tiles they reach "
-          "are redone; the passes after them by time are renumbered (tiled again, and the other tiles' results "
-          "renumbered)",
+          "are redone; the passes after them by time are renumbered, and so are their tiling and the other "
+          "tiles' results",
           now - recorded);
     } else if (renumbered) {
       log::info(
           "{} pass(es) removed since the last run, older than the newest: the tiles they reached are redone; "
-          "the passes after them by time are renumbered (tiled again, and the other tiles' results renumbered)",
+          "the passes after them by time are renumbered, and so are their tiling and the other tiles' results",
           recorded - now);
     }
     for (const auto& [k, v] : keys) {

@@ -28,11 +28,12 @@ struct RunFingerprints {
   /// depends on them.
   std::uint64_t settings = 0;
   /// Per acquisition: the keys that change the tile store (input, tiling) and its own keys
-  /// (path, file size and time, date...): its tiled folder, and the tile results it is in.
+  /// without its index (path, file size and time, date...): its tiled folder, found by it
+  /// when a pass delivered late renumbers the passes after it (move_renumbered_tilings).
   std::vector<std::uint64_t> acquisitions;
   /// Per acquisition: its own keys without its index (what `acquisitions` holds but the
-  /// tiling keys and the index). A pass delivered late renumbers the passes after it by time;
-  /// their identities stay, so a tile it does not reach is known to hold the same passes.
+  /// tiling keys). A pass delivered late renumbers the passes after it by time; their
+  /// identities stay, so a tile it does not reach is known to hold the same passes.
   std::vector<std::uint64_t> identities;
   /// The tile store as a whole (its manifest): the tiling keys and every acquisition's.
   std::uint64_t store = 0;

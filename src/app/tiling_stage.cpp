@@ -90,7 +90,15 @@ TileStore reused_or_tiled_store(const Config& config, const RunFingerprints& fin
   Stopwatch clock;
   const std::vector<Acquisition> acquisitions = config.acquisition_list();
   const std::vector<std::uint64_t> sizes = file_sizes(acquisitions);
-  // Only a run that owns the folder removes unfinished staging: subsets may be tiling there.
+  // Only a run that owns the folder moves tilings and removes unfinished staging: subsets may
+  // be tiling or reading there.
+  if (cluster.root() && !subset) {
+    std::filesystem::create_directories(dir);
+    if (const std::size_t moved = move_renumbered_tilings(dir, wanted_each); moved > 0) {
+      log::info("{}: the tiling of {} renumbered acquisition(s) moved to their new index, not made again", dir.string(),
+                moved);
+    }
+  }
   if (cluster.root()) prune_tile_store(dir, wanted_each, wanted, !subset);
 
   TilerParams params;

@@ -615,6 +615,9 @@ TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedT
   EXPECT_NE(late.err.find("1 pass(es) added since the last run, older than passes already processed"),
             std::string::npos)
       << late.err;
+  // Only the late pass is tiled: the three after it have their tiling moved up one.
+  EXPECT_NE(late.err.find("the tiling of 3 renumbered acquisition(s) moved"), std::string::npos) << late.err;
+  EXPECT_NE(late.err.find("reusing the tiling of 5 of 6 acquisitions"), std::string::npos) << late.err;
   const nlohmann::json report = read_json(dir / "sim/l/run.json");
   const nlohmann::json manifest = read_json(dir / "sim/work-l/tiles/manifest.json");
   std::set<std::string> reached, renumbered;  // by epoch 2 (now acquisition 2 by time); the others
@@ -648,6 +651,7 @@ TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedT
   const auto removed = run("five.toml", "l");
   ASSERT_EQ(removed.exit_code, 0) << removed.err;
   EXPECT_EQ(removed.err.find("processed again"), std::string::npos) << removed.err;
+  EXPECT_NE(removed.err.find("reusing the tiling of 5 of 5 acquisitions"), std::string::npos) << removed.err;
   const nlohmann::json after = read_json(dir / "sim/l/run.json");
   EXPECT_EQ(after["reused_tiles"], after["kept_tiles"]);
   EXPECT_GE(after["kept_tiles"].get<std::size_t>(), renumbered.size() / 2) << removed.err;

@@ -481,6 +481,42 @@ TEST(Tiler, PruneKeepsEachAcquisitionTiledWithItsOwnFingerprint) {
   EXPECT_FALSE(read_acquisition_tiling(f.params.dir, 0, "other").has_value());
 }
 
+TEST(Tiler, RenumberedAcquisitionsTilingsAreMovedToTheirNewIndexNotMadeAgain) {
+  Fixture f;
+  std::filesystem::remove_all(f.params.dir);
+  const AcquisitionTiling p = tile_acquisition(f.acquisitions[0], f.params, "p");
+  const AcquisitionTiling q = tile_acquisition(f.acquisitions[1], f.params, "q");
+  const auto blocks = [&](std::uint32_t k) { return test::read_text(acquisition_blocks_path(f.params.dir, k)); };
+  const std::string q_blocks = blocks(1);
+  const auto expect_at = [&](std::uint32_t k, const char* fingerprint, const AcquisitionTiling& tiling) {
+    const std::optional<AcquisitionTiling> found = read_acquisition_tiling(f.params.dir, k, fingerprint);
+    ASSERT_TRUE(found.has_value()) << fingerprint << " at " << k;
+    EXPECT_EQ(found->tiles, tiling.tiles);
+  };
+  // A pass delivered late, older than q: q becomes acquisition 2, the late pass 1 (not tiled).
+  EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "late", "q"}), 1u);
+  expect_at(0, "p", p);
+  expect_at(2, "q", q);
+  EXPECT_EQ(blocks(2), q_blocks);
+  EXPECT_FALSE(std::filesystem::exists(acquisition_tiles_path(f.params.dir, 1)));
+  EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "late", "q"}), 0u) << "in place";
+  // Removed again: q moves back down.
+  EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "q"}), 1u);
+  expect_at(1, "q", q);
+  EXPECT_FALSE(std::filesystem::exists(acquisition_tiles_path(f.params.dir, 2)));
+  // Two passes re-dated past each other swap folders (each folder the source of one move and
+  // the target of the other); a folder of a fingerprint no acquisition has stays for pruning.
+  std::filesystem::create_directories(f.params.dir / "a5");
+  EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"q", "p"}), 2u);
+  expect_at(0, "q", q);
+  expect_at(1, "p", p);
+  EXPECT_EQ(blocks(0), q_blocks);
+  EXPECT_TRUE(std::filesystem::exists(f.params.dir / "a5"));
+  prune_tile_store(f.params.dir, std::vector<std::string>{"q", "p"}, "store", true);
+  EXPECT_FALSE(std::filesystem::exists(f.params.dir / "staging")) << "nothing left aside";
+  expect_at(0, "q", q);
+}
+
 TEST(Tiler, ADamagedAcquisitionSummaryIsNotReusedEvenWhenItStillParses) {
   Fixture f;
   std::filesystem::remove_all(f.params.dir);

@@ -117,6 +117,15 @@ TileStore assemble_tile_store(const std::filesystem::path& dir, const TileGridPa
 void prune_tile_store(const std::filesystem::path& dir, std::span<const std::string> acquisition_fingerprints,
                       const std::string& store_fingerprint, bool staging);
 
+/// Moves the tiling of each acquisition whose folder in `dir` holds another's to its own
+/// folder, found by its fingerprint (`acquisition_fingerprints`, one per acquisition in order,
+/// which name the acquisition without its index): a pass delivered late, or one removed
+/// before others, renumbers the passes after it, whose tiling is then moved rather than made
+/// again. Only for a process that owns `dir` (no other may be tiling or reading there).
+/// Returns the number of folders moved; throws OutputError when one cannot be.
+std::size_t move_renumbered_tilings(const std::filesystem::path& dir,
+                                    std::span<const std::string> acquisition_fingerprints);
+
 /// The bytes tiling `acquisition` reads: its file's size; 0 when it is withdrawn (not read)
 /// or cannot be read (tile_acquisition says why). Used to hand out the largest first.
 std::uint64_t acquisition_bytes(const Acquisition& acquisition);
