@@ -204,10 +204,16 @@ std::size_t move_renumbered_tilings(const std::filesystem::path& dir,
   for (std::size_t k = 0; k < acquisition_fingerprints.size(); ++k) {
     const auto own = held.find(k);
     if (own != held.end() && own->second == acquisition_fingerprints[k]) continue;
+    // A folder holding its own acquisition's tiling stays; one moved goes once.
+    const auto in_place = [&](std::size_t j, const std::string& f) {
+      return j < acquisition_fingerprints.size() && acquisition_fingerprints[j] == f;
+    };
     const auto from = std::find_if(held.begin(), held.end(), [&](const auto& h) {
-      return h.first != k && h.second == acquisition_fingerprints[k];
+      return h.second == acquisition_fingerprints[k] && !in_place(h.first, h.second);
     });
-    if (from != held.end()) moves.emplace_back(from->first, k);
+    if (from == held.end()) continue;
+    moves.emplace_back(from->first, k);
+    held.erase(from);
   }
   if (moves.empty()) return 0;
   // Every folder is moved aside before any is put in place: a folder may be the source of one

@@ -500,6 +500,9 @@ TEST(Tiler, RenumberedAcquisitionsTilingsAreMovedToTheirNewIndexNotMadeAgain) {
   EXPECT_EQ(blocks(2), q_blocks);
   EXPECT_FALSE(std::filesystem::exists(acquisition_tiles_path(f.params.dir, 1)));
   EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "late", "q"}), 0u) << "in place";
+  // A fingerprint listed twice (no config does) takes no folder from its own place, nor one twice.
+  EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "q", "q", "p", "q"}), 0u);
+  expect_at(2, "q", q);
   // Removed again: q moves back down.
   EXPECT_EQ(move_renumbered_tilings(f.params.dir, std::vector<std::string>{"p", "q"}), 1u);
   expect_at(1, "q", q);
