@@ -33,11 +33,6 @@ std::string encode_keyed_piece(const KeyedPiece& piece);
 /// (another magic, counts that disagree with the size, a checksum that does not match).
 KeyedPiece decode_keyed_piece(std::string_view bytes, std::string_view source);
 
-/// The key of vertex `id` of acquisition `acquisition` (below kNewVertexKey).
-inline std::uint64_t input_vertex_key(std::uint32_t acquisition, std::uint32_t id) {
-  return std::uint64_t{acquisition} << 32 | id;
-}
-
 /// A tile's selected triangles of one acquisition (as a tile result holds them) as a keyed
 /// piece: vertices keyed by input_vertex_key, positions in the project CRS.
 KeyedPiece keyed_piece(const TilePiece& piece);

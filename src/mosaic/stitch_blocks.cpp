@@ -25,11 +25,13 @@
 #include "citymesh/core/stopwatch.h"
 #include "gap_fill.h"
 #include "part_cut.h"
+#include "part_sources.h"
 
 namespace citymesh {
 
 using mosaic_detail::Neighbour;
 using mosaic_detail::PartCut;
+using mosaic_detail::SourceRanks;
 
 namespace {
 
@@ -265,24 +267,49 @@ std::uint64_t part_digest(std::span<const BlockPart> parts, std::size_t p, const
   return sum.value();
 }
 
-/// Part p as `cache` kept it, its keys those of this run; nothing when it is not kept (or
-/// names a part this run does not have).
+/// part_digest with each source named by its rank among those the part reads (`ranks`): a
+/// part whose sources were renumbered (a pass delivered late elsewhere) keeps its digest.
+/// When the sources are 0 to n-1 it is part_digest itself (no copy).
+std::uint64_t ranked_part_digest(std::span<const BlockPart> parts, std::size_t p, const Vec3d& origin, double context,
+                                 const KeyedPiece& own, std::span<const std::uint32_t> around_parts,
+                                 std::span<const Neighbour> around, std::span<const std::uint64_t> source_sizes,
+                                 const SourceRanks& ranks) {
+  if (ranks.identity()) return part_digest(parts, p, origin, context, own, around_parts, around, source_sizes);
+  std::vector<Neighbour> ranked;
+  for (const Neighbour& n : around) ranked.push_back({std::make_shared<KeyedPiece>(*ranks.to_ranks(*n.piece)), n.role});
+  // Clipping's precedence compares the sources by size, then index: by rank, the same order.
+  std::vector<std::uint64_t> sizes;
+  for (const std::uint32_t s : ranks.sources()) sizes.push_back(s < source_sizes.size() ? source_sizes[s] : 0);
+  return part_digest(parts, p, origin, context, *ranks.to_ranks(own), around_parts, ranked, sizes);
+}
+
+/// Part p as `cache` kept it, its keys and sources those of this run (it was kept under the
+/// ranks of the sources it read); nothing when it is not kept (or names a part or a rank this
+/// run does not have).
 std::optional<std::pair<KeyedPiece, PartOutcome>> find_kept(const PartCache& cache, std::span<const BlockPart> parts,
-                                                            std::size_t p, std::uint64_t digest) {
+                                                            std::size_t p, std::uint64_t digest,
+                                                            const SourceRanks& ranks) {
   auto kept = cache.find(parts[p].key, digest);
   if (!kept || !rename_for_this_run(kept->first.keys, kept->second.key_parts, parts)) return std::nullopt;
+  if (!ranks.identity()) {
+    std::optional<KeyedPiece> named = ranks.from_ranks(kept->first);
+    if (!named) return std::nullopt;
+    kept->first = std::move(*named);
+  }
   kept->second.key_parts.clear();
   return kept;
 }
 
-/// Keeps stitched part p in `cache`, its new vertices named by their part's rank.
+/// Keeps stitched part p in `cache`, its new vertices named by their part's rank and its
+/// sources by their rank among those it read (nothing kept when it holds another).
 void keep_stitched(PartCache& cache, std::span<const BlockPart> parts, std::size_t p, const KeyedPiece& stitched,
-                   PartOutcome outcome) {
-  RelativeKeys relative = relative_keys(stitched.keys, parts);
-  KeyedPiece kept = stitched;
-  kept.keys = std::move(relative.keys);
+                   PartOutcome outcome, const SourceRanks& ranks) {
+  std::optional<KeyedPiece> kept = ranks.identity() ? stitched : ranks.to_ranks(stitched);
+  if (!kept) return;
+  RelativeKeys relative = relative_keys(kept->keys, parts);
+  kept->keys = std::move(relative.keys);
   outcome.key_parts = std::move(relative.parts);
-  cache.keep(parts[p].key, kept, outcome);
+  cache.keep(parts[p].key, *kept, outcome);
 }
 
 /// Loads part p and the parts around it as level `level` sees them, stitches it (or takes it
@@ -301,9 +328,11 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   const std::shared_ptr<const KeyedPiece> own = store.load(p, false);
   const Vec3d origin = run.frame ? *run.frame : whole_metre_origin(parts[p].box.min);
   PartOutcome out;
+  std::optional<SourceRanks> ranks;
   if (run.cache != nullptr) {
-    out.digest = part_digest(parts, p, origin, context, *own, around_parts, around, run.source_sizes);
-    if (auto kept = find_kept(*run.cache, parts, p, out.digest)) {
+    ranks.emplace(*own, around);
+    out.digest = ranked_part_digest(parts, p, origin, context, *own, around_parts, around, run.source_sizes, *ranks);
+    if (auto kept = find_kept(*run.cache, parts, p, out.digest, *ranks)) {
       kept->second.digest = out.digest;
       kept->second.reused = true;
       store.save_stitched(p, std::move(kept->first));
@@ -316,7 +345,7 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
   out.stats = stitch_cut(cut, run.params, run.source_sizes);
   KeyedPiece stitched = mosaic_detail::stitched_piece(cut, p);
   out.box = stitched.box();
-  if (run.cache != nullptr) keep_stitched(*run.cache, parts, p, stitched, out);
+  if (run.cache != nullptr) keep_stitched(*run.cache, parts, p, stitched, out, *ranks);
   store.save_stitched(p, std::move(stitched));
   return out;
 }

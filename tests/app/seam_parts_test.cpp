@@ -436,5 +436,35 @@ TEST(SeamCache, PartsAreReusedWhenAPartAppearsOrGoesBeforeThemInTheList) {
   EXPECT_LT(back.stats.reused_parts, back.parts);
 }
 
+TEST(SeamCache, PartsWhoseSourcesWereRenumberedAreReusedUnderTheNewNumbers) {
+  // A pass delivered late, older than sources 1 to 3 but over none of this scene: they
+  // become 2 to 4. Every part reads the same sources in the same order, so every part is
+  // found (kept under the ranks of its sources), to the output of stitching the renumbered
+  // scene without the cache; and back when the pass is removed again.
+  test::TempDir dir;
+  const auto none = [](const MergedMesh&, std::uint32_t) { return false; };
+  const MergedMesh scene = test::four_source_scene();
+  MergedMesh renumbered = scene;
+  for (std::int32_t& s : renumbered.source_acq) s += s >= 1 ? 1 : 0;
+  SeamPartCache cache(dir / "cache", 7);
+  const CachedStitch first = stitch_scene(dir, "first", none, &cache, scene);
+  ASSERT_EQ(first.stats.reused_parts, 0u);
+  const CachedStitch late_plain = stitch_scene(dir, "late-plain", none, nullptr, renumbered);
+  const CachedStitch late = stitch_scene(dir, "late", none, &cache, renumbered);
+  EXPECT_EQ(late.stats.reused_parts, late.parts);
+  expect_same_output(late.out, late_plain.out);
+  std::set<std::int32_t> sources(late.out.source_acq.begin(), late.out.source_acq.end());
+  EXPECT_TRUE(sources.contains(2) && sources.contains(3) && !sources.contains(1)) << "the renumbered sources, found";
+  const CachedStitch back = stitch_scene(dir, "back", none, &cache, scene);
+  EXPECT_EQ(back.stats.reused_parts, back.parts);
+  expect_same_output(back.out, first.out);
+  // Sources renumbered out of order (1 and 2 swapped) are another stitching: not found.
+  MergedMesh swapped = scene;
+  for (std::int32_t& s : swapped.source_acq) s = s == 1 ? 2 : s == 2 ? 1 : s;
+  const CachedStitch other = stitch_scene(dir, "swapped", none, &cache, swapped);
+  EXPECT_LT(other.stats.reused_parts, other.parts);
+  expect_same_output(other.out, stitch_scene(dir, "swapped-plain", none, nullptr, swapped).out);
+}
+
 }  // namespace
 }  // namespace citymesh::app

@@ -12,6 +12,15 @@
 
 namespace citymesh {
 
+/// The key of vertex `id` of source (acquisition) `source` in a keyed piece: keys below
+/// bit 63 name input vertices so (the seam pass's cache renames their sources), the others
+/// the vertices stitching makes (kNewVertexKey).
+inline std::uint64_t input_vertex_key(std::uint32_t source, std::uint32_t id) {
+  return std::uint64_t{source} << 32 | id;
+}
+/// The source of an input vertex's key (input_vertex_key).
+inline std::uint32_t input_vertex_source(std::uint64_t key) { return static_cast<std::uint32_t>(key >> 32); }
+
 /// Some triangles of an output, on vertices named by 64-bit keys (one key, one vertex of the
 /// whole output, wherever it is stored), positions in the project CRS as doubles: what
 /// block stitching keeps of a part between levels.
