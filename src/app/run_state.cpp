@@ -89,8 +89,9 @@ std::vector<std::string> passes_of(const std::map<std::string, std::string>& key
 /// all of them after the others by time: a pass delivered late, older than passes already
 /// processed, or a pass removed before the last. Acquisitions are numbered by time, so the
 /// passes after it are renumbered: input too, as an appended or withdrawn pass is (the tiles
-/// whose passes changed numbers are redone, to the bytes of a fresh run). False for passes
-/// appended or removed after all the others: the keys tell those apart one by one.
+/// it reaches are redone; the others' results, the tilings and the seam parts are found by
+/// identity and renumbered, to the bytes of a fresh run). False for passes appended or
+/// removed after all the others: the keys tell those apart one by one.
 bool passes_added_or_removed(const std::map<std::string, std::string>& before,
                              const std::map<std::string, std::string>& now) {
   std::vector<std::string> fewer = passes_of(before), more = passes_of(now);

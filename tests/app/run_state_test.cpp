@@ -28,6 +28,18 @@ Keys keys_of(std::size_t n) {
   return keys;
 }
 
+/// What check_run_config says when it refuses `keys` in `work` (nothing when it resumes:
+/// then the test fails, saying `what` should have been refused).
+std::string refusal(const test::TempDir& work, const Keys& keys, const char* what) {
+  try {
+    check_run_config(work.path(), keys, false);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << what;
+  return {};
+}
+
 TEST(RunState, AcquisitionsAppendedOrRemovedResumeAndOneChangedIsRefused) {
   test::TempDir work;
   check_run_config(work.path(), keys_of(3), false);
@@ -48,21 +60,14 @@ TEST(RunState, AcquisitionsAppendedOrRemovedResumeAndOneChangedIsRefused) {
   // Removed while another pass changed: refused, naming the change.
   Keys middle_changed = middle;
   middle_changed["acquisition[0].path"] = "/data/other.ply";
-  try {
-    check_run_config(work.path(), middle_changed, false);
-    ADD_FAILURE() << "a pass removed in the middle, another one changed";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("acquisition[0].path"), std::string::npos) << e.what();
-  }
+  const std::string middle_changed_refused =
+      refusal(work, middle_changed, "a pass removed in the middle, another one changed");
+  EXPECT_NE(middle_changed_refused.find("acquisition[0].path"), std::string::npos) << middle_changed_refused;
   Keys changed = keys_of(6);
   changed["acquisition[1].time"] = "2026-02-02T10:00:00Z";
-  try {
-    check_run_config(work.path(), changed, false);
-    ADD_FAILURE() << "an existing pass's date changed beside an appended one";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("acquisition[1].time"), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).find("acquisition[5]"), std::string::npos) << e.what();
-  }
+  const std::string changed_refused = refusal(work, changed, "an existing pass's date changed beside an appended one");
+  EXPECT_NE(changed_refused.find("acquisition[1].time"), std::string::npos) << changed_refused;
+  EXPECT_EQ(changed_refused.find("acquisition[5]"), std::string::npos) << changed_refused;
   // A pass inserted before the last one renumbers it: its keys change.
   check_run_config(work.path(), keys_of(5), false);
   Keys inserted = keys_of(5);
@@ -108,13 +113,9 @@ TEST(RunState, APassDeliveredLateResumesThoughTheLaterPassesAreRenumbered) {
   // The same with a setting changed too: refused, for the setting alone.
   Keys changed = with_inserted(late, 4, 4, "2026-09-01T10:00:00Z");
   changed["change.distance_threshold"] = "0.2";
-  try {
-    check_run_config(work.path(), changed, false);
-    ADD_FAILURE() << "a setting changed beside a pass delivered late";
-  } catch (const ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("change.distance_threshold"), std::string::npos) << e.what();
-    EXPECT_EQ(std::string(e.what()).find("acquisition["), std::string::npos) << e.what();
-  }
+  const std::string changed_refused = refusal(work, changed, "a setting changed beside a pass delivered late");
+  EXPECT_NE(changed_refused.find("change.distance_threshold"), std::string::npos) << changed_refused;
+  EXPECT_EQ(changed_refused.find("acquisition["), std::string::npos) << changed_refused;
   // A pass inserted while another one's date changed: not only passes added, refused.
   Keys redated = with_inserted(late, 4, 0, "2025-12-01T10:00:00Z");
   redated["acquisition[4].time"] = "2026-04-02T10:00:00Z";

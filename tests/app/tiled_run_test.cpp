@@ -388,6 +388,31 @@ TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
   EXPECT_EQ(read_json(dir / "sim/c/run.json")["reused_tiles"], report["tiles"]);
 }
 
+/// The store tiles (by name) that hold triangles of acquisition `a` (any role) and those
+/// that hold none, as the tile manifest counts them.
+struct TilesByPass {
+  std::set<std::string> holding, others;
+};
+TilesByPass tiles_by_pass(const nlohmann::json& manifest, std::size_t a) {
+  TilesByPass out;
+  for (const auto& tile : manifest["tiles"]) {
+    const auto& counts = tile["triangles"];
+    const bool holds =
+        counts.size() > a && counts[a][0].get<int>() + counts[a][1].get<int>() + counts[a][2].get<int>() > 0;
+    (holds ? out.holding : out.others).insert(fmt::format("{}_{}", tile["i"].get<int>(), tile["j"].get<int>()));
+  }
+  return out;
+}
+
+/// The tiles a run processed (its report's tiles not marked reused).
+std::set<std::string> processed_tiles(const nlohmann::json& report) {
+  std::set<std::string> processed;
+  for (const auto& entry : report["per_tile"]) {
+    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
+  }
+  return processed;
+}
+
 TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFreshRun) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
@@ -420,18 +445,8 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   // The tiles redone are those the new pass reaches (their inputs changed) and later-phase
   // neighbours whose border decisions changed; the other later-phase neighbours of redone
   // tiles keep their results (kept_after_neighbours).
-  const nlohmann::json manifest = read_json(dir / "sim/work-u/tiles/manifest.json");
-  std::set<std::string> reached;
-  for (const auto& tile : manifest["tiles"]) {
-    const auto& counts = tile["triangles"];
-    if (counts.size() > 5 && counts[5][0].get<int>() + counts[5][1].get<int>() + counts[5][2].get<int>() > 0) {
-      reached.insert(fmt::format("{}_{}", tile["i"].get<int>(), tile["j"].get<int>()));
-    }
-  }
-  std::set<std::string> processed;
-  for (const auto& entry : report["per_tile"]) {
-    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
-  }
+  const std::set<std::string> reached = tiles_by_pass(read_json(dir / "sim/work-u/tiles/manifest.json"), 5).holding;
+  const std::set<std::string> processed = processed_tiles(report);
   EXPECT_FALSE(reached.empty());
   for (const std::string& tile : reached) EXPECT_TRUE(processed.contains(tile)) << tile << " is reached";
   EXPECT_GT(report["kept_tiles"].get<int>(), 0) << "later-phase neighbours of reached tiles, decisions unchanged";
@@ -620,20 +635,12 @@ TEST(TiledRun, APassDeliveredLateRedoesOnlyTheTilesItReachesTheOthersRenumberedT
   EXPECT_NE(late.err.find("reusing the tiling of 5 of 6 acquisitions"), std::string::npos) << late.err;
   const nlohmann::json report = read_json(dir / "sim/l/run.json");
   const nlohmann::json manifest = read_json(dir / "sim/work-l/tiles/manifest.json");
-  std::set<std::string> reached, renumbered;  // by epoch 2 (now acquisition 2 by time); the others
-  for (const auto& tile : manifest["tiles"]) {
-    const auto& counts = tile["triangles"];
-    const std::string key = fmt::format("{}_{}", tile["i"].get<int>(), tile["j"].get<int>());
-    ASSERT_EQ(counts.size(), 6u);
-    (counts[2][0].get<int>() + counts[2][1].get<int>() + counts[2][2].get<int>() > 0 ? reached : renumbered)
-        .insert(key);
-  }
+  for (const auto& tile : manifest["tiles"]) ASSERT_EQ(tile["triangles"].size(), 6u);
+  // Reached by epoch 2 (now acquisition 2 by time), and the others.
+  const auto [reached, renumbered] = tiles_by_pass(manifest, 2);
   ASSERT_FALSE(reached.empty());
   ASSERT_FALSE(renumbered.empty());
-  std::set<std::string> processed;
-  for (const auto& entry : report["per_tile"]) {
-    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
-  }
+  const std::set<std::string> processed = processed_tiles(report);
   for (const std::string& tile : reached) EXPECT_TRUE(processed.contains(tile)) << tile << " is reached";
   // Every tile holds a renumbered pass, so none is reused as it was; those the new pass does
   // not reach are kept renumbered, unless a decision on their border changed.
