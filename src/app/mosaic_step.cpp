@@ -8,6 +8,7 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/progress.h"
 #include "citymesh/core/record_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -129,12 +130,14 @@ nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPa
                                        SeamPartCache* cache) {
   check_seam_pass(config);
   Stopwatch clock;
+  StageProgress progress({.stage = "final pass: seam parts stitched", .total = parts.size()});
   const PartStitchRun run{.params = stitch_params(config),
                           .blocks = tile_grid_blocks(config),
                           .source_sizes = {source_sizes.begin(), source_sizes.end()},
                           .frame = std::nullopt,
                           .run_level = work.run_level,
-                          .cache = cache};
+                          .cache = cache,
+                          .progress = &progress};
   const double before = parts_open_boundary(parts, store, false, run.blocks, work.measure_parts);
   log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   BlockStitchStats s = stitch_parts(parts, store, run);

@@ -15,6 +15,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
+#include "citymesh/core/progress.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_reader.h"
 #include "detect_output.h"
@@ -170,8 +171,9 @@ class FinalOutput {
     // The other ranks, done with the seam pass and the filing by grid tile, map leaves and
     // build cells of the tree until the root ends (help_outputs).
     const bool shared = cluster_ != nullptr && cluster_->size() > 1;
-    const nlohmann::json exported =
-        write_tileset_outputs(config_, *leaves_, shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{});
+    ExportWork work = shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{};
+    work.progress = "final pass: 3D Tiles";
+    const nlohmann::json exported = write_tileset_outputs(config_, *leaves_, work);
     if (shared) end_shared_outputs(config_, *cluster_);
     leaves_.reset();
     seams_.reset();
@@ -224,6 +226,7 @@ void read_tile_results(const Config& config, const TileStore& store, std::span<c
   std::vector<std::optional<TileResult>> batch(kBatch);
   std::vector<std::optional<SeamPartFiles::FiledTile>> filed(kBatch);
   const std::vector<std::uint64_t> read_bytes = result_read_bytes(config, store);
+  StageProgress progress({.stage = "final pass: tile results read", .total = store.tiles.size()});
   for (std::size_t first = 0, count = 0; first < store.tiles.size(); first += count) {
     count = batch_within(read_bytes, first, kBatch, memory_left(config.run.memory));
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
@@ -239,6 +242,7 @@ void read_tile_results(const Config& config, const TileStore& store, std::span<c
       add_tile_result(config, store.tiles[first + i], tiles.processed[first + i] != 0, std::move(batch[i]), assembly,
                       per_tile);
     }
+    progress.advance(count);
   }
 }
 

@@ -21,6 +21,7 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
+#include "citymesh/core/progress.h"
 #include "citymesh/core/radix_sort.h"
 #include "citymesh/core/stopwatch.h"
 #include "gap_fill.h"
@@ -357,7 +358,10 @@ PartOutcome stitch_one(std::span<const BlockPart> parts, std::size_t p, int leve
 void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, const PartStitchRun& run,
                   BlockStitchStats& stats) {
   const LevelStitcher stitcher(parts, level, store, run);
+  const std::uint64_t done_before = run.progress != nullptr ? run.progress->done() : 0;
   const std::vector<PartOutcome> outcomes = run.run_level ? run.run_level(stitcher) : stitch_level_here(stitcher);
+  // The level's parts other processes stitched are counted once it ends.
+  if (run.progress != nullptr) run.progress->advance(done_before + stitcher.size() - run.progress->done());
   if (outcomes.size() != stitcher.size())
     throw ProcessingError("stitching block by block: a level's outcomes are missing");
   for (std::size_t i = 0; i < outcomes.size(); ++i) {
@@ -493,7 +497,9 @@ LevelStitcher::LevelStitcher(std::span<const BlockPart> parts, int level, PartSt
 LevelStitcher::~LevelStitcher() = default;
 
 PartOutcome LevelStitcher::stitch(std::size_t i) const {
-  return stitch_one(parts_, of_level_.at(i), level_, *finder_, store_, run_, context_);
+  PartOutcome out = stitch_one(parts_, of_level_.at(i), level_, *finder_, store_, run_, context_);
+  if (run_.progress != nullptr) run_.progress->advance();
+  return out;
 }
 
 std::vector<PartOutcome> stitch_level_here(const LevelStitcher& level) {

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 #include <set>
 
 #include "citymesh/core/atomic_file.h"
@@ -13,6 +14,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/progress.h"
 #include "citymesh/core/read_file.h"
 #include "citymesh/core/stopwatch.h"
 #include "tileset_json.h"
@@ -355,13 +357,22 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       if (!written.contains({node.level, node.key})) sink(node);
     };
     const TileTreeBuild tree(keys, source, params.tree, unless_written);
+    std::optional<StageProgress> progress;
+    if (!work.progress.empty())
+      progress.emplace(StageProgressParams{.stage = work.progress + " cells built", .total = tree.cell_count()});
     const std::function<ExportedCell(std::size_t)> here = [&](std::size_t c) {
-      return export_cell(leaves, crs, frame, params, c);
+      ExportedCell cell = export_cell(leaves, crs, frame, params, c);
+      if (progress) progress->advance();
+      return cell;
     };
     Stopwatch cells_clock;
     std::vector<ExportedCell> built =
         work.cells ? work.cells(frame, tree, here) : parallel_map(tree.cell_count(), here);
     log::debug("3D Tiles: {} cells built in {:.2f} s", built.size(), cells_clock.seconds());
+    if (progress) {
+      progress->finish();
+      log::info("{}: the levels above the cells", work.progress);
+    }
     std::vector<TileSubtree> subtrees;
     for (ExportedCell& e : built) {
       const TileNode& open = e.subtree.nodes.at(e.subtree.open);

@@ -6,10 +6,13 @@
 #include <gtest/gtest.h>
 
 #include <cfloat>
+#include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "citymesh/io/mesh_io.h"
 #include "citymesh/io/ply_writer.h"
@@ -736,6 +739,58 @@ std::size_t ply_faces(const std::filesystem::path& ply) {
   const std::string text = test::read_text(ply);
   const auto at = text.find("element face ");
   return at == std::string::npos ? 0 : std::stoul(text.substr(at + 13));
+}
+
+/// One stage's progress lines (StageProgress: "<stage> <done>/<total>, ETA ..."), in order,
+/// with the place in `err` of each.
+struct ProgressLine {
+  std::size_t at = 0;
+  long done = 0, total = 0;
+};
+std::vector<ProgressLine> progress_lines(const std::string& err, const std::string& stage) {
+  std::vector<ProgressLine> lines;
+  for (std::size_t at = err.find(stage + " "); at != std::string::npos; at = err.find(stage + " ", at + 1)) {
+    ProgressLine l{.at = at};
+    EXPECT_EQ(std::sscanf(err.c_str() + at + stage.size(), " %ld/%ld, ETA", &l.done, &l.total), 2)
+        << err.substr(at, 80);
+    lines.push_back(l);
+  }
+  return lines;
+}
+
+TEST(TiledRun, TheFinalPassSaysHowFarEachOfItsStagesHasGot) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  // Tiles of 20 m: wide enough for the seam pass by blocks (10 m tiles are stitched whole).
+  const auto run = test::run_citymesh(run_args(sim, "out", "--set tiling.tile_size=20"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json parts = read_json(dir / "sim/out/mosaic/summary.json")["stitch"]["by_blocks"]["parts"];
+  long part_count = 0;
+  for (const auto& n : parts) part_count += n.get<long>();
+  const long tiles = read_json(dir / "sim/out/run.json")["tiles"].get<long>();
+  // Each stage counts up to its total and ends on it, once; the stages come in order.
+  std::size_t after = run.err.find("tiles " + std::to_string(tiles) + "/" + std::to_string(tiles));
+  ASSERT_NE(after, std::string::npos) << run.err;
+  for (const auto& [stage, total] :
+       std::vector<std::pair<std::string, long>>{{"final pass: tile results read", tiles},
+                                                 {"final pass: seam parts stitched", part_count},
+                                                 {"final pass: 3D Tiles cells built", -1}}) {
+    const std::vector<ProgressLine> lines = progress_lines(run.err, stage);
+    ASSERT_FALSE(lines.empty()) << stage << " said nothing:\n" << run.err;
+    for (std::size_t k = 0; k < lines.size(); ++k) {
+      EXPECT_EQ(lines[k].total, total < 0 ? lines[0].total : total) << stage;
+      EXPECT_LE(lines[k].done, lines[k].total) << stage;
+      EXPECT_EQ(lines[k].done == lines[k].total, k + 1 == lines.size()) << stage << ": the total said once, last";
+      if (k > 0) {
+        EXPECT_GT(lines[k].done, lines[k - 1].done) << stage;
+      }
+    }
+    EXPECT_GT(lines[0].at, after) << stage << " said before the stage before it ended";
+    after = lines.back().at;
+  }
+  EXPECT_GT(part_count, 1);
+  EXPECT_GT(run.err.find("final pass: 3D Tiles: the levels above the cells"), after);
 }
 
 TEST(TiledRun, ProvenancePlyPerTileAndTilesetCheck) {

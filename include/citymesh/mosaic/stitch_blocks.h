@@ -110,6 +110,7 @@ struct BlockPart {
 };
 
 class LevelStitcher;
+class StageProgress;
 
 namespace stitch_detail {
 class PartFinder;  ///< which parts' boxes (as a level sees them) meet a box
@@ -165,6 +166,9 @@ struct PartStitchRun {
   std::function<std::vector<PartOutcome>(const LevelStitcher&)> run_level;
   /// Where stitched parts are looked up before stitching and kept after; null: none.
   PartCache* cache = nullptr;
+  /// Told of each part stitched by this process, and of a level's other parts when the level
+  /// ends (run_level may hand them to other processes); null: none.
+  StageProgress* progress = nullptr;
 };
 
 /// The parts of one level of stitch_parts(), each stitched on its own: loaded with the parts

@@ -118,6 +118,9 @@ using ExportBoxes = std::function<std::vector<Box3d>(const Geodetic& origin, std
 struct ExportWork {
   ExportBoxes boxes;
   ExportCells cells;
+  /// Non-empty: the cells built are counted on stderr under this name (StageProgress, those
+  /// of other processes when all are built), and the levels above them announced.
+  std::string progress;
 };
 
 /// Writes the tileset of `leaves` as export_tileset writes a mesh's, reading each leaf twice
