@@ -90,6 +90,7 @@ class AcquisitionTiler {
     // The tile store carries no per-vertex times, so they are not parsed.
     ply.time_names.clear();
     PlyReader reader(file, ply);
+    check_has_faces(file, reader.header());
     if (reader.vertex_count() > std::uint64_t{UINT32_MAX}) {
       throw InputError(fmt::format("{}: {} vertices; the tile store numbers them in 32 bits (split the file)",
                                    file.string(), reader.vertex_count()));

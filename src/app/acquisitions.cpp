@@ -32,6 +32,7 @@ Mesh read_acquisition(const Config& config, const Acquisition& a, const std::opt
   params.ply = config.ply_read_params();
   params.acquisition = a.index;
   params.origin = origin;
+  params.require_faces = true;
   MeshReadResult r = read_mesh(a.path, params);
   check_provenance_ids(a.path, r.stats.faces);
   log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());

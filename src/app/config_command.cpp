@@ -1,18 +1,31 @@
 // SPDX-License-Identifier: MIT
 // `citymesh config`: print every key with its default, or validate a config file.
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
+
+#include <CLI/CLI.hpp>
 #include <iostream>
 
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
+#include "citymesh/io/ply_reader.h"
 #include "command.h"
 #include "mosaic_step.h"
 
 namespace citymesh::app {
 
 namespace {
+
+/// Each acquisition file's PLY header (not its data): readable, and a mesh rather than a point
+/// cloud, which `run` would otherwise take for a pass of no triangle. Withdrawn passes are not
+/// read.
+void check_acquisition_headers(const Config& config) {
+  for (const Acquisition& a : config.acquisition_list()) {
+    if (a.withdrawn) continue;
+    const PlyReader reader(a.path, config.ply_read_params());
+    check_has_faces(a.path, reader.header());
+  }
+}
 
 class ConfigCommand final : public Command {
  public:
@@ -39,6 +52,7 @@ class ConfigCommand final : public Command {
     if (file.empty()) throw UsageError("give --dump-defaults, --check FILE or --print FILE");
     const Config config = load_config(file, {.overrides = overrides_, .check_files = !no_file_check_});
     check_seam_pass(config);  // what `run` would refuse at its start
+    if (!no_file_check_) check_acquisition_headers(config);
     if (!print_.empty()) {
       std::cout << effective_config_toml(config);
       return;

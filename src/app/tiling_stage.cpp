@@ -153,6 +153,11 @@ TileStore reused_or_tiled_store(const Config& config, const RunFingerprints& fin
 TileStore prepare_tile_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                              const std::optional<Subset>& subset) {
   TileStore store = reused_or_tiled_store(config, fingerprints, cluster, subset);
+  // Nothing to process: said here, rather than by an output step failing on an empty map.
+  if (store.tiles.empty()) {
+    throw InputError(
+        fmt::format("{}: the acquisitions hold no triangle (every file is empty, or withdrawn)", config.file.string()));
+  }
   if (cluster.root()) warn_if_halo_too_narrow(store, config);
   return store;
 }

@@ -73,6 +73,7 @@ void check_faces(const std::filesystem::path& path, const Mesh& mesh) {
 
 MeshReadResult read_mesh(const std::filesystem::path& path, const MeshReadParams& params) {
   PlyReader reader(path, params.ply);
+  if (params.require_faces) check_has_faces(path, reader.header());
   MeshReadResult result;
   Mesh& mesh = result.mesh;
   mesh.positions.reserve(reader.vertex_count());

@@ -509,6 +509,14 @@ void check_face_extent(const std::filesystem::path& file, std::uint64_t face, co
   }
 }
 
+void check_has_faces(const std::filesystem::path& file, const PlyHeader& header) {
+  if (header.find("face") != nullptr) return;
+  throw InputError(fmt::format(
+      "{}: no face element: a point cloud, not a mesh (an acquisition is a triangle mesh; `citymesh mesh` meshes "
+      "scan-ordered points)",
+      file.string()));
+}
+
 void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
                          std::uint64_t read) {
   for (const std::uint32_t v : triangle) {

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -86,6 +87,58 @@ TEST(Cli, LogJsonWritesOneObjectPerLine) {
   const auto j = nlohmann::json::parse(r.err.substr(0, r.err.find('\n')));
   EXPECT_EQ(j["level"], "error");
   EXPECT_NE(j["msg"].get<std::string>().find("not a PLY file"), std::string::npos);
+}
+
+/// A config of two acquisitions, `first` and `second` (files in `dir`), in Lambert-93.
+void write_two_pass_config(const std::filesystem::path& config, const std::string& first, const std::string& second) {
+  test::write_text(config, fmt::format("[project]\ncrs = \"EPSG:2154\"\nvertical_datum = \"ellipsoidal\"\n"
+                                       "[[acquisition]]\npath = \"{}\"\ntime = \"2026-01-01T00:00:00Z\"\n"
+                                       "[[acquisition]]\npath = \"{}\"\ntime = \"2026-02-01T00:00:00Z\"\n",
+                                       first, second));
+}
+
+/// Three points with sensor positions, as ASCII PLY, and `faces` (may be empty) after them:
+/// with `face_element` false, no face element at all (a point cloud).
+void write_three_points(const std::filesystem::path& path, bool face_element, const std::string& faces = "") {
+  const int face_count = static_cast<int>(std::count(faces.begin(), faces.end(), '\n'));
+  test::write_text(path, fmt::format("ply\nformat ascii 1.0\nelement vertex 3\nproperty double x\nproperty double y\n"
+                                     "property double z\nproperty double x_origin\nproperty double y_origin\n"
+                                     "property double z_origin\n{}end_header\n"
+                                     "651000 6860000 30 651000 6859990 32\n651001 6860000 30 651000 6859990 32\n"
+                                     "651000 6860001 30 651000 6859990 32\n{}",
+                                     face_element ? fmt::format("element face {}\nproperty list uchar int "
+                                                                "vertex_indices\n",
+                                                                face_count)
+                                                  : std::string(),
+                                     faces));
+}
+
+TEST(Cli, APointCloudGivenAsAnAcquisitionIsRefusedByNameBeforeAnyWork) {
+  test::TempDir dir;
+  write_three_points(dir / "mesh.ply", true, "3 0 1 2\n");
+  write_three_points(dir / "points.ply", false);
+  write_two_pass_config(dir / "run.toml", "mesh.ply", "points.ply");
+  const std::string config = (dir / "run.toml").string();
+  for (const char* command : {"config --check", "detect", "run --no-pictures"}) {
+    const auto r = test::run_citymesh(fmt::format("{} {}", command, config));
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("points.ply: no face element: a point cloud, not a mesh"), std::string::npos)
+        << command << ": " << r.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic")) << "no output begun";
+  // `--no-file-check` reads no file.
+  EXPECT_EQ(test::run_citymesh("config --no-file-check --check " + config).exit_code, 0);
+}
+
+TEST(Cli, ARunWhoseAcquisitionsHoldNoTriangleSaysSoAtItsStart) {
+  test::TempDir dir;
+  write_three_points(dir / "a.ply", true);  // a face element of no face
+  write_three_points(dir / "b.ply", true);
+  write_two_pass_config(dir / "run.toml", "a.ply", "b.ply");
+  const auto r = test::run_citymesh("run --no-pictures " + (dir / "run.toml").string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("run.toml: the acquisitions hold no triangle"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic")) << "no output begun";
 }
 
 /// A spinning sensor's frame at (sx, 0, 1.5): 8 rings from -10 to +10 degrees, 64 columns,

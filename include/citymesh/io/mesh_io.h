@@ -24,6 +24,8 @@ struct MeshReadParams {
   /// Triangles with less than this doubled area (m^2), measured on the file's double
   /// coordinates, are degenerate: dropped and counted.
   double min_doubled_area = kMinDoubledArea;
+  /// A file with no face element (a point cloud) is an InputError (check_has_faces).
+  bool require_faces = false;
 };
 
 struct MeshReadResult {

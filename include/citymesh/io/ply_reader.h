@@ -80,6 +80,11 @@ inline void check_face_extent(const std::filesystem::path& file, std::uint64_t f
 void check_vertices_read(const std::filesystem::path& file, std::uint64_t face, const Triangle& triangle,
                          std::uint64_t read);
 
+/// Throws InputError naming `file` when `header` has no face element: a point cloud given
+/// where a mesh is needed (an acquisition), which would otherwise run through as a pass of no
+/// triangle and fail at the end on an empty output.
+void check_has_faces(const std::filesystem::path& file, const PlyHeader& header);
+
 /// Triangles from consecutive faces; polygons are fan-triangulated, faces that repeat a vertex
 /// are dropped (and counted). Each triangle keeps its face index and fan number.
 struct PlyFaceChunk {
