@@ -5,7 +5,9 @@
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
+#include "citymesh/geo/crs.h"
 #include "citymesh/io/mesh_io.h"
+#include "citymesh/io/ply_reader.h"
 
 namespace citymesh::app {
 
@@ -18,6 +20,35 @@ std::vector<std::int32_t> source_faces(const Mesh& m) {
 void check_provenance_ids(const std::filesystem::path& file, std::uint64_t faces) {
   if (faces > std::uint64_t{INT32_MAX}) {
     throw InputError(fmt::format("{}: {} faces; provenance ids are 32-bit (split the file)", file.string(), faces));
+  }
+}
+
+void check_within_crs_area(const Config& config, const Acquisition& a, const Vec3d& position) {
+  const Crs crs = config.crs();
+  const AreaOfUse area = crs.area_of_use();
+  const Geodetic at = crs.to_lat_lon(position);
+  if (area.holds(at)) return;
+  throw InputError(fmt::format(
+      "{}: a vertex at x {:.2f}, y {:.2f} lies at lat {:.4f}, lon {:.4f}, outside the area {} ({}) is meant for "
+      "(lat {}..{}, lon {}..{}): are the file's coordinates in another CRS (longitude and latitude as metres, "
+      "another UTM zone)? Set [project] crs to the files' CRS",
+      a.path.string(), position.x, position.y, at.lat, at.lon, crs.spec(), crs.name(), area.lat_min, area.lat_max,
+      area.lon_min, area.lon_max));
+}
+
+void check_acquisition_location(const Config& config, const Acquisition& a) {
+  if (a.withdrawn) return;
+  PlyReadParams params = config.ply_read_params();
+  params.time_names.clear();  // only a position is wanted
+  PlyReader reader(a.path, params);
+  PlyVertexChunk vertices;
+  PlyFaceChunk faces;
+  for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;
+       kind = reader.next(vertices, faces)) {
+    if (kind == PlyReader::ChunkKind::vertices && !vertices.positions.empty()) {
+      check_within_crs_area(config, a, vertices.positions.front());
+      return;
+    }
   }
 }
 
@@ -35,6 +66,7 @@ Mesh read_acquisition(const Config& config, const Acquisition& a, const std::opt
   params.require_faces = true;
   MeshReadResult r = read_mesh(a.path, params);
   check_provenance_ids(a.path, r.stats.faces);
+  if (r.mesh.vertex_count() > 0) check_within_crs_area(config, a, r.mesh.world_position(0));
   log::info("{}: {} triangles", a.path.string(), r.mesh.triangle_count());
   return std::move(r.mesh);
 }

@@ -24,6 +24,16 @@ void check_provenance_ids(const std::filesystem::path& file, std::uint64_t faces
 /// Per triangle of an acquisition's mesh: the face index in the file (the provenance id).
 std::vector<std::int32_t> source_faces(const Mesh& acquisition);
 
+/// Throws InputError naming acquisition `a`'s file when `position` (one of its vertices, in
+/// the file's coordinates) lies outside the area the project CRS is meant for
+/// (Crs::area_of_use): its coordinates are in another CRS, and the map would be placed
+/// elsewhere on Earth.
+void check_within_crs_area(const Config& config, const Acquisition& a, const Vec3d& position);
+
+/// The same for the first vertex of `a`'s file, read without the rest (nothing for a
+/// withdrawn pass or a file with no vertex).
+void check_acquisition_location(const Config& config, const Acquisition& a);
+
 /// Reads acquisition `a` (with `origin`, the local frame every mesh of a run shares, when
 /// given). Throws InputError naming the file.
 Mesh read_acquisition(const Config& config, const Acquisition& a, const std::optional<Vec3d>& origin);

@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 #include <iostream>
 
+#include "acquisitions.h"
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
 #include "citymesh/io/ply_reader.h"
@@ -16,14 +17,17 @@ namespace citymesh::app {
 
 namespace {
 
-/// Each acquisition file's PLY header (not its data): readable, and a mesh rather than a point
-/// cloud, which `run` would otherwise take for a pass of no triangle. Withdrawn passes are not
-/// read.
+/// Each acquisition file's PLY header and first vertex (not the rest): readable, a mesh rather
+/// than a point cloud (which `run` would otherwise take for a pass of no triangle), and within
+/// the area the project CRS is meant for. Withdrawn passes are not read.
 void check_acquisition_headers(const Config& config) {
   for (const Acquisition& a : config.acquisition_list()) {
     if (a.withdrawn) continue;
-    const PlyReader reader(a.path, config.ply_read_params());
-    check_has_faces(a.path, reader.header());
+    {
+      const PlyReader reader(a.path, config.ply_read_params());
+      check_has_faces(a.path, reader.header());
+    }
+    check_acquisition_location(config, a);
   }
 }
 

@@ -51,6 +51,19 @@ nlohmann::json properties_json(const PlyElement& e) {
   return props;
 }
 
+/// Whether the file's box lies within the area its CRS is meant for (Crs::area_of_use):
+/// outside, its coordinates are likely in another CRS (run refuses such a file).
+bool within_area(const Crs& crs, const LatLonBox& g) {
+  const AreaOfUse area = crs.area_of_use();
+  return area.holds({.lat = g.lat_min, .lon = g.lon_min, .height = 0}) &&
+         area.holds({.lat = g.lat_max, .lon = g.lon_max, .height = 0});
+}
+
+std::string outside_area_note(const Crs& crs) {
+  return fmt::format(" -- OUTSIDE the area {} is meant for: coordinates in another CRS? (run refuses them)",
+                     crs.spec());
+}
+
 nlohmann::json inspection_json(const PlyInspection& r, const std::optional<Crs>& crs) {
   nlohmann::json j;
   j["file"] = r.path.string();
@@ -72,6 +85,7 @@ nlohmann::json inspection_json(const PlyInspection& r, const std::optional<Crs>&
       const LatLonBox g = lat_lon_box(*crs, r.bounds);
       j["crs"] = crs->spec();
       j["lat_lon_bounds"] = {{"lat", {g.lat_min, g.lat_max}}, {"lon", {g.lon_min, g.lon_max}}};
+      j["within_crs_area"] = within_area(*crs, g);
     }
   }
   return j;
@@ -102,8 +116,8 @@ void print_text(const PlyInspection& r, const std::optional<Crs>& crs) {
                        r.bounds.max.z);
     if (crs) {
       const LatLonBox g = lat_lon_box(*crs, r.bounds);
-      out += fmt::format("  lat/lon: lat {:.7f} .. {:.7f}, lon {:.7f} .. {:.7f}\n", g.lat_min, g.lat_max,
-                         g.lon_min, g.lon_max);
+      out += fmt::format("  lat/lon: lat {:.7f} .. {:.7f}, lon {:.7f} .. {:.7f}{}\n", g.lat_min, g.lat_max, g.lon_min,
+                         g.lon_max, within_area(*crs, g) ? "" : outside_area_note(*crs));
     } else {
       out += "  lat/lon: unknown (pass --crs or --config)\n";
     }

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "acquisitions.h"
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
@@ -152,6 +153,10 @@ TileStore reused_or_tiled_store(const Config& config, const RunFingerprints& fin
 
 TileStore prepare_tile_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                              const std::optional<Subset>& subset) {
+  // Before any work, and even when the tiling is reused (it does not depend on the CRS): a
+  // file in another CRS would put the map elsewhere on Earth. Every rank looks, so that all
+  // stop alike.
+  for (const Acquisition& a : config.acquisition_list()) check_acquisition_location(config, a);
   TileStore store = reused_or_tiled_store(config, fingerprints, cluster, subset);
   // Nothing to process: said here, rather than by an output step failing on an empty map.
   if (store.tiles.empty()) {

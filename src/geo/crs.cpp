@@ -105,6 +105,18 @@ struct Crs::Impl {
   }
 };
 
+AreaOfUse Crs::area_of_use() const {
+  if (std::holds_alternative<Lambert93>(impl_->projection)) return {40.15, 52.56, -10.86, 11.38};
+  if (const auto* utm = std::get_if<Utm>(&impl_->projection)) {
+    const double lon0 = utm->central_meridian();
+    return utm->north ? AreaOfUse{-1.0, 85.0, lon0 - 4.5, lon0 + 4.5} : AreaOfUse{-81.0, 1.0, lon0 - 4.5, lon0 + 4.5};
+  }
+  const auto& enu = std::get<LocalEnu>(impl_->projection);
+  // Near a pole or the antimeridian a box of degrees does not hold the frame's surroundings.
+  if (std::abs(enu.lat0) > 88.0 || std::abs(enu.lon0) > 178.0) return {};
+  return {enu.lat0 - 1.0, enu.lat0 + 1.0, enu.lon0 - 1.0, enu.lon0 + 1.0};
+}
+
 Crs Crs::parse(std::string_view spec, VerticalDatum datum) {
   auto impl = std::make_shared<Impl>();
   impl->spec = std::string(spec);

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "citymesh/config/config.h"
 #include "citymesh/io/mesh_io.h"
@@ -57,6 +58,7 @@ TEST(Cli, DemoConfigChecksAndDescribesItsAcquisitions) {
   while (std::getline(lines, line)) {
     const auto j = nlohmann::json::parse(line);
     EXPECT_TRUE(j["sensor_origin"].get<bool>());
+    EXPECT_TRUE(j["within_crs_area"].get<bool>());
     EXPECT_GT(j["triangles"].get<int>(), 0);
     const double lat = j["lat_lon_bounds"]["lat"][0].get<double>();
     EXPECT_NEAR(lat, 48.84, 0.05);  // the demo street is in Paris
@@ -113,19 +115,27 @@ void write_three_points(const std::filesystem::path& path, bool face_element, co
                                      faces));
 }
 
+/// `config --check`, `detect` and `run` of `config` (in `dir`) each stop with exit code 2 and
+/// an error holding every one of `phrases`, and no output is begun.
+void expect_refused_before_any_work(const std::filesystem::path& dir, const std::string& config,
+                                    const std::vector<std::string>& phrases) {
+  for (const char* command : {"config --check", "detect", "run --no-pictures"}) {
+    const auto r = test::run_citymesh(fmt::format("{} {}", command, config));
+    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.err;
+    for (const std::string& phrase : phrases) {
+      EXPECT_NE(r.err.find(phrase), std::string::npos) << command << ": " << r.err;
+    }
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic")) << "no output begun";
+}
+
 TEST(Cli, APointCloudGivenAsAnAcquisitionIsRefusedByNameBeforeAnyWork) {
   test::TempDir dir;
   write_three_points(dir / "mesh.ply", true, "3 0 1 2\n");
   write_three_points(dir / "points.ply", false);
   write_two_pass_config(dir / "run.toml", "mesh.ply", "points.ply");
   const std::string config = (dir / "run.toml").string();
-  for (const char* command : {"config --check", "detect", "run --no-pictures"}) {
-    const auto r = test::run_citymesh(fmt::format("{} {}", command, config));
-    EXPECT_EQ(r.exit_code, 2) << command << ": " << r.err;
-    EXPECT_NE(r.err.find("points.ply: no face element: a point cloud, not a mesh"), std::string::npos)
-        << command << ": " << r.err;
-  }
-  EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic")) << "no output begun";
+  expect_refused_before_any_work(dir.path(), config, {"points.ply: no face element: a point cloud, not a mesh"});
   // `--no-file-check` reads no file.
   EXPECT_EQ(test::run_citymesh("config --no-file-check --check " + config).exit_code, 0);
 }
@@ -139,6 +149,44 @@ TEST(Cli, ARunWhoseAcquisitionsHoldNoTriangleSaysSoAtItsStart) {
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("run.toml: the acquisitions hold no triangle"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(dir / "out/mosaic")) << "no output begun";
+}
+
+TEST(Cli, AnAcquisitionInAnotherCrsIsRefusedByNameBeforeAnyWork) {
+  test::TempDir dir;
+  write_three_points(dir / "lambert.ply", true, "3 0 1 2\n");
+  // The same triangle with longitude and latitude written where metres belong.
+  std::string degrees = test::read_text(dir / "lambert.ply");
+  for (const auto& [from, to] :
+       std::vector<std::pair<std::string, std::string>>{{"651000 6860000 ", "2.3500 48.8500 "},
+                                                        {"651001 6860000 ", "2.3501 48.8500 "},
+                                                        {"651000 6860001 ", "2.3500 48.8501 "},
+                                                        {"651000 6859990 ", "2.3500 48.8499 "}}) {
+    for (std::size_t at = degrees.find(from); at != std::string::npos; at = degrees.find(from, at)) {
+      degrees.replace(at, from.size(), to);
+    }
+  }
+  // Every pass so: a pass in another CRS than the others is refused anyway (too far from the
+  // first one's frame), but not when all of them are.
+  test::write_text(dir / "degrees.ply", degrees);
+  test::write_text(dir / "degrees2.ply", degrees);
+  write_two_pass_config(dir / "run.toml", "degrees.ply", "degrees2.ply");
+  const std::string config = (dir / "run.toml").string();
+  expect_refused_before_any_work(dir.path(), config,
+                                 {"degrees.ply: a vertex at x 2.35, y 48.85 lies at lat",
+                                  "outside the area EPSG:2154 (RGF93 / Lambert-93) is meant for"});
+  // `info` describes them, and says where they fall.
+  const auto info = test::run_citymesh("info --json --config " + config);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_FALSE(nlohmann::json::parse(info.out.substr(0, info.out.find('\n')))["within_crs_area"].get<bool>());
+  // Lambert-93 metres in a local frame at Paris are refused too.
+  test::write_text(dir / "lambert2.ply", test::read_text(dir / "lambert.ply"));
+  write_two_pass_config(dir / "run.toml", "lambert.ply", "lambert2.ply");
+  std::string enu = test::read_text(dir / "run.toml");
+  enu.replace(enu.find("EPSG:2154"), 9, "ENU:48.8566,2.3522,35");
+  test::write_text(dir / "enu.toml", enu);
+  const auto local = test::run_citymesh("config --check " + (dir / "enu.toml").string());
+  EXPECT_EQ(local.exit_code, 2) << local.err;
+  EXPECT_NE(local.err.find("lambert.ply: a vertex at x 651000.00"), std::string::npos) << local.err;
 }
 
 /// A spinning sensor's frame at (sx, 0, 1.5): 8 rings from -10 to +10 degrees, 64 columns,

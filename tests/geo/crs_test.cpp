@@ -114,6 +114,30 @@ TEST(Crs, RefusesUnsupportedSpecs) {
   EXPECT_EQ(Crs::parse("EPSG:32733").name(), "WGS 84 / UTM zone 33S");
 }
 
+TEST(Crs, AreaOfUseHoldsItsRegionAndNotAnotherCrssCoordinates) {
+  const Crs lambert = Crs::parse("EPSG:2154");
+  const AreaOfUse france = lambert.area_of_use();
+  EXPECT_TRUE(france.holds(lambert.to_lat_lon({651000, 6860700, 40})));   // Paris
+  EXPECT_TRUE(france.holds(lambert.to_lat_lon({1230000, 6100000, 0})));   // Corsica
+  EXPECT_FALSE(france.holds(lambert.to_lat_lon({2.3522, 48.8566, 35})));  // lon/lat as metres
+  EXPECT_FALSE(france.holds(lambert.to_lat_lon({500000, 4000000, 0})));   // Lambert's north-south reach
+  EXPECT_FALSE(france.holds({.lat = std::nan(""), .lon = 2.35, .height = 0}));
+
+  const Crs utm31n = Crs::parse("EPSG:32631");
+  const AreaOfUse zone31 = utm31n.area_of_use();
+  EXPECT_TRUE(zone31.holds({.lat = 48.85, .lon = 2.35, .height = 0}));
+  EXPECT_TRUE(zone31.holds({.lat = 48.85, .lon = 7.0, .height = 0}));  // a little past the band's edge
+  EXPECT_FALSE(zone31.holds({.lat = 48.85, .lon = 12.0, .height = 0}));
+  EXPECT_FALSE(zone31.holds({.lat = -20, .lon = 3.0, .height = 0}));  // the southern hemisphere
+  EXPECT_TRUE(Crs::parse("EPSG:32731").area_of_use().holds({.lat = -20, .lon = 3.0, .height = 0}));
+
+  const Crs enu = Crs::parse("ENU:48.8566,2.3522,35");
+  EXPECT_TRUE(enu.area_of_use().holds(enu.to_lat_lon({20000, -30000, 0})));
+  EXPECT_FALSE(enu.area_of_use().holds(enu.to_lat_lon({651000, 6860700, 40})));  // Lambert-93 metres
+  // Near a pole a box of degrees would not hold the frame's surroundings: anywhere goes.
+  EXPECT_TRUE(Crs::parse("ENU:89.5,0,0").area_of_use().holds({.lat = 89.9, .lon = 170, .height = 0}));
+}
+
 TEST(VerticalDatum, ParsesKindsAndChecksTheUndulation) {
   EXPECT_EQ(parse_vertical_datum("ellipsoidal", 0).kind, VerticalDatum::Kind::ellipsoidal);
   EXPECT_EQ(parse_vertical_datum("orthometric", 44.6).geoid_undulation, 44.6);

@@ -26,6 +26,17 @@ struct Geodetic {
   double lat = 0, lon = 0, height = 0;
 };
 
+/// Where a CRS is meant for, in degrees: EPSG's area of use widened by a margin, so that data
+/// near its edges passes. A point outside it lies in another CRS's coordinates (longitude and
+/// latitude given as metres, another projection, another UTM zone or hemisphere).
+struct AreaOfUse {
+  double lat_min = -90, lat_max = 90, lon_min = -180, lon_max = 180;
+  /// False for NaN coordinates too.
+  [[nodiscard]] bool holds(const Geodetic& g) const {
+    return g.lat >= lat_min && g.lat <= lat_max && g.lon >= lon_min && g.lon <= lon_max;
+  }
+};
+
 /// A project coordinate reference system:
 /// - "EPSG:2154": RGF93 / Lambert-93 (GRS80);
 /// - "EPSG:32601".."EPSG:32660" and "EPSG:32701".."EPSG:32760": WGS 84 / UTM north and south;
@@ -43,6 +54,10 @@ class Crs {
   [[nodiscard]] std::string name() const;
   [[nodiscard]] const VerticalDatum& vertical_datum() const;
   [[nodiscard]] bool is_local_frame() const;
+  /// Lambert-93: metropolitan France and Corsica (EPSG: 41.15..51.56 N, 9.86 W..10.38 E) and a
+  /// degree around; UTM: the zone's 6-degree band and 1.5 degrees either side, its hemisphere
+  /// and a degree across the equator; a local ENU frame: a degree around its origin.
+  [[nodiscard]] AreaOfUse area_of_use() const;
 
   /// Latitude/longitude of a projected point (the height is irrelevant, no datum needed).
   [[nodiscard]] Geodetic to_lat_lon(const Vec3d& p) const;
