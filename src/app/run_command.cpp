@@ -9,15 +9,28 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
+#include "citymesh/core/process_memory.h"
+#include "cluster.h"
 #include "command.h"
 #include "pipeline.h"
-#include "cluster.h"
 #include "tile_plan.h"
 #include "tiled_run.h"
 
 namespace citymesh::app {
 
 namespace {
+
+/// A budget past the machine's memory bounds nothing: the tiles in flight may then take the
+/// machine into swap, or the process be killed, with no word from the run.
+void warn_if_budget_past_the_machine(const Config& config) {
+  const std::uint64_t machine = physical_memory_bytes();
+  if (machine == 0 || config.run.memory <= machine) return;
+  log::warn(
+      "the memory budget ({:.1f} GiB) is more than this machine's memory ({:.1f} GiB): it bounds nothing, and "
+      "the tiles in flight may take the machine into swap; give [run] memory or --memory below {:.1f} GiB",
+      static_cast<double>(config.run.memory) / (1ull << 30), static_cast<double>(machine) / (1ull << 30),
+      static_cast<double>(machine) / (1ull << 30));
+}
 
 class RunCommand final : public Command {
  public:
@@ -53,6 +66,7 @@ class RunCommand final : public Command {
     if (subset && cluster->size() > 1) throw UsageError("--subset is for runs without MPI; under mpirun the ranks share the tiles");
     try {
       const Config config = options_.load();
+      warn_if_budget_past_the_machine(config);
       const ThreadLimit limit(options_.threads.value_or(config.run.threads));
       run_tiled(config, {.force = force_, .pictures = options_.pictures(), .subset = subset}, *cluster);
     } catch (const Error& e) {

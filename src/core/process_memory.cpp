@@ -9,6 +9,7 @@
 
 #if defined(__GLIBC__)
 #include <malloc.h>
+#include <unistd.h>
 #endif
 
 namespace citymesh {
@@ -32,6 +33,11 @@ std::uint64_t status_kib(const std::string& name) {
 
 std::uint64_t resident_bytes() { return status_kib("VmRSS"); }
 std::uint64_t peak_resident_bytes() { return status_kib("VmHWM"); }
+
+std::uint64_t physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) : 0;
+}
 
 std::uint64_t memory_left(std::uint64_t budget) {
   const std::uint64_t resident = resident_bytes();

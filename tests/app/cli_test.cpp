@@ -189,6 +189,21 @@ TEST(Cli, AnAcquisitionInAnotherCrsIsRefusedByNameBeforeAnyWork) {
   EXPECT_NE(local.err.find("lambert.ply: a vertex at x 651000.00"), std::string::npos) << local.err;
 }
 
+TEST(Cli, ABudgetPastTheMachinesMemoryIsWarnedOf) {
+  test::TempDir dir;
+  write_three_points(dir / "a.ply", true, "3 0 1 2\n");
+  write_three_points(dir / "b.ply", true, "3 0 1 2\n");
+  write_two_pass_config(dir / "run.toml", "a.ply", "b.ply");
+  const std::string config = (dir / "run.toml").string();
+  constexpr const char* kWarning = "is more than this machine's memory";
+  const auto past = test::run_citymesh("run --no-pictures --memory 1000TiB " + config);
+  EXPECT_EQ(past.exit_code, 0) << past.err;
+  EXPECT_NE(past.err.find(kWarning), std::string::npos) << past.err;
+  const auto within = test::run_citymesh("run --no-pictures --memory 1GiB " + config);
+  EXPECT_EQ(within.exit_code, 0) << within.err;
+  EXPECT_EQ(within.err.find(kWarning), std::string::npos) << within.err;
+}
+
 /// A spinning sensor's frame at (sx, 0, 1.5): 8 rings from -10 to +10 degrees, 64 columns,
 /// every return 6 m away (a round wall about the sensor), as ASCII PLY with ring and column.
 void write_spinning_frame(const std::filesystem::path& path, double sx) {

@@ -5,6 +5,8 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
+#include <string>
 
 namespace citymesh {
 namespace {
@@ -15,6 +17,18 @@ TEST(ProcessMemory, ReadsThisProcesssResidentSet) {
   const std::uint64_t now = resident_bytes();
   EXPECT_GT(now, 0u);
   EXPECT_GE(peak_resident_bytes(), now);
+}
+
+TEST(ProcessMemory, TheMachinesMemoryHoldsThisProcessAndAgreesWithProc) {
+  const std::uint64_t machine = physical_memory_bytes();
+  EXPECT_GT(machine, peak_resident_bytes());
+  // /proc/meminfo's MemTotal is what the kernel manages: a little under the pages counted.
+  std::ifstream meminfo("/proc/meminfo");
+  std::string key;
+  std::uint64_t kib = 0;
+  ASSERT_TRUE(meminfo >> key >> kib);
+  ASSERT_EQ(key, "MemTotal:");
+  EXPECT_NEAR(static_cast<double>(machine), static_cast<double>(kib) * 1024, 0.05 * static_cast<double>(machine));
 }
 
 #if defined(__GLIBC__) && !defined(__SANITIZE_ADDRESS__)  // ASan has its own allocator

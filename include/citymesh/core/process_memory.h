@@ -12,6 +12,8 @@ namespace citymesh {
 std::uint64_t resident_bytes();
 /// Largest resident set size so far (VmHWM), in bytes.
 std::uint64_t peak_resident_bytes();
+/// This machine's physical memory, in bytes (0 where it cannot be told).
+std::uint64_t physical_memory_bytes();
 /// What a memory budget leaves beside the resident set now (0 once it is passed).
 std::uint64_t memory_left(std::uint64_t budget);
 /// "resident N MiB (peak M MiB)": how the debug lines of long stages report memory.
