@@ -108,8 +108,15 @@ struct Crs::Impl {
 AreaOfUse Crs::area_of_use() const {
   if (std::holds_alternative<Lambert93>(impl_->projection)) return {40.15, 52.56, -10.86, 11.38};
   if (const auto* utm = std::get_if<Utm>(&impl_->projection)) {
+    AreaOfUse area =
+        utm->north ? AreaOfUse{.lat_min = -1.0, .lat_max = 85.0} : AreaOfUse{.lat_min = -81.0, .lat_max = 1.0};
     const double lon0 = utm->central_meridian();
-    return utm->north ? AreaOfUse{-1.0, 85.0, lon0 - 4.5, lon0 + 4.5} : AreaOfUse{-81.0, 1.0, lon0 - 4.5, lon0 + 4.5};
+    // Zones 1 and 60 reach across the antimeridian: their longitudes are not one interval.
+    if (std::abs(lon0) + 4.5 <= 180.0) {
+      area.lon_min = lon0 - 4.5;
+      area.lon_max = lon0 + 4.5;
+    }
+    return area;
   }
   const auto& enu = std::get<LocalEnu>(impl_->projection);
   // Near a pole or the antimeridian a box of degrees does not hold the frame's surroundings.

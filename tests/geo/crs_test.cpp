@@ -130,6 +130,8 @@ TEST(Crs, AreaOfUseHoldsItsRegionAndNotAnotherCrssCoordinates) {
   EXPECT_FALSE(zone31.holds({.lat = 48.85, .lon = 12.0, .height = 0}));
   EXPECT_FALSE(zone31.holds({.lat = -20, .lon = 3.0, .height = 0}));  // the southern hemisphere
   EXPECT_TRUE(Crs::parse("EPSG:32731").area_of_use().holds({.lat = -20, .lon = 3.0, .height = 0}));
+  // Zone 60's band reaches 180 degrees: data just across it (-179.5) is no mistake.
+  EXPECT_TRUE(Crs::parse("EPSG:32760").area_of_use().holds({.lat = -40, .lon = -179.5, .height = 0}));
 
   const Crs enu = Crs::parse("ENU:48.8566,2.3522,35");
   EXPECT_TRUE(enu.area_of_use().holds(enu.to_lat_lon({20000, -30000, 0})));

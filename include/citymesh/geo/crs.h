@@ -55,8 +55,9 @@ class Crs {
   [[nodiscard]] const VerticalDatum& vertical_datum() const;
   [[nodiscard]] bool is_local_frame() const;
   /// Lambert-93: metropolitan France and Corsica (EPSG: 41.15..51.56 N, 9.86 W..10.38 E) and a
-  /// degree around; UTM: the zone's 6-degree band and 1.5 degrees either side, its hemisphere
-  /// and a degree across the equator; a local ENU frame: a degree around its origin.
+  /// degree around; UTM: the zone's 6-degree band and 1.5 degrees either side (any longitude
+  /// for zones 1 and 60, whose margin crosses the antimeridian), its hemisphere and a degree
+  /// across the equator; a local ENU frame: a degree around its origin.
   [[nodiscard]] AreaOfUse area_of_use() const;
 
   /// Latitude/longitude of a projected point (the height is irrelevant, no datum needed).
