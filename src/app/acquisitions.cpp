@@ -36,11 +36,12 @@ void check_within_crs_area(const Config& config, const Acquisition& a, const Vec
       area.lon_min, area.lon_max));
 }
 
-void check_acquisition_location(const Config& config, const Acquisition& a) {
+void check_acquisition_file(const Config& config, const Acquisition& a) {
   if (a.withdrawn) return;
   PlyReadParams params = config.ply_read_params();
   params.time_names.clear();  // only a position is wanted
   PlyReader reader(a.path, params);
+  check_has_faces(a.path, reader.header());
   PlyVertexChunk vertices;
   PlyFaceChunk faces;
   for (auto kind = reader.next(vertices, faces); kind != PlyReader::ChunkKind::end;

@@ -30,9 +30,11 @@ std::vector<std::int32_t> source_faces(const Mesh& acquisition);
 /// elsewhere on Earth.
 void check_within_crs_area(const Config& config, const Acquisition& a, const Vec3d& position);
 
-/// The same for the first vertex of `a`'s file, read without the rest (nothing for a
-/// withdrawn pass or a file with no vertex).
-void check_acquisition_location(const Config& config, const Acquisition& a);
+/// What `a`'s file must be before any work, from its header and first vertex only (nothing
+/// read of a withdrawn pass): a mesh, not a point cloud (check_has_faces), whose first vertex
+/// lies within the area of the project CRS (check_within_crs_area). Throws InputError naming
+/// the file.
+void check_acquisition_file(const Config& config, const Acquisition& a);
 
 /// Reads acquisition `a` (with `origin`, the local frame every mesh of a run shares, when
 /// given). Throws InputError naming the file.

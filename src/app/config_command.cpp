@@ -9,27 +9,12 @@
 #include "acquisitions.h"
 #include "citymesh/config/config.h"
 #include "citymesh/core/error.h"
-#include "citymesh/io/ply_reader.h"
 #include "command.h"
 #include "mosaic_step.h"
 
 namespace citymesh::app {
 
 namespace {
-
-/// Each acquisition file's PLY header and first vertex (not the rest): readable, a mesh rather
-/// than a point cloud (which `run` would otherwise take for a pass of no triangle), and within
-/// the area the project CRS is meant for. Withdrawn passes are not read.
-void check_acquisition_headers(const Config& config) {
-  for (const Acquisition& a : config.acquisition_list()) {
-    if (a.withdrawn) continue;
-    {
-      const PlyReader reader(a.path, config.ply_read_params());
-      check_has_faces(a.path, reader.header());
-    }
-    check_acquisition_location(config, a);
-  }
-}
 
 class ConfigCommand final : public Command {
  public:
@@ -56,7 +41,10 @@ class ConfigCommand final : public Command {
     if (file.empty()) throw UsageError("give --dump-defaults, --check FILE or --print FILE");
     const Config config = load_config(file, {.overrides = overrides_, .check_files = !no_file_check_});
     check_seam_pass(config);  // what `run` would refuse at its start
-    if (!no_file_check_) check_acquisition_headers(config);
+    if (!no_file_check_) {
+      // What `run` checks of each file before any work: a mesh, within the CRS's area.
+      for (const Acquisition& a : config.acquisition_list()) check_acquisition_file(config, a);
+    }
     if (!print_.empty()) {
       std::cout << effective_config_toml(config);
       return;

@@ -153,10 +153,10 @@ TileStore reused_or_tiled_store(const Config& config, const RunFingerprints& fin
 
 TileStore prepare_tile_store(const Config& config, const RunFingerprints& fingerprints, Cluster& cluster,
                              const std::optional<Subset>& subset) {
-  // Before any work, and even when the tiling is reused (it does not depend on the CRS): a
-  // file in another CRS would put the map elsewhere on Earth. Every rank looks, so that all
-  // stop alike.
-  for (const Acquisition& a : config.acquisition_list()) check_acquisition_location(config, a);
+  // Before any work, and even when the tiling is reused (it depends on neither the CRS nor a
+  // face element being there): a point cloud or a file in another CRS would give an empty map
+  // or one elsewhere on Earth. Every rank looks, so that all stop alike.
+  for (const Acquisition& a : config.acquisition_list()) check_acquisition_file(config, a);
   TileStore store = reused_or_tiled_store(config, fingerprints, cluster, subset);
   // Nothing to process: said here, rather than by an output step failing on an empty map.
   if (store.tiles.empty()) {
