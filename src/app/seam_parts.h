@@ -77,7 +77,7 @@ class SeamPartFiles final : public PartStore {
   void release_stitched();
   [[nodiscard]] const std::filesystem::path& dir() const { return dir_; }
   /// Bytes of part `part`'s file before stitching: what stitching it costs, roughly.
-  [[nodiscard]] std::uint64_t input_bytes(std::size_t part) const;
+  [[nodiscard]] std::uint64_t input_bytes(std::size_t part) const override;
   /// "<dir>/<part>.<suffix>": a file beside the part's (the outcome of its stitching).
   [[nodiscard]] std::filesystem::path beside(std::size_t part, std::string_view suffix) const;
 

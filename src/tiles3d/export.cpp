@@ -357,12 +357,15 @@ TilesetExportStats export_tileset(const TilesetLeaves& leaves, const Crs& crs, c
       if (!written.contains({node.level, node.key})) sink(node);
     };
     const TileTreeBuild tree(keys, source, params.tree, unless_written);
+    // The cells weighed by their leaves: those along the output's edges hold few.
     std::optional<StageProgress> progress;
-    if (!work.progress.empty())
-      progress.emplace(StageProgressParams{.stage = work.progress + " cells built", .total = tree.cell_count()});
+    if (!work.progress.empty()) {
+      progress.emplace(StageProgressParams{
+          .stage = work.progress + " cells built", .total = tree.cell_count(), .total_work = keys.size()});
+    }
     const std::function<ExportedCell(std::size_t)> here = [&](std::size_t c) {
       ExportedCell cell = export_cell(leaves, crs, frame, params, c);
-      if (progress) progress->advance();
+      if (progress) progress->advance(1, tree.cell_leaves(c).size());
       return cell;
     };
     Stopwatch cells_clock;

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstdio>
 #include <mutex>
 #include <string>
@@ -87,6 +88,28 @@ TEST(StageProgress, FinishSaysTheLastLineWhenOthersDidTheItems) {
   ASSERT_EQ(heard.text.size(), 1u);
   EXPECT_EQ(heard.read(0).done, 10u);
   EXPECT_EQ(heard.read(0).total, 10u);
+}
+
+TEST(StageProgress, TheEtaWeighsTheItemsByTheirWorkWhenTheyDiffer) {
+  // Two parts: a small one done, a large one left. Counted alike, the ETA would be the time
+  // spent so far (~50 ms: "0 s"); weighed, 99 times it (at least 4.95 s).
+  Heard heard;
+  StageProgress weighed({.stage = "parts stitched", .total = 2, .total_work = 100, .interval = 0, .say = heard.sink()});
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  weighed.advance(1, 1);
+  EXPECT_EQ(weighed.done_work(), 1u);
+  weighed.advance(1, 99);
+  ASSERT_EQ(heard.text.size(), 2u);
+  EXPECT_GE(heard.read(0).eta, 4.0) << heard.text[0];
+  EXPECT_EQ(heard.read(1).eta, 0.0) << heard.text[1];
+
+  // Without work the items count alike, as before.
+  Heard alike;
+  StageProgress counted({.stage = "parts stitched", .total = 100, .interval = 0, .say = alike.sink()});
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  counted.advance(99);
+  EXPECT_LT(alike.read(0).eta, 1.0) << alike.text[0];
+  EXPECT_EQ(counted.done_work(), 0u);
 }
 
 }  // namespace

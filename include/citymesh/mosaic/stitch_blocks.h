@@ -101,6 +101,9 @@ class PartStore {
   /// Part `part` as it was before stitching is not read again (its level is done): the store
   /// may let it go.
   virtual void release_input(std::size_t /*part*/) {}
+  /// The size of part `part`'s input in bytes, while it is kept (what stitching it costs,
+  /// roughly); 0 when the store does not tell.
+  [[nodiscard]] virtual std::uint64_t input_bytes(std::size_t /*part*/) const { return 0; }
 };
 
 /// A part of a run: its key and the box of its triangles before and after stitching.
@@ -169,6 +172,9 @@ struct PartStitchRun {
   /// Told of each part stitched by this process, and of a level's other parts when the level
   /// ends (run_level may hand them to other processes); null: none.
   StageProgress* progress = nullptr;
+  /// Per part: what stitching it costs, roughly (its input's bytes), as the progress's work;
+  /// empty: the parts count alike.
+  std::vector<std::uint64_t> part_work{};
 };
 
 /// The parts of one level of stitch_parts(), each stitched on its own: loaded with the parts
