@@ -43,6 +43,9 @@ class RunCommand final : public Command {
     options_.declare(app);
     app.add_option("--memory", memory_, "memory budget for tiles in flight, e.g. 2GiB (default: [run] memory)");
     app.add_flag("--force", force_, "discard work in the work folder made with another config instead of refusing");
+    app.add_flag("--plan", plan_,
+                 "say what the run would do with each tile (process, keep or reuse it) and how long the tiles would "
+                 "take, then stop: tiles what is not tiled yet, processes nothing, writes no output");
     app.add_option("--subset", subset_,
                    "process only part i of N of the tiles (and the tiles of other parts they wait for), e.g. "
                    "--subset 2/8 in a job array; then citymesh merge CONFIG writes the outputs");
@@ -64,11 +67,18 @@ class RunCommand final : public Command {
     if (subset_) subset = Subset::parse(*subset_);
     const std::unique_ptr<Cluster> cluster = join_cluster();
     if (subset && cluster->size() > 1) throw UsageError("--subset is for runs without MPI; under mpirun the ranks share the tiles");
+    if (plan_ && (subset || cluster->size() > 1)) {
+      throw UsageError("--plan is for a whole run in one process: leave out --subset, and run it without mpirun");
+    }
+    if (plan_ && force_) {
+      throw UsageError(
+          "--plan discards no work: leave out --force (a run with --force redoes the work its changed keys reach)");
+    }
     try {
       const Config config = options_.load();
       warn_if_budget_past_the_machine(config);
       const ThreadLimit limit(options_.threads.value_or(config.run.threads));
-      run_tiled(config, {.force = force_, .pictures = options_.pictures(), .subset = subset}, *cluster);
+      run_tiled(config, {.force = force_, .pictures = options_.pictures(), .subset = subset, .plan = plan_}, *cluster);
     } catch (const Error& e) {
       // The other ranks may be waiting for this one: end them all, with this error's code.
       if (cluster->size() > 1) {
@@ -84,6 +94,7 @@ class RunCommand final : public Command {
   std::optional<std::string> memory_;
   std::optional<std::string> subset_;
   bool force_ = false;
+  bool plan_ = false;
 };
 
 }  // namespace

@@ -197,7 +197,8 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
   return f;
 }
 
-void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
+void check_run_config_unrecorded(const std::filesystem::path& work, const std::map<std::string, std::string>& keys,
+                                 bool force) {
   const std::filesystem::path file = work / kRunConfigFile;
   std::ifstream in(file);
   const std::string build = build_name();
@@ -294,8 +295,12 @@ void check_run_config(const std::filesystem::path& work, const std::map<std::str
                       work.string(), fmt::join(changed, "; ")));
     }
   }
+}
+
+void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force) {
+  check_run_config_unrecorded(work, keys, force);
   std::filesystem::create_directories(work);
-  write_file_atomically(file, nlohmann::json{{"keys", keys}, {"build", build}}.dump(1) + "\n");
+  write_file_atomically(work / kRunConfigFile, nlohmann::json{{"keys", keys}, {"build", build_name()}}.dump(1) + "\n");
 }
 
 }  // namespace citymesh::app

@@ -50,5 +50,9 @@ RunFingerprints run_fingerprints(const std::map<std::string, std::string>& keys,
 /// Says when another build of citymesh did the work (its results are made again: the run
 /// fingerprint holds the build). Then records `keys` and this build there.
 void check_run_config(const std::filesystem::path& work, const std::map<std::string, std::string>& keys, bool force);
+/// The same checks and messages, recording nothing: a plan of the run (`run --plan`) leaves
+/// the record as the last run made it.
+void check_run_config_unrecorded(const std::filesystem::path& work, const std::map<std::string, std::string>& keys,
+                                 bool force);
 
 }  // namespace citymesh::app

@@ -24,6 +24,7 @@
 #include "mosaic_output.h"
 #include "mosaic_step.h"
 #include "output_ranks.h"
+#include "run_plan.h"
 #include "run_stages.h"
 #include "run_state.h"
 #include "seam_cache.h"
@@ -383,7 +384,11 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   if (cluster.root()) {
     // The root holds the lock for the whole job (its ranks share the work); subsets share it.
     lock.emplace(config.project.work, !options.subset);
-    check_run_config(config.project.work, keys, options.force);
+    if (options.plan) {
+      check_run_config_unrecorded(config.project.work, keys, options.force);
+    } else {
+      check_run_config(config.project.work, keys, options.force);
+    }
     remove_leftovers_of_ended_runs(config);
   }
   const RunFingerprints fingerprints = run_fingerprints(keys, config.acquisitions.size());
@@ -393,6 +398,10 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   // system instead of staying resident under the next one's peak.
   release_freed_memory();
   nlohmann::json seconds{{"tiling", clock.restart()}};
+  if (options.plan) {
+    std::cout << describe_plan(plan_run(config, store, digests), available_threads());
+    return;
+  }
   if (options.subset) return run_subset(config, store, digests, *options.subset, cluster);
   const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();

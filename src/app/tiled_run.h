@@ -21,6 +21,9 @@ struct TiledRunOptions {
   PictureOptions pictures;
   /// Only this part of the tiles, and no outputs (`citymesh merge` writes them).
   std::optional<Subset> subset;
+  /// Tile what is not tiled yet, then say what the run would do with each tile and stop
+  /// (run_plan.h): no tile processed, no output written, the run config not recorded.
+  bool plan = false;
 };
 
 /// Runs every step tile by tile, on this process or on every rank of `cluster`; see

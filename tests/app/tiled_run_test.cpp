@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <set>
 #include <string>
 #include <utility>
@@ -407,12 +408,19 @@ TilesByPass tiles_by_pass(const nlohmann::json& manifest, std::size_t a) {
   return out;
 }
 
-/// The tiles a run processed (its report's tiles not marked reused).
+/// The per_tile entries of the tiles a run processed (its report's tiles not marked reused).
+std::vector<nlohmann::json> processed_entries(const nlohmann::json& report) {
+  std::vector<nlohmann::json> processed;
+  for (const auto& entry : report["per_tile"]) {
+    if (!entry.contains("reused")) processed.push_back(entry);
+  }
+  return processed;
+}
+
+/// The tiles a run processed.
 std::set<std::string> processed_tiles(const nlohmann::json& report) {
   std::set<std::string> processed;
-  for (const auto& entry : report["per_tile"]) {
-    if (!entry.contains("reused")) processed.insert(entry["tile"].get<std::string>());
-  }
+  for (const auto& entry : processed_entries(report)) processed.insert(entry["tile"].get<std::string>());
   return processed;
 }
 
@@ -472,6 +480,113 @@ TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFres
   const auto five_fresh = run("five.toml", "g");
   ASSERT_EQ(five_fresh.exit_code, 0) << five_fresh.err;
   expect_same_outputs(dir / "sim/u", dir / "sim/g", "withdrawing differs from a fresh run");
+}
+
+/// What the first line of `run --plan` says: tiles in all, to process and their input
+/// triangles, kept unless a neighbour decides otherwise (and theirs), reused. Zeros and a
+/// failure when the line is not there.
+struct PlanLine {
+  long tiles = 0, to_process = 0, to_process_triangles = 0, may_be_kept = 0, may_be_kept_triangles = 0, reused = 0;
+};
+PlanLine plan_line(const std::string& out) {
+  static const std::regex line(
+      R"(plan: (\d+) tiles: (\d+) to process \((\d+) input triangles\)(?:, (\d+) kept unless [^(]*\((\d+) input triangles\))?, (\d+) reused)");
+  std::smatch m;
+  PlanLine p;
+  if (!std::regex_search(out, m, line)) {
+    ADD_FAILURE() << "no plan line in:\n" << out;
+    return p;
+  }
+  const auto number = [&](int k) { return m[k].matched ? std::stol(m[k].str()) : 0L; };
+  p = {number(1), number(2), number(3), number(4), number(5), number(6)};
+  return p;
+}
+
+/// The owned triangles of the tiles `report` (run.json) says were processed.
+long processed_triangles(const nlohmann::json& report) {
+  long n = 0;
+  for (const auto& entry : processed_entries(report)) n += entry["owned"].get<long>();
+  return n;
+}
+
+TEST(TiledRun, APlanSaysWhatARunWouldDoWithEachTileAndDoesNoneOfIt) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
+  // As in the append test above: a sixth pass that some tiles' neighbours wait for.
+  ASSERT_TRUE(test::write_append_configs(dir / "sim", 0.35, 27.8 / 60));
+  const auto command = [&](const std::string& file, const std::string& extra) {
+    return test::run_citymesh(run_file_args(sim, file, "u", "--set tiling.tile_size=10 " + extra));
+  };
+
+  // A new work folder: every tile to process, none processed, no output, no run recorded.
+  const auto fresh = command("five.toml", "--plan");
+  ASSERT_EQ(fresh.exit_code, 0) << fresh.err;
+  const PlanLine first = plan_line(fresh.out);
+  EXPECT_GT(first.tiles, 8);
+  EXPECT_EQ(first.to_process, first.tiles);
+  EXPECT_EQ(first.may_be_kept + first.reused, 0);
+  EXPECT_NE(fresh.out.find("no estimate of the time"), std::string::npos) << fresh.out;
+  EXPECT_TRUE(!std::filesystem::exists(dir / "sim/work-u/results") ||
+              std::filesystem::is_empty(dir / "sim/work-u/results"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/u"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/work-u/run-config.json"));
+
+  const auto five = command("five.toml", "");
+  ASSERT_EQ(five.exit_code, 0) << five.err;
+  const nlohmann::json five_report = read_json(dir / "sim/u/run.json");
+  EXPECT_EQ(five_report["tiles"].get<long>(), first.tiles);
+  EXPECT_EQ(processed_triangles(five_report), first.to_process_triangles);
+  const auto outputs = test::result_bytes(dir / "sim/u");
+  const auto results = test::result_bytes(dir / "sim/work-u/results");
+
+  // The sixth pass appended: the plan tiles it, and changes no result and no output.
+  const auto planned = command("six.toml", "--plan --threads 2");
+  ASSERT_EQ(planned.exit_code, 0) << planned.err;
+  const PlanLine plan = plan_line(planned.out);
+  EXPECT_GT(plan.to_process, 0);
+  EXPECT_GT(plan.may_be_kept, 0) << "later-phase neighbours of the tiles the pass reaches";
+  EXPECT_GT(plan.reused, 0);
+  EXPECT_EQ(plan.to_process + plan.may_be_kept + plan.reused, plan.tiles);
+  EXPECT_TRUE(test::result_bytes(dir / "sim/work-u/results") == results) << "the plan changed a tile result";
+  EXPECT_TRUE(test::result_bytes(dir / "sim/u") == outputs) << "the plan changed an output";
+  // The estimate is the five-pass run's thread-seconds per triangle over the triangles to
+  // process and those that may be kept, on two threads.
+  double seconds = 0;
+  for (const auto& entry : five_report["per_tile"]) {
+    for (const auto& [step, s] : entry["seconds"].items()) seconds += s.get<double>();
+  }
+  const double per_thread = seconds / static_cast<double>(first.to_process_triangles) / 2;
+  EXPECT_NE(
+      planned.out.find(fmt::format(
+          "would take {:.1f} to {:.1f} s on 2 thread(s)", static_cast<double>(plan.to_process_triangles) * per_thread,
+          static_cast<double>(plan.to_process_triangles + plan.may_be_kept_triangles) * per_thread)),
+      std::string::npos)
+      << planned.out;
+
+  // The run does what the plan said: it processes every tile to process, and of those that
+  // may be kept, keeps the ones whose neighbours decided the same.
+  const auto appended = command("six.toml", "");
+  ASSERT_EQ(appended.exit_code, 0) << appended.err;
+  const nlohmann::json report = read_json(dir / "sim/u/run.json");
+  const long processed = report["tiles"].get<long>() - report["reused_tiles"].get<long>();
+  const long kept = report["kept_tiles"].get<long>();
+  EXPECT_EQ(processed + kept, plan.to_process + plan.may_be_kept);
+  EXPECT_GE(processed, plan.to_process);
+  EXPECT_GE(processed_triangles(report), plan.to_process_triangles);
+  EXPECT_LE(processed_triangles(report), plan.to_process_triangles + plan.may_be_kept_triangles);
+  EXPECT_EQ(report["reused_tiles"].get<long>() - kept, plan.reused);
+
+  // Planned again: nothing left to do.
+  const auto again = command("six.toml", "--plan");
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  const PlanLine none = plan_line(again.out);
+  EXPECT_EQ(none.reused, none.tiles);
+  EXPECT_NE(again.out.find("the run would do the final pass only"), std::string::npos) << again.out;
+
+  // What --plan does not take.
+  EXPECT_EQ(command("six.toml", "--plan --force").exit_code, 1);
+  EXPECT_EQ(command("six.toml", "--plan --subset 1/2").exit_code, 1);
 }
 
 /// The simulator's config with epoch 2's table moved to the end (a pass delivered late), and

@@ -4,7 +4,8 @@
 # acquisition but the last, then the last one's triangles within a box appended to the same
 # work folder, against a fresh run of the same config; then that pass withdrawn again
 # (session 65), against the first run's outputs. Prints the wall times, the tiles reused and
-# whether the outputs are the same bytes.
+# whether the outputs are the same bytes; before appending, what `run --plan` expects
+# (session 77).
 # Usage: tools/bench/append.sh FOLDER XMIN YMIN XMAX YMAX [threads (default 2)]
 #   (FOLDER holds a config.toml, e.g. from tools/bench/out_of_core.sh; the box in the files' CRS)
 # LATE=1: the district's pass is dated one day after the first acquisition (a pass delivered
@@ -49,6 +50,11 @@ rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh" "
 echo "every acquisition but the last:"
 run append-before.toml append
 cp -r "$dir/out-append" "$dir/out-before"
+echo "the plan of appending it (run --plan: tiles the district's pass, processes nothing):"
+/usr/bin/time -f "  plan: %e s" "$bin" run "$dir/append-after.toml" --plan --threads "$threads" \
+  --set output.labels=false --set project.work=work-append --set project.output=out-append 2>"$dir/append-plan.log" |
+  grep -v "to process:" | sed 's/^/  /'
+tail -1 "$dir/append-plan.log"
 echo "the district appended to that work folder:"
 run append-after.toml append
 reused

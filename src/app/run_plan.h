@@ -1,0 +1,51 @@
+// SPDX-License-Identifier: MIT
+// `citymesh run --plan`: what a run would do with each tile of the work folder, before it
+// processes any: which tiles it would process, which it may keep, which it reuses, and how
+// long the tiles would take at the speed of the last run's.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "citymesh/config/config.h"
+#include "citymesh/tiler/tile_store.h"
+#include "tile_plan.h"
+
+namespace citymesh::app {
+
+/// What a run would do with the tiles of `store`.
+struct RunPlan {
+  std::size_t tiles = 0;
+  /// No result under the tile's inputs (a pass reaches it that was added, rewritten or
+  /// withdrawn since, or it was never processed): processed.
+  std::size_t to_process = 0;
+  /// A result from the same inputs under another digest: a tile it waits for is redone, or a
+  /// pass delivered late renumbered its passes. Kept unless a tile it waits for decides
+  /// otherwise about its halo, then processed.
+  std::size_t may_be_kept = 0;
+  /// A finished result under its digest: reused as it is.
+  std::size_t reused = 0;
+  /// Input triangles (owned) of the tiles to process, and of those that may be kept.
+  std::uint64_t triangles_to_process = 0, triangles_may_be_kept = 0;
+  /// Names of the tiles to process, ascending.
+  std::vector<std::string> names_to_process{};
+  /// Thread-seconds per input triangle of the tiles the last run processed (its run.json in
+  /// the output folder); none when there is no such run.
+  std::optional<double> seconds_per_triangle{};
+};
+
+/// Looks at each tile's result in the work folder under `digests` (their headers only) and
+/// at the last run's report; writes nothing.
+RunPlan plan_run(const Config& config, const TileStore& store, const TileDigests& digests);
+
+/// The thread-seconds per input triangle of the tiles the run report `run_json` (run.json's
+/// text) says were processed; none when it is not a run report or processed no tile.
+std::optional<double> seconds_per_triangle(const std::string& run_json);
+
+/// The lines `run --plan` prints, the estimate for `threads` threads.
+std::string describe_plan(const RunPlan& plan, unsigned threads);
+
+}  // namespace citymesh::app
