@@ -19,7 +19,8 @@ constexpr std::size_t kNamesShown = 12;
 
 }  // namespace
 
-std::optional<double> seconds_per_triangle(const std::string& run_json) {
+LastRunSpeed last_run_speed(const std::string& run_json) {
+  LastRunSpeed speed;
   try {
     const nlohmann::json report = nlohmann::json::parse(run_json);
     double seconds = 0;
@@ -30,10 +31,15 @@ std::optional<double> seconds_per_triangle(const std::string& run_json) {
       for (const auto& [step, s] : tile.at("seconds").items()) seconds += s.get<double>();
       triangles += tile.at("owned").get<std::uint64_t>();
     }
-    if (triangles == 0) return std::nullopt;
-    return seconds / static_cast<double>(triangles);
+    if (triangles > 0) speed.seconds_per_triangle = seconds / static_cast<double>(triangles);
+    double final_pass = 0;
+    for (const auto& [stage, s] : report.at("seconds").items()) {
+      if (stage != "tiling" && stage != "tiles" && stage != "total") final_pass += s.get<double>();
+    }
+    speed.final_pass_seconds = final_pass;
+    return speed;
   } catch (const nlohmann::json::exception&) {
-    return std::nullopt;  // not a run report (an older format, or damaged): no estimate
+    return {};  // not a run report (an older format, or damaged): no estimate
   }
 }
 
@@ -60,7 +66,7 @@ RunPlan plan_run(const Config& config, const TileStore& store, const TileDigests
     plan.names_to_process.push_back(tile.key.name());
   }
   if (const std::optional<std::string> text = read_file_bytes(config.project.output / "run.json")) {
-    plan.seconds_per_triangle = seconds_per_triangle(*text);
+    plan.last_run = last_run_speed(*text);
   }
   return plan;
 }
@@ -83,19 +89,23 @@ std::string describe_plan(const RunPlan& plan, unsigned threads) {
                            ? fmt::format(" and {} more", plan.names_to_process.size() - shown)
                            : std::string());
   }
-  if (plan.seconds_per_triangle && plan.to_process + plan.may_be_kept > 0) {
-    const double per_thread = *plan.seconds_per_triangle / std::max(threads, 1u);
+  const std::string last_final_pass =
+      plan.last_run.final_pass_seconds ? fmt::format(" ({:.1f} s in the last run)", *plan.last_run.final_pass_seconds)
+                                       : std::string();
+  if (plan.last_run.seconds_per_triangle && plan.to_process + plan.may_be_kept > 0) {
+    const double per_thread = *plan.last_run.seconds_per_triangle / std::max(threads, 1u);
     const double least = static_cast<double>(plan.triangles_to_process) * per_thread;
     const double most = static_cast<double>(plan.triangles_to_process + plan.triangles_may_be_kept) * per_thread;
     out += fmt::format(
         "plan: the tiles would take {} s on {} thread(s) at the speed of the last run's tiles ({:.2f} µs of a "
-        "thread per input triangle); then the final pass, over the whole output\n",
+        "thread per input triangle); then the final pass, over the whole output{}\n",
         most > least ? fmt::format("{:.1f} to {:.1f}", least, most) : fmt::format("{:.1f}", least), threads,
-        *plan.seconds_per_triangle * 1e6);
+        *plan.last_run.seconds_per_triangle * 1e6, last_final_pass);
   } else if (plan.to_process + plan.may_be_kept > 0) {
     out += "plan: no estimate of the time: the output folder holds no report of a run that processed tiles\n";
   } else {
-    out += "plan: every tile's result is reused: the run would do the final pass only\n";
+    out +=
+        fmt::format("plan: every tile's result is reused: the run would do the final pass only{}\n", last_final_pass);
   }
   out += "plan: nothing was processed; run the same command without --plan to do it\n";
   return out;

@@ -16,6 +16,14 @@
 
 namespace citymesh::app {
 
+/// What the last run's report (run.json) says of its speed.
+struct LastRunSpeed {
+  /// Thread-seconds per input triangle of the tiles it processed; none when it processed none.
+  std::optional<double> seconds_per_triangle{};
+  /// The wall time of its final pass (every stage after the tiles').
+  std::optional<double> final_pass_seconds{};
+};
+
 /// What a run would do with the tiles of `store`.
 struct RunPlan {
   std::size_t tiles = 0;
@@ -32,18 +40,17 @@ struct RunPlan {
   std::uint64_t triangles_to_process = 0, triangles_may_be_kept = 0;
   /// Names of the tiles to process, ascending.
   std::vector<std::string> names_to_process{};
-  /// Thread-seconds per input triangle of the tiles the last run processed (its run.json in
-  /// the output folder); none when there is no such run.
-  std::optional<double> seconds_per_triangle{};
+  /// How fast the last run went (its run.json in the output folder).
+  LastRunSpeed last_run{};
 };
 
 /// Looks at each tile's result in the work folder under `digests` (their headers only) and
 /// at the last run's report; writes nothing.
 RunPlan plan_run(const Config& config, const TileStore& store, const TileDigests& digests);
 
-/// The thread-seconds per input triangle of the tiles the run report `run_json` (run.json's
-/// text) says were processed; none when it is not a run report or processed no tile.
-std::optional<double> seconds_per_triangle(const std::string& run_json);
+/// The speed the run report `run_json` (run.json's text) gives; nothing when it is not a run
+/// report.
+LastRunSpeed last_run_speed(const std::string& run_json);
 
 /// The lines `run --plan` prints, the estimate for `threads` threads.
 std::string describe_plan(const RunPlan& plan, unsigned threads);

@@ -18,14 +18,19 @@ TEST(RunPlan, TheSpeedIsTheProcessedTilesThreadSecondsOverTheirTriangles) {
       {{"tile", "0_1"}, {"owned", 3000}, {"seconds", {{"read", 1.0}, {"detect", 2.0}, {"mosaic", 5.0}}}},
       // Reused: its work was done before, and counts neither way.
       {{"tile", "1_0"}, {"owned", 99999}, {"reused", true}}};
-  const std::optional<double> speed = seconds_per_triangle(report.dump());
-  ASSERT_TRUE(speed.has_value());
-  EXPECT_DOUBLE_EQ(*speed, (4.0 + 8.0) / 4000);
+  report["seconds"] = {{"tiling", 1.0},   {"tiles", 7.0},  {"assembly", 0.5}, {"stitch", 2.0},
+                       {"outputs", 0.25}, {"export", 1.0}, {"total", 11.75}};
+  const LastRunSpeed speed = last_run_speed(report.dump());
+  ASSERT_TRUE(speed.seconds_per_triangle.has_value());
+  EXPECT_DOUBLE_EQ(*speed.seconds_per_triangle, (4.0 + 8.0) / 4000);
+  ASSERT_TRUE(speed.final_pass_seconds.has_value());
+  EXPECT_DOUBLE_EQ(*speed.final_pass_seconds, 3.75) << "the stages after the tiles'";
 
   report["per_tile"] = {{{"tile", "1_0"}, {"owned", 5}, {"reused", true}}};
-  EXPECT_FALSE(seconds_per_triangle(report.dump())) << "no tile processed";
-  EXPECT_FALSE(seconds_per_triangle("{\"tiles\": 3")) << "damaged";
-  EXPECT_FALSE(seconds_per_triangle("{\"tiles\": 3}")) << "no per_tile";
+  EXPECT_FALSE(last_run_speed(report.dump()).seconds_per_triangle) << "no tile processed";
+  EXPECT_TRUE(last_run_speed(report.dump()).final_pass_seconds) << "its final pass ran";
+  EXPECT_FALSE(last_run_speed("{\"tiles\": 3").final_pass_seconds) << "damaged";
+  EXPECT_FALSE(last_run_speed("{\"tiles\": 3}").seconds_per_triangle) << "no per_tile";
 }
 
 TEST(RunPlan, TheLinesSayTheCountsTheTilesToProcessAndTheTimeRange) {
@@ -37,7 +42,7 @@ TEST(RunPlan, TheLinesSayTheCountsTheTilesToProcessAndTheTimeRange) {
   plan.triangles_to_process = 10'000'000;
   plan.triangles_may_be_kept = 5'000'000;
   for (int k = 0; k < 14; ++k) plan.names_to_process.push_back("0_" + std::to_string(k));
-  plan.seconds_per_triangle = 4e-6;
+  plan.last_run = {.seconds_per_triangle = 4e-6, .final_pass_seconds = 12.3};
   const std::string text = describe_plan(plan, 2);
   EXPECT_NE(text.find("plan: 40 tiles: 14 to process (10000000 input triangles), 6 kept unless a tile they wait "
                       "for decides otherwise about their halo (5000000 input triangles), 20 reused\n"),
@@ -48,10 +53,12 @@ TEST(RunPlan, TheLinesSayTheCountsTheTilesToProcessAndTheTimeRange) {
       << text;
   // 10 M triangles at 4 µs on 2 threads, up to 15 M if none is kept.
   EXPECT_NE(text.find("the tiles would take 20.0 to 30.0 s on 2 thread(s)"), std::string::npos) << text;
+  EXPECT_NE(text.find("then the final pass, over the whole output (12.3 s in the last run)"), std::string::npos)
+      << text;
 
   plan.may_be_kept = 0;
   plan.triangles_may_be_kept = 0;
-  plan.seconds_per_triangle.reset();
+  plan.last_run = {};
   const std::string bare = describe_plan(plan, 2);
   EXPECT_EQ(bare.find("kept unless"), std::string::npos) << bare;
   EXPECT_NE(bare.find("no estimate of the time"), std::string::npos) << bare;
