@@ -9,7 +9,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <nlohmann/json.hpp>
-#include <regex>
 #include <set>
 #include <string>
 #include <utility>
@@ -489,16 +488,21 @@ struct PlanLine {
   long tiles = 0, to_process = 0, to_process_triangles = 0, may_be_kept = 0, may_be_kept_triangles = 0, reused = 0;
 };
 PlanLine plan_line(const std::string& out) {
-  static const std::regex line(
-      R"(plan: (\d+) tiles: (\d+) to process \((\d+) input triangles\)(?:, (\d+) kept unless [^(]*\((\d+) input triangles\))?, (\d+) reused)");
-  std::smatch m;
   PlanLine p;
-  if (!std::regex_search(out, m, line)) {
-    ADD_FAILURE() << "no plan line in:\n" << out;
-    return p;
+  const std::size_t at = out.find("plan: ");
+  const std::string line = at == std::string::npos ? std::string() : out.substr(at, out.find('\n', at) - at);
+  const std::size_t kept = line.find(" kept unless ");
+  const std::size_t reused = line.rfind(", ");
+  bool read = std::sscanf(line.c_str(), "plan: %ld tiles: %ld to process (%ld input triangles)", &p.tiles,
+                          &p.to_process, &p.to_process_triangles) == 3 &&
+              reused != std::string::npos && std::sscanf(line.c_str() + reused, ", %ld reused", &p.reused) == 1;
+  if (read && kept != std::string::npos) {
+    const std::size_t count = line.rfind(", ", kept), triangles = line.find('(', kept);
+    read = count != std::string::npos && triangles != std::string::npos &&
+           std::sscanf(line.c_str() + count, ", %ld", &p.may_be_kept) == 1 &&
+           std::sscanf(line.c_str() + triangles, "(%ld input triangles)", &p.may_be_kept_triangles) == 1;
   }
-  const auto number = [&](int k) { return m[k].matched ? std::stol(m[k].str()) : 0L; };
-  p = {number(1), number(2), number(3), number(4), number(5), number(6)};
+  if (!read) ADD_FAILURE() << "no plan line in:\n" << out;
   return p;
 }
 
