@@ -43,8 +43,10 @@ run() {  # config, work/output name
 same_as() {  # output folder against another: mosaic.ply and 3D Tiles
   cmp -s "$dir/$1/mosaic/mosaic.ply" "$dir/$2/mosaic/mosaic.ply" && diff -rq "$dir/$1/tiles" "$dir/$2/tiles" >/dev/null
 }
-reused() {  # what the last run into out-append reused
-  python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} of them kept: a neighbour redone, or their passes renumbered)\")"
+reused() {  # what the last run into out-append reused, and its stages' times
+  python3 -c "import json; r = json.load(open('$dir/out-append/run.json')); s = r['seconds']
+print(f\"  tiles reused: {r['reused_tiles']} of {r['tiles']} ({r.get('kept_tiles', 0)} of them kept: a neighbour redone, or their passes renumbered)\")
+print(f\"  tiling {s['tiling']:.1f} s, tiles {s['tiles']:.1f} s, final pass {s['total'] - s['tiling'] - s['tiles']:.1f} s\")"
 }
 rm -rf "$dir/work-append" "$dir/out-append" "$dir/work-fresh" "$dir/out-fresh" "$dir/out-before"
 echo "every acquisition but the last:"
