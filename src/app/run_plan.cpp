@@ -49,14 +49,16 @@ RunPlan plan_run(const Config& config, const TileStore& store, const TileDigests
   for (std::size_t k = 0; k < store.tiles.size(); ++k) {
     const TileContents& tile = store.tiles[k];
     const std::filesystem::path file = result_path(config, tile.key);
-    // As the tile stage decides: a finished result under the digest is reused; one from the
-    // same inputs is kept when the decisions it keeps are the same (keep_if_still_right).
+    // As the tile stage decides: a finished result under the digest is reused; a whole one
+    // from the same inputs is kept when the decisions it keeps are the same
+    // (keep_if_still_right); a damaged one is processed again.
     if (tile_result_is_finished(file, digests.result[k], store)) {
       ++plan.reused;
       continue;
     }
+    // Its header first: after a change of settings every tile would be read whole for nothing.
     const std::optional<ResultOrigin> origin = tile_result_origin(file);
-    if (origin && origin->inputs == digests.inputs[k]) {
+    if (origin && origin->inputs == digests.inputs[k] && whole_tile_result_origin(file)) {
       ++plan.may_be_kept;
       plan.triangles_may_be_kept += tile.owned();
       continue;
@@ -102,7 +104,7 @@ std::string describe_plan(const RunPlan& plan, unsigned threads) {
         most > least ? fmt::format("{:.1f} to {:.1f}", least, most) : fmt::format("{:.1f}", least), threads,
         *plan.last_run.seconds_per_triangle * 1e6, last_final_pass);
   } else if (plan.to_process + plan.may_be_kept > 0) {
-    out += "plan: no estimate of the time: the output folder holds no report of a run that processed tiles\n";
+    out += "plan: no estimate of the time: the output folder holds no readable report of a run that processed tiles\n";
   } else {
     out +=
         fmt::format("plan: every tile's result is reused: the run would do the final pass only{}\n", last_final_pass);

@@ -27,10 +27,10 @@ struct LastRunSpeed {
 /// What a run would do with the tiles of `store`.
 struct RunPlan {
   std::size_t tiles = 0;
-  /// No result under the tile's inputs (a pass reaches it that was added, rewritten or
-  /// withdrawn since, or it was never processed): processed.
+  /// No whole result under the tile's inputs (a pass reaches it that was added, rewritten or
+  /// withdrawn since, its result is damaged, or it was never processed): processed.
   std::size_t to_process = 0;
-  /// A result from the same inputs under another digest: a tile it waits for is redone, or a
+  /// A whole result from the same inputs under another digest: a tile it waits for is redone, or a
   /// pass delivered late renumbered its passes. Kept unless a tile it waits for decides
   /// otherwise about its halo, then processed.
   std::size_t may_be_kept = 0;

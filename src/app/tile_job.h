@@ -116,6 +116,10 @@ struct ResultOrigin {
   bool kept = false;  ///< last written by restamp_tile_result (kept, not processed)
 };
 std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file);
+/// The same of a whole result only: its magic and its checksum (which covers every section)
+/// pass; nothing otherwise, quietly (what a plan of the run asks of a result it already found
+/// not finished, which said why). Reads the whole file.
+std::optional<ResultOrigin> whole_tile_result_origin(const std::filesystem::path& file);
 /// Writes the result in `file` again under the digest `result` (atomically), marked kept and
 /// unchanged otherwise; false, leaving it as it is, unless `file` holds a whole result of this
 /// version (checked as resuming does) made from `made_from`'s inputs and settled fingerprint.

@@ -431,6 +431,18 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
   return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
 }
 
+std::optional<ResultOrigin> whole_tile_result_origin(const std::filesystem::path& file) {
+  const std::optional<std::string> bytes = read_file_bytes(file);
+  ResultHeader h{};
+  std::uint64_t sum = 0;
+  if (!bytes || bytes->size() < sizeof h + sizeof sum) return std::nullopt;
+  std::memcpy(&h, bytes->data(), sizeof h);
+  std::memcpy(&sum, bytes->data() + bytes->size() - sizeof sum, sizeof sum);
+  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
+  if (bulk_checksum(bytes->data(), bytes->size() - sizeof sum) != sum) return std::nullopt;
+  return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
+}
+
 namespace {
 
 /// The k-th of `from` as the k-th of `to`; nothing for an acquisition `from` does not hold.

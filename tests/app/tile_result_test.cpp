@@ -270,6 +270,16 @@ TEST(TileResult, KeepsWhatItWasMadeFromAndIsWrittenAgainUnderANewDigestUnchanged
   EXPECT_TRUE(tile_result_origin(tmp / "bad.bin").has_value()) << "the header alone is read";
   EXPECT_FALSE(restamp_tile_result(tmp / "bad.bin", store, *origin, 1, r.passes)) << "but the whole file is checked";
   EXPECT_EQ(*read_file_bytes(tmp / "bad.bin"), bytes);
+  // What a plan asks (run --plan): the origin of a whole result only, whatever its digest.
+  const std::optional<ResultOrigin> whole = whole_tile_result_origin(tmp / "t.bin");
+  ASSERT_TRUE(whole.has_value());
+  EXPECT_EQ(whole->result, kFingerprint + 7);
+  EXPECT_EQ(whole->inputs, kDigests.inputs);
+  EXPECT_FALSE(whole_tile_result_origin(tmp / "bad.bin").has_value()) << "a bit flipped past the header";
+  std::ofstream(tmp / "short.bin", std::ios::binary) << bytes.substr(0, 1000);
+  EXPECT_TRUE(tile_result_origin(tmp / "short.bin").has_value());
+  EXPECT_FALSE(whole_tile_result_origin(tmp / "short.bin").has_value()) << "cut short";
+  EXPECT_FALSE(whole_tile_result_origin(tmp / "none.bin").has_value());
 }
 
 TEST(TileResult, AResultOfAnOlderVersionIsProcessedAgain) {
