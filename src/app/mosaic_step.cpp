@@ -5,7 +5,6 @@
 
 #include <cmath>
 #include <iostream>
-#include <numeric>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/log.h"
@@ -136,9 +135,8 @@ nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPa
   log::debug("stitch by blocks: open boundary before measured at {:.2f} s", clock.seconds());
   // Weighed by their input's size: the tile interiors, stitched first, are the largest parts,
   // and an ETA counting parts alike ran three times too high at the start (the city's).
-  std::vector<std::uint64_t> part_work;
-  for (std::size_t p = 0; p < parts.size(); ++p) part_work.push_back(store.input_bytes(p));
-  const std::uint64_t total_work = std::accumulate(part_work.begin(), part_work.end(), std::uint64_t{0});
+  std::uint64_t total_work = 0;
+  for (std::size_t p = 0; p < parts.size(); ++p) total_work += store.input_bytes(p);
   // Started once the measure above is done, so that its time is not taken for stitching's.
   StageProgress progress({.stage = "final pass: seam parts stitched", .total = parts.size(), .total_work = total_work});
   const PartStitchRun run{.params = stitch_params(config),
@@ -147,8 +145,7 @@ nlohmann::json stitch_parts_and_report(const Config& config, std::vector<BlockPa
                           .frame = std::nullopt,
                           .run_level = work.run_level,
                           .cache = cache,
-                          .progress = &progress,
-                          .part_work = std::move(part_work)};
+                          .progress = &progress};
   BlockStitchStats s = stitch_parts(parts, store, run);
   if (cache != nullptr) cache->prune(parts, s.digests);
   log::debug("stitch by blocks: stitched at {:.2f} s", clock.seconds());

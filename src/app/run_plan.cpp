@@ -32,11 +32,10 @@ LastRunSpeed last_run_speed(const std::string& run_json) {
       triangles += tile.at("owned").get<std::uint64_t>();
     }
     if (triangles > 0) speed.seconds_per_triangle = seconds / static_cast<double>(triangles);
-    double final_pass = 0;
-    for (const auto& [stage, s] : report.at("seconds").items()) {
-      if (stage != "tiling" && stage != "tiles" && stage != "total") final_pass += s.get<double>();
-    }
-    speed.final_pass_seconds = final_pass;
+    // A report of `merge` has no tiling or tiles stage: its total is its final pass.
+    const nlohmann::json& seconds_of = report.at("seconds");
+    speed.final_pass_seconds =
+        seconds_of.at("total").get<double>() - seconds_of.value("tiling", 0.0) - seconds_of.value("tiles", 0.0);
     return speed;
   } catch (const nlohmann::json::exception&) {
     return {};  // not a run report (an older format, or damaged): no estimate

@@ -328,6 +328,18 @@ bool pieces_fit(std::string_view bytes, std::size_t at, std::uint64_t acquisitio
   return true;
 }
 
+/// What is wrong with `bytes` as a whole result of this version, in the order it is checked.
+enum class ResultDamage { none, truncated, older_version, checksum };
+ResultDamage result_damage(std::string_view bytes) {
+  std::uint64_t sum = 0;
+  if (bytes.size() < sizeof kMagic) return ResultDamage::truncated;
+  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return ResultDamage::older_version;
+  if (bytes.size() < sizeof(ResultHeader) + sizeof sum) return ResultDamage::truncated;
+  std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
+  if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return ResultDamage::checksum;
+  return ResultDamage::none;
+}
+
 /// The result in `file` when it is whole and was made under `digest` (any digest: nothing),
 /// read under the numbering of a config listing `listed` acquisitions (pieces of those past
 /// it refused; any: as restamp_tile_result reads it, to renumber).
@@ -336,18 +348,22 @@ std::optional<CheckedResult> checked_result(const std::filesystem::path& file, s
   std::optional<std::string> read = read_file_bytes(file);
   if (!read) return std::nullopt;
   const std::string_view bytes = *read;
+  switch (result_damage(bytes)) {
+    case ResultDamage::truncated:
+      return stale(file, "truncated");
+    case ResultDamage::older_version:
+      return older_version(file);
+    case ResultDamage::checksum:
+      return stale(file, "checksum mismatch");
+    case ResultDamage::none:
+      break;
+  }
   ResultHeader h{};
-  std::uint64_t sum = 0;
-  if (bytes.size() < sizeof kMagic) return stale(file, "truncated");
-  if (std::memcmp(bytes.data(), kMagic, sizeof kMagic) != 0) return older_version(file);
-  if (bytes.size() < sizeof h + sizeof sum) return stale(file, "truncated");
-  std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
-  if (bulk_checksum(bytes.data(), bytes.size() - sizeof sum) != sum) return stale(file, "checksum mismatch");
   std::memcpy(&h, bytes.data(), sizeof h);
   // Made from other inputs: another config (--force was given), a rewritten or added
   // acquisition in this tile, a dependency redone, or its passes renumbered.
   if (digest && h.fingerprint != *digest) return std::nullopt;
-  const std::size_t body = bytes.size() - sizeof sum - sizeof h;
+  const std::size_t body = bytes.size() - sizeof(std::uint64_t) - sizeof h;  // less the checksum
   // Counts are checked against the section sizes (a varint takes a byte at least, a piece
   // its 8-byte size) before anything is allocated. A result made before acquisitions were
   // appended holds fewer pieces, one made before the last ones were withdrawn more (empty):
@@ -433,13 +449,9 @@ std::optional<ResultOrigin> tile_result_origin(const std::filesystem::path& file
 
 std::optional<ResultOrigin> whole_tile_result_origin(const std::filesystem::path& file) {
   const std::optional<std::string> bytes = read_file_bytes(file);
+  if (!bytes || result_damage(*bytes) != ResultDamage::none) return std::nullopt;
   ResultHeader h{};
-  std::uint64_t sum = 0;
-  if (!bytes || bytes->size() < sizeof h + sizeof sum) return std::nullopt;
   std::memcpy(&h, bytes->data(), sizeof h);
-  std::memcpy(&sum, bytes->data() + bytes->size() - sizeof sum, sizeof sum);
-  if (std::memcmp(h.magic, kMagic, sizeof kMagic) != 0) return std::nullopt;
-  if (bulk_checksum(bytes->data(), bytes->size() - sizeof sum) != sum) return std::nullopt;
   return ResultOrigin{h.fingerprint, h.inputs_fingerprint, h.settled_fingerprint, h.kept != 0};
 }
 

@@ -139,11 +139,6 @@ double part_context(const PartStitchRun& run) {
   return run.blocks.context > 0 ? run.blocks.context : block_context(run.params);
 }
 
-/// Part p's share of the progress's work (0 when the run does not weigh the parts).
-std::uint64_t part_work(const PartStitchRun& run, std::size_t p) {
-  return p < run.part_work.size() ? run.part_work[p] : 0;
-}
-
 /// Stitches a part cut out with its surroundings; throws ProcessingError if stitching
 /// changed them (they must come out first, unchanged, for the part to be taken back).
 StitchStats stitch_cut(PartCut& cut, const StitchParams& params, std::span<const std::uint64_t> sizes) {
@@ -369,7 +364,8 @@ void stitch_level(std::vector<BlockPart>& parts, int level, PartStore& store, co
   // The level's parts other processes stitched are counted once it ends.
   if (run.progress != nullptr) {
     std::uint64_t level_work = 0;
-    for (const std::size_t p : stitcher.parts_of_level()) level_work += part_work(run, p);
+    // The level's inputs are let go only after it: their sizes are still there.
+    for (const std::size_t p : stitcher.parts_of_level()) level_work += store.input_bytes(p);
     run.progress->advance(done_before + stitcher.size() - run.progress->done(),
                           work_before + level_work - run.progress->done_work());
   }
@@ -509,7 +505,7 @@ LevelStitcher::~LevelStitcher() = default;
 
 PartOutcome LevelStitcher::stitch(std::size_t i) const {
   PartOutcome out = stitch_one(parts_, of_level_.at(i), level_, *finder_, store_, run_, context_);
-  if (run_.progress != nullptr) run_.progress->advance(1, part_work(run_, of_level_.at(i)));
+  if (run_.progress != nullptr) run_.progress->advance(1, store_.input_bytes(of_level_.at(i)));
   return out;
 }
 

@@ -29,6 +29,8 @@ TEST(RunPlan, TheSpeedIsTheProcessedTilesThreadSecondsOverTheirTriangles) {
   report["per_tile"] = {{{"tile", "1_0"}, {"owned", 5}, {"reused", true}}};
   EXPECT_FALSE(last_run_speed(report.dump()).seconds_per_triangle) << "no tile processed";
   EXPECT_TRUE(last_run_speed(report.dump()).final_pass_seconds) << "its final pass ran";
+  report["seconds"] = {{"assembly", 0.5}, {"export", 1.0}, {"total", 1.5}};
+  EXPECT_DOUBLE_EQ(*last_run_speed(report.dump()).final_pass_seconds, 1.5) << "merge's report: no tiles stage";
   EXPECT_FALSE(last_run_speed("{\"tiles\": 3").final_pass_seconds) << "damaged";
   EXPECT_FALSE(last_run_speed("{\"tiles\": 3}").seconds_per_triangle) << "no per_tile";
 }

@@ -423,16 +423,22 @@ std::set<std::string> processed_tiles(const nlohmann::json& report) {
   return processed;
 }
 
+/// A 60 m street in <dir>/sim with five.toml (its first five passes) and six.toml, whose
+/// sixth pass covers the first 21 m of the street on one side and 27.8 m on the other: it ends
+/// in the third of six 10 m tile columns, whose later-phase neighbours in the fourth wait for
+/// it. Their border with the third is 9 m from the pass's end on the first side (decisions
+/// there unchanged: those tiles are kept) and 2.2 m on the other (a decision on their halo
+/// changed: redone). False when the street could not be made.
+bool write_append_street(const std::filesystem::path& dir) {
+  return test::run_citymesh(fmt::format("simulate --out {} --length 60", (dir / "sim").string())).exit_code == 0 &&
+         test::write_append_configs(dir / "sim", 0.35, 27.8 / 60);
+}
+
 TEST(TiledRun, AnAppendedAcquisitionRedoesOnlyTheTilesItReachesToTheBytesOfAFreshRun) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
-  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
-  // Five passes first; then a sixth over the first 21 m of the street on one side and 27.8 m
-  // on the other is appended: it ends in the third of six 10 m tile columns, whose later-phase
-  // neighbours in the fourth wait for it. Their border with the third is 9 m from the pass's
-  // end on the first side (decisions there unchanged: those tiles are kept) and 2.2 m on the
-  // other (a decision on their halo changed: redone).
-  ASSERT_TRUE(test::write_append_configs(dir / "sim", 0.35, 27.8 / 60));
+  // Five passes first; then the sixth is appended.
+  ASSERT_TRUE(write_append_street(dir.path()));
   const auto run = [&](const std::string& file, const std::string& name) {
     return test::run_citymesh(run_file_args(sim, file, name, "--set tiling.tile_size=10"));
   };
@@ -516,9 +522,8 @@ long processed_triangles(const nlohmann::json& report) {
 TEST(TiledRun, APlanSaysWhatARunWouldDoWithEachTileAndDoesNoneOfIt) {
   test::TempDir dir;
   const std::string sim = (dir / "sim").string();
-  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 60", sim)).exit_code, 0);
   // As in the append test above: a sixth pass that some tiles' neighbours wait for.
-  ASSERT_TRUE(test::write_append_configs(dir / "sim", 0.35, 27.8 / 60));
+  ASSERT_TRUE(write_append_street(dir.path()));
   const auto command = [&](const std::string& file, const std::string& extra) {
     return test::run_citymesh(run_file_args(sim, file, "u", "--set tiling.tile_size=10 " + extra));
   };

@@ -170,11 +170,9 @@ struct PartStitchRun {
   /// Where stitched parts are looked up before stitching and kept after; null: none.
   PartCache* cache = nullptr;
   /// Told of each part stitched by this process, and of a level's other parts when the level
-  /// ends (run_level may hand them to other processes); null: none.
+  /// ends (run_level may hand them to other processes), each weighed by its input's bytes
+  /// (PartStore::input_bytes); null: none.
   StageProgress* progress = nullptr;
-  /// Per part: what stitching it costs, roughly (its input's bytes), as the progress's work;
-  /// empty: the parts count alike.
-  std::vector<std::uint64_t> part_work{};
 };
 
 /// The parts of one level of stitch_parts(), each stitched on its own: loaded with the parts
