@@ -96,12 +96,9 @@ class LeavesToExport final : public TilesetLeaves {
   /// returns their box.
   [[nodiscard]] Box3d local_box(const TileKey& key, const LocalMapping& to_local) const override {
     const std::size_t l = index_.at(key);
-    std::vector<Vec3f> local;
+    const std::vector<Vec3f> local = to_local(leaves_.load(l).positions);
     Box3d box;
-    for (const Vec3d& p : leaves_.load(l).positions) {
-      local.push_back(to_local(p));
-      box.extend(Vec3d(local.back()));
-    }
+    for (const Vec3f& p : local) box.extend(Vec3d(p));
     leaves_.keep(l, kMapped, {reinterpret_cast<const char*>(local.data()), local.size() * sizeof(Vec3f)});
     return box;
   }

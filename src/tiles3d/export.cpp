@@ -17,6 +17,7 @@
 #include "citymesh/core/progress.h"
 #include "citymesh/core/read_file.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/geo/local_frame_map.h"
 #include "tileset_json.h"
 
 namespace citymesh {
@@ -37,8 +38,10 @@ Box3d world_box(const Mesh& mesh) {
 
 std::vector<Vec3f> local_positions(const Mesh& mesh, const Crs& crs, const EnuFrame& frame) {
   std::vector<Vec3f> out(mesh.vertex_count());
-  parallel_for_blocks(out.size(), 4096, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t v = begin; v < end; ++v) out[v] = Vec3f(frame.from_ecef(crs.to_ecef(mesh.world_position(v))));
+  parallel_for_blocks(out.size(), 16384, [&](std::size_t begin, std::size_t end) {
+    std::vector<Vec3d> world;
+    for (std::size_t v = begin; v < end; ++v) world.push_back(mesh.world_position(v));
+    std::ranges::copy(map_to_local_frame(world, crs, frame), out.begin() + static_cast<std::ptrdiff_t>(begin));
   });
   return out;
 }
@@ -304,7 +307,7 @@ TilesetExportStats write_tileset(const TilesetFrame& frame, const TilesetExportP
 }
 
 LocalMapping local_mapping(const Crs& crs, const EnuFrame& frame) {
-  return [&crs, &frame](const Vec3d& p) { return Vec3f(frame.from_ecef(crs.to_ecef(p))); };
+  return [&crs, &frame](std::span<const Vec3d> positions) { return map_to_local_frame(positions, crs, frame); };
 }
 
 }  // namespace
@@ -420,10 +423,7 @@ Box3d TilesetLeaves::local_box(const TileKey& key, const LocalMapping& to_local)
 }
 
 TileMesh tile_mesh(const KeyedPiece& piece, const LocalMapping& to_local) {
-  std::vector<Vec3f> local;
-  local.reserve(piece.vertex_count());
-  for (const Vec3d& p : piece.positions) local.push_back(to_local(p));
-  return tile_mesh(piece, local);
+  return tile_mesh(piece, to_local(piece.positions));
 }
 
 TileMesh tile_mesh(const KeyedPiece& piece, std::span<const Vec3f> local) {

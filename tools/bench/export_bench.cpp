@@ -1,16 +1,20 @@
 // SPDX-License-Identifier: MIT
 // 3D Tiles export throughput and size: the simulated street of the change benchmark (all
 // epochs together stand in for a ~300 k-triangle output, one source acquisition per epoch)
-// written as Draco-compressed and as plain glb tiles.
+// written as Draco-compressed and as plain glb tiles; and the mapping of its vertices to the
+// tiles' local frame, exact against interpolated (map_to_local_frame).
 //   export_bench [--length 30] [--epochs 7] [--tile 10]
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 
 #include "bench_scene.h"
 #include "citymesh/core/process_memory.h"
 #include "citymesh/core/stopwatch.h"
+#include "citymesh/geo/local_frame_map.h"
 #include "citymesh/tiles3d/export.h"
 
 using namespace citymesh;
@@ -38,6 +42,39 @@ Output concatenate(const bench::BenchScene& scene) {
   return out;
 }
 
+/// The output's vertices mapped to the local frame on one thread, exactly and by
+/// map_to_local_frame: the seconds of each and how many coordinates round otherwise.
+void print_mapping_speed(const Mesh& mesh, const Crs& crs) {
+  std::vector<Vec3d> world;
+  Box3d box;
+  for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+    world.push_back(mesh.world_position(v));
+    box.extend(world.back());
+  }
+  const EnuFrame frame(crs.to_geodetic((box.min + box.max) * 0.5));
+  Stopwatch exact_clock;
+  std::vector<Vec3f> exact;
+  for (const Vec3d& p : world) exact.push_back(exact_local_position(crs, frame, p));
+  const double exact_seconds = exact_clock.seconds();
+  Stopwatch fast_clock;
+  const std::vector<Vec3f> fast = map_to_local_frame(world, crs, frame);
+  const double fast_seconds = fast_clock.seconds();
+  std::size_t differing = 0;
+  float largest = 0;
+  for (std::size_t v = 0; v < world.size(); ++v) {
+    for (int axis = 0; axis < 3; ++axis) {
+      differing += fast[v][axis] != exact[v][axis];
+      largest = std::max(largest, std::abs(fast[v][axis] - exact[v][axis]));
+    }
+  }
+  fmt::print(
+      "local frame: {} vertices on one thread, exact {:.3f} s ({:.0f} ns each), interpolated {:.3f} s ({:.0f} ns "
+      "each, {:.1f}x); {} of {} coordinates round otherwise, by {:.1e} m at most\n",
+      world.size(), exact_seconds, exact_seconds / double(world.size()) * 1e9, fast_seconds,
+      fast_seconds / double(world.size()) * 1e9, exact_seconds / fast_seconds, differing, 3 * world.size(),
+      double(largest));
+}
+
 double arg(int argc, char** argv, const char* name, double fallback) {
   for (int i = 1; i + 1 < argc; ++i)
     if (std::strcmp(argv[i], name) == 0) return std::stod(argv[i + 1]);
@@ -56,6 +93,7 @@ int main(int argc, char** argv) {
   const std::filesystem::path dir = std::filesystem::temp_directory_path() / "citymesh_export_bench";
   fmt::print("export of {} triangles ({} vertices, {} acquisitions), leaves of {} m\n", output.mesh.triangle_count(),
              output.mesh.vertex_count(), epochs, tile);
+  print_mapping_speed(output.mesh, crs);
   std::uint64_t bytes[2] = {0, 0};
   for (const bool draco : {true, false}) {
     TilesetExportParams params;

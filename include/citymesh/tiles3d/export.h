@@ -57,8 +57,9 @@ struct TilesetSource {
 /// for the output's extent, OutputError when a file cannot be written.
 TilesetExportStats export_tileset(const TilesetSource& source, const TilesetExportParams& params);
 
-/// Where a position in the project CRS lies in the tileset's local frame.
-using LocalMapping = std::function<Vec3f(const Vec3d&)>;
+/// Where positions in the project CRS lie in the tileset's local frame (map_to_local_frame: a
+/// position maps to the same bits in any batch).
+using LocalMapping = std::function<std::vector<Vec3f>(std::span<const Vec3d>)>;
 
 /// An output given to the export one grid tile at a time, for an output too large to hold at
 /// once. Called from several threads at once.
