@@ -175,6 +175,12 @@ nlohmann::json evaluate_mosaic(const std::filesystem::path& output, const std::f
   const nlohmann::json summary = read_json(dir / "summary.json", "run citymesh run first");
   const double reach = summary.at("distance_threshold").get<double>();
   const std::filesystem::path output_ply = dir / kMosaicFile;
+  if (summary.value("ply", std::string(kMosaicFile)).empty()) {
+    throw InputError(
+        fmt::format("{}: the run wrote no mosaic ([output] mosaic_ply = false); run citymesh run with "
+                    "--set output.mosaic_ply=true to score it",
+                    output_ply.string()));
+  }
   const OutputMesh out = read_output(output_ply);
   const MeshProximity near(out.local, reach);
   const auto& acquisitions = detect_summary.at("acquisitions");

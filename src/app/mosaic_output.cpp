@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 #include "mosaic_output.h"
 
+#include <fmt/format.h>
+
 #include <array>
 
 #include "citymesh/core/atomic_file.h"
@@ -116,9 +118,22 @@ void write_summary(const Config& config, const LoadedAcquisitions& input, const 
   }
   summary["stitch"] = params.stitch;
   summary["seconds"] = params.seconds;
-  summary["ply"] = kMosaicFile;
+  summary["ply"] = config.output.mosaic_ply ? kMosaicFile : "";
   summary["png"] = params.pictures ? "mosaic.png" : "";
   write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
+}
+
+/// Removes an earlier run's mosaic.ply from `dir` when this run writes none ([output]
+/// mosaic_ply = false), so that no stale mosaic lies beside this run's summary. Returns whether
+/// this run writes it.
+bool drop_mosaic_ply_unless_written(const Config& config, const std::filesystem::path& dir) {
+  if (config.output.mosaic_ply) return true;
+  std::error_code ec;
+  std::filesystem::remove(dir / kMosaicFile, ec);
+  if (ec)
+    throw OutputError(
+        fmt::format("{}: cannot remove an earlier run's mosaic: {}", (dir / kMosaicFile).string(), ec.message()));
+  return false;
 }
 
 /// The picture of the output's tiles, drawn one at a time.
@@ -149,9 +164,11 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
   std::filesystem::create_directories(params.dir);
   const std::vector<std::int32_t> faces = source_faces(merged);
   const std::vector<std::int32_t> sources = as_listed(merged.source_acq, config.listed_indices());
-  write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
-                 {{kSourceAcqProperty, std::span<const std::int32_t>(sources)},
-                  {"source_face", std::span<const std::int32_t>(faces)}});
+  if (drop_mosaic_ply_unless_written(config, params.dir)) {
+    write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
+                   {{kSourceAcqProperty, std::span<const std::int32_t>(sources)},
+                    {"source_face", std::span<const std::int32_t>(faces)}});
+  }
   if (params.pictures) write_picture(params.dir / "mosaic.png", merged.mesh, sources, params.pixel_size);
   write_summary(config, input, counts_of(merged, input.acquisitions.size()), stats, params);
 }
@@ -160,7 +177,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                           const MosaicStats& stats, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
   const std::vector<std::int32_t> listed = config.listed_indices();
-  write_leaves_ply(params.dir / kMosaicFile, leaves, listed);
+  if (drop_mosaic_ply_unless_written(config, params.dir)) write_leaves_ply(params.dir / kMosaicFile, leaves, listed);
   if (params.pictures) write_leaves_picture(params.dir / "mosaic.png", leaves, listed, params.pixel_size);
   OutputCounts counts{leaves.per_source(), leaves.stitched(), 0};
   counts.per_source.resize(input.acquisitions.size(), 0);

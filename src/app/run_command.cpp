@@ -53,8 +53,9 @@ class RunCommand final : public Command {
         "Tiles the acquisitions into <work>/tiles ([tiling]), processes the tiles in parallel within\n"
         "the memory budget (<work>/results; finished tiles are reused when the command is run again),\n"
         "then writes <output>/detect (as citymesh detect; [output] labels), <output>/mosaic:\n"
-        "mosaic.ply (per-face source_acq and source_face), mosaic.png and summary.json, and\n"
-        "<output>/run.json. --set mosaic.method=update-model runs the paper's baseline.\n"
+        "mosaic.ply (per-face source_acq and source_face; [output] mosaic_ply), mosaic.png and\n"
+        "summary.json, and <output>/run.json. --set mosaic.method=update-model runs the paper's\n"
+        "baseline.\n"
         "Started by mpirun or srun (MPI), the ranks share the work folder: they tile the acquisitions\n"
         "and process the tiles together, rank 0 writes the outputs (docs/cluster.md). Example:\n"
         "  citymesh simulate --out sim && citymesh run sim/config.toml && citymesh eval sim/out --truth sim");

@@ -304,6 +304,11 @@ std::vector<KeyDef> make_keys() {
 
   keys.push_back(bool_key(output, "tiles_3d", "write a 3D Tiles tileset with Draco-compressed glb tiles (false also removes an earlier run's)",
       [](auto& c) -> auto& { return c.output.tiles_3d; }));
+  keys.push_back(bool_key(
+      output, "mosaic_ply",
+      "write the whole output as one PLY with provenance, mosaic/mosaic.ply (what citymesh eval scores; for a city, "
+      "one PLY per tile, ply = true, may serve better; false also removes an earlier run's)",
+      [](auto& c) -> auto& { return c.output.mosaic_ply; }));
   keys.push_back(bool_key(output, "ply", "also write one PLY per tile with provenance (source_acq, source_face; false also removes an earlier run's)",
       [](auto& c) -> auto& { return c.output.ply; }));
   keys.push_back(bool_key(output, "labels",

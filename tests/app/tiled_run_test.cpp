@@ -961,5 +961,31 @@ TEST(TiledRun, ProvenancePlyPerTileAndTilesetCheck) {
   EXPECT_EQ(test::run_citymesh(fmt::format("check {}/p", sim)).exit_code, 2) << "no tileset to check";
 }
 
+TEST(TiledRun, WithoutTheMosaicPlyEveryOtherOutputIsTheSameAndEvalSaysWhyItCannotScore) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const std::string args = "--set tiling.tile_size=10 --set output.ply=true";
+  ASSERT_EQ(test::run_citymesh(run_args(sim, "p", args)).exit_code, 0);
+  std::map<std::string, std::string> with = test::result_bytes(dir / "sim/p");
+  const std::size_t mosaic_faces = ply_faces(dir / "sim/p/mosaic/mosaic.ply");
+  ASSERT_EQ(with.erase("mosaic/mosaic.ply"), 1u);
+
+  const auto without = test::run_citymesh(run_args(sim, "p", args + " --set output.mosaic_ply=false"));
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  EXPECT_FALSE(std::filesystem::exists(dir / "sim/p/mosaic/mosaic.ply")) << "the earlier run's is removed";
+  EXPECT_TRUE(std::filesystem::exists(dir / "sim/p/mosaic/summary.json"));
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(dir / "sim/p/mosaic/summary.json")).at("ply"), "");
+  EXPECT_TRUE(test::result_bytes(dir / "sim/p") == with) << "the tiles, per-tile PLYs and labels are unchanged";
+  std::size_t tile_faces = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "sim/p/ply")) tile_faces += ply_faces(e.path());
+  EXPECT_EQ(tile_faces, mosaic_faces);
+
+  const auto eval = test::run_citymesh(fmt::format("eval {}/p --truth {}", sim, sim));
+  EXPECT_EQ(eval.exit_code, 2);
+  EXPECT_NE(eval.err.find("mosaic.ply: the run wrote no mosaic ([output] mosaic_ply = false)"), std::string::npos)
+      << eval.err;
+}
+
 }  // namespace
 }  // namespace citymesh

@@ -73,6 +73,7 @@ struct RunParams {
 
 struct OutputParams {
   bool tiles_3d = true;
+  bool mosaic_ply = true;  ///< <output>/mosaic/mosaic.ply: the whole output in one file
   bool ply = false;
   bool labels = true;  ///< run: the change step's labelled PLYs (<output>/detect)
   double draco_tolerance = 0.001;  ///< metres
