@@ -24,6 +24,7 @@
 #include "mosaic_output.h"
 #include "mosaic_step.h"
 #include "output_ranks.h"
+#include "output_record.h"
 #include "run_plan.h"
 #include "run_stages.h"
 #include "run_state.h"
@@ -254,6 +255,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
                        Cluster* cluster) {
   const int ranks = cluster != nullptr ? cluster->size() : 1;
   Stopwatch total, clock;
+  forget_outputs(config.project.work);
   // Each stage hands the memory it freed back to the system: the next one then starts from
   // what is still in use, and the pass peaks at its largest stage rather than at the heap
   // every stage left behind (city: 1.37 -> 0.99 GiB).
@@ -340,6 +342,7 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
       "memory {:.0f} MiB (rank 0)\n",
       store.tiles.size(), reused, kept, assembly.owned(), output_triangles, wall, rate, ranks,
       static_cast<double>(peak_resident_bytes()) / (1 << 20));
+  record_outputs(config, final_pass_digest(config, digests, pictures));
 }
 
 /// Every tile index of the store.
@@ -406,6 +409,16 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
+  // Under MPI every rank would have to agree to skip: the final pass always runs there.
+  if (cluster.size() == 1 && tiles.count == 0 &&
+      outputs_up_to_date(config, final_pass_digest(config, digests.result, options.pictures))) {
+    std::cout << fmt::format(
+        "run: {} tiles (all reused); the outputs in {} are the last run's and nothing they are made from has "
+        "changed: nothing written ({:.2f} s). Remove any of them to have them written again\n",
+        store.tiles.size(), config.project.output.string(),
+        clock.seconds() + seconds["tiling"].get<double>() + seconds["tiles"].get<double>());
+    return;
+  }
   // The seam pass and the outputs need every tile: the root writes them, the other ranks
   // help it stitch.
   if (cluster.root()) {

@@ -244,7 +244,8 @@ TEST(TiledRun, SameBytesOnOneAndTwoThreadsAndAfterKills) {
                 entry.path().parent_path().filename() != "staging")
         << entry.path() << " left by a killed run";
   }
-  // A re-run reuses every tile.
+  // A re-run reuses every tile (and, with its report removed, writes the outputs again).
+  std::filesystem::remove(dir / "sim/k/run.json");
   const auto again = test::run_citymesh(run_args(sim, "k", tiles));
   ASSERT_EQ(again.exit_code, 0) << again.err;
   const nlohmann::json report = read_json(dir / "sim/k/run.json");
@@ -385,6 +386,7 @@ TEST(TiledRun, AnotherBuildsTileResultsAreMadeAgainAndThisBuildsAreReused) {
   EXPECT_EQ(report["citymesh"]["version"], other_build["version"]);
   EXPECT_EQ(report["citymesh"]["build"].get<std::string>().size(), 16u);
   EXPECT_NE(report["citymesh"]["build"], other_build["build"]);
+  std::filesystem::remove(dir / "sim/c/run.json");  // else the outputs are found up to date
   const auto reused = test::run_citymesh(run_args(sim, "c", "--set tiling.tile_size=10"));
   ASSERT_EQ(reused.exit_code, 0) << reused.err;
   EXPECT_EQ(reused.err.find("another build"), std::string::npos) << reused.err;
@@ -985,6 +987,49 @@ TEST(TiledRun, WithoutTheMosaicPlyEveryOtherOutputIsTheSameAndEvalSaysWhyItCanno
   EXPECT_EQ(eval.exit_code, 2);
   EXPECT_NE(eval.err.find("mosaic.ply: the run wrote no mosaic ([output] mosaic_ply = false)"), std::string::npos)
       << eval.err;
+}
+
+TEST(TiledRun, ARunWithNothingNewLeavesTheOutputsAsTheLastRunWroteThem) {
+  test::TempDir dir;
+  const std::string sim = (dir / "sim").string();
+  ASSERT_EQ(test::run_citymesh(fmt::format("simulate --out {} --length 30", sim)).exit_code, 0);
+  const std::string args = run_args(sim, "p", "--set tiling.tile_size=10");
+  ASSERT_EQ(test::run_citymesh(args).exit_code, 0);
+  const std::map<std::string, std::string> bytes = test::result_bytes(dir / "sim/p");
+  const std::string report = test::read_text(dir / "sim/p/run.json");
+  const auto skipped = [](const test::CommandResult& r) { return r.out.find("nothing written") != std::string::npos; };
+
+  const auto again = test::run_citymesh(args);
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(skipped(again)) << again.out;
+  EXPECT_EQ(test::read_text(dir / "sim/p/run.json"), report) << "its timings would differ had it been written again";
+  EXPECT_TRUE(test::result_bytes(dir / "sim/p") == bytes);
+
+  // An output removed is written again, to the same bytes.
+  std::filesystem::path glb;
+  for (const auto& e : std::filesystem::directory_iterator(dir / "sim/p/tiles"))
+    if (e.path().extension() == ".glb") glb = e.path();
+  std::filesystem::remove(glb);
+  const auto restored = test::run_citymesh(args);
+  ASSERT_EQ(restored.exit_code, 0) << restored.err;
+  EXPECT_FALSE(skipped(restored)) << restored.out;
+  EXPECT_TRUE(test::result_bytes(dir / "sim/p") == bytes);
+  EXPECT_NE(test::read_text(dir / "sim/p/run.json"), report);
+
+  // Another output key, or another picture scale, is not the same run.
+  const auto with_ply = test::run_citymesh(args + " --set output.ply=true");
+  ASSERT_EQ(with_ply.exit_code, 0) << with_ply.err;
+  EXPECT_FALSE(skipped(with_ply)) << with_ply.out;
+  EXPECT_TRUE(std::filesystem::is_directory(dir / "sim/p/ply"));
+  EXPECT_TRUE(skipped(test::run_citymesh(args + " --set output.ply=true")));
+  EXPECT_FALSE(skipped(test::run_citymesh(args + " --set output.ply=true --pixel 0.1")));
+
+  // A record that cannot be read only means the outputs are written again.
+  test::write_text(dir / "sim/work-p/outputs.json", "{not json");
+  const auto damaged = test::run_citymesh(args + " --set output.ply=true --pixel 0.1");
+  ASSERT_EQ(damaged.exit_code, 0) << damaged.err;
+  EXPECT_FALSE(skipped(damaged)) << damaged.out;
+  EXPECT_TRUE(skipped(test::run_citymesh(args + " --set output.ply=true --pixel 0.1")));
 }
 
 }  // namespace
