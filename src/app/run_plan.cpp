@@ -104,6 +104,10 @@ std::string describe_plan(const RunPlan& plan, unsigned threads) {
         *plan.last_run.seconds_per_triangle * 1e6, last_final_pass);
   } else if (plan.to_process + plan.may_be_kept > 0) {
     out += "plan: no estimate of the time: the output folder holds no readable report of a run that processed tiles\n";
+  } else if (plan.outputs_up_to_date) {
+    out +=
+        "plan: every tile's result is reused and the outputs are the last run's, made from the same: the run would "
+        "write nothing\n";
   } else {
     out +=
         fmt::format("plan: every tile's result is reused: the run would do the final pass only{}\n", last_final_pass);

@@ -42,6 +42,9 @@ struct RunPlan {
   std::vector<std::string> names_to_process{};
   /// How fast the last run went (its run.json in the output folder).
   LastRunSpeed last_run{};
+  /// Every tile reused, and the outputs as the last run left them from the same inputs
+  /// (outputs_up_to_date): the run would write nothing. Set by the caller.
+  bool outputs_up_to_date = false;
 };
 
 /// Looks at each tile's result in the work folder under `digests` (their headers only) and

@@ -345,6 +345,14 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   record_outputs(config, final_pass_digest(config, digests, pictures));
 }
 
+/// Whether the outputs are the last run's, made from what this run's final pass would make them
+/// from (outputs.json): it would write the same again. Never under MPI, where every rank would
+/// have to agree to skip the pass.
+bool outputs_are_current(const Config& config, const TileDigests& digests, const PictureOptions& pictures,
+                         const Cluster& cluster) {
+  return cluster.size() == 1 && outputs_up_to_date(config, final_pass_digest(config, digests.result, pictures));
+}
+
 /// Every tile index of the store.
 std::vector<std::size_t> all_tiles(const TileStore& store) {
   std::vector<std::size_t> tiles(store.tiles.size());
@@ -402,16 +410,17 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   release_freed_memory();
   nlohmann::json seconds{{"tiling", clock.restart()}};
   if (options.plan) {
-    std::cout << describe_plan(plan_run(config, store, digests), available_threads());
+    RunPlan plan = plan_run(config, store, digests);
+    plan.outputs_up_to_date =
+        plan.to_process + plan.may_be_kept == 0 && outputs_are_current(config, digests, options.pictures, cluster);
+    std::cout << describe_plan(plan, available_threads());
     return;
   }
   if (options.subset) return run_subset(config, store, digests, *options.subset, cluster);
   const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
-  // Under MPI every rank would have to agree to skip: the final pass always runs there.
-  if (cluster.size() == 1 && tiles.count == 0 &&
-      outputs_up_to_date(config, final_pass_digest(config, digests.result, options.pictures))) {
+  if (tiles.count == 0 && outputs_are_current(config, digests, options.pictures, cluster)) {
     std::cout << fmt::format(
         "run: {} tiles (all reused); the outputs in {} are the last run's and nothing they are made from has "
         "changed: nothing written ({:.2f} s). Remove any of them to have them written again\n",

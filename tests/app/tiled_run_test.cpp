@@ -593,7 +593,13 @@ TEST(TiledRun, APlanSaysWhatARunWouldDoWithEachTileAndDoesNoneOfIt) {
   ASSERT_EQ(again.exit_code, 0) << again.err;
   const PlanLine none = plan_line(again.out);
   EXPECT_EQ(none.reused, none.tiles);
-  EXPECT_NE(again.out.find("the run would do the final pass only"), std::string::npos) << again.out;
+  EXPECT_NE(again.out.find("the outputs are the last run's, made from the same: the run would write nothing"),
+            std::string::npos)
+      << again.out;
+  // With an output gone, the final pass only.
+  std::filesystem::remove(dir / "sim/u/run.json");
+  const auto outputs_gone = command("six.toml", "--plan");
+  EXPECT_NE(outputs_gone.out.find("the run would do the final pass only"), std::string::npos) << outputs_gone.out;
 
   // What --plan does not take.
   EXPECT_EQ(command("six.toml", "--plan --force").exit_code, 1);
