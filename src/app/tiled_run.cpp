@@ -345,12 +345,13 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
   record_outputs(config, final_pass_digest(config, digests, pictures));
 }
 
-/// Whether the outputs are the last run's, made from what this run's final pass would make them
-/// from (outputs.json): it would write the same again. Never under MPI, where every rank would
-/// have to agree to skip the pass.
-bool outputs_are_current(const Config& config, const TileDigests& digests, const PictureOptions& pictures,
-                         const Cluster& cluster) {
-  return cluster.size() == 1 && outputs_up_to_date(config, final_pass_digest(config, digests.result, pictures));
+/// Whether no tile was processed and the outputs are the last run's, made from what this run's
+/// final pass would make them from (outputs.json): it would write the same again. Collective:
+/// under MPI each rank looks (they share the folders) and true only when every rank found so.
+bool nothing_to_write(const Config& config, const TileDigests& digests, const PictureOptions& pictures,
+                      bool tiles_processed, Cluster& cluster) {
+  const bool here = !tiles_processed && outputs_up_to_date(config, final_pass_digest(config, digests.result, pictures));
+  return cluster.same_everywhere(here ? 1 : 0) && here;
 }
 
 /// Every tile index of the store.
@@ -412,7 +413,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   if (options.plan) {
     RunPlan plan = plan_run(config, store, digests);
     plan.outputs_up_to_date =
-        plan.to_process + plan.may_be_kept == 0 && outputs_are_current(config, digests, options.pictures, cluster);
+        nothing_to_write(config, digests, options.pictures, plan.to_process + plan.may_be_kept > 0, cluster);
     std::cout << describe_plan(plan, available_threads());
     return;
   }
@@ -420,7 +421,8 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
-  if (tiles.count == 0 && outputs_are_current(config, digests, options.pictures, cluster)) {
+  if (nothing_to_write(config, digests, options.pictures, tiles.count > 0, cluster)) {
+    if (!cluster.root()) return;
     std::cout << fmt::format(
         "run: {} tiles (all reused); the outputs in {} are the last run's and nothing they are made from has "
         "changed: nothing written ({:.2f} s). Remove any of them to have them written again\n",

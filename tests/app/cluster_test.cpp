@@ -73,6 +73,15 @@ TEST_F(ClusterRun, ThreeMpiRanksGiveTheBytesOfOneProcess) {
   const nlohmann::json report = read_json(output("mpi") / "run.json");
   EXPECT_EQ(report["ranks"], 3);
   EXPECT_EQ(report["reused_tiles"], 0);
+  // Run again with nothing new, every rank finds the outputs as they were: none is written.
+  const std::string report_text = test::read_text(output("mpi") / "run.json");
+  const std::string again =
+      fmt::format("{} run {} > {} 2>&1", mpirun(3), args(sim_, "mpi"), (*dir_ / "mpi-again.log").string());
+  ASSERT_EQ(std::system(again.c_str()), 0) << test::read_text(*dir_ / "mpi-again.log");
+  EXPECT_NE(test::read_text(*dir_ / "mpi-again.log").find("nothing written"), std::string::npos)
+      << test::read_text(*dir_ / "mpi-again.log");
+  EXPECT_EQ(test::read_text(output("mpi") / "run.json"), report_text);
+  EXPECT_TRUE(test::result_bytes(output("mpi")) == *reference_);
 }
 
 TEST_F(ClusterRun, ThreeMpiRanksShareTheFinalPassAndGiveTheBytesOfOneProcess) {
