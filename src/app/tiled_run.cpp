@@ -8,6 +8,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string_view>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
@@ -354,6 +355,14 @@ bool nothing_to_write(const Config& config, const TileDigests& digests, const Pi
   return cluster.same_everywhere(here ? 1 : 0) && here;
 }
 
+/// What `command` says when it finds nothing to write.
+std::string nothing_written(std::string_view command, std::size_t tiles, const Config& config) {
+  return fmt::format(
+      "{}: {} tiles (all reused); the outputs in {} are the last run's and nothing they are made from has changed: "
+      "nothing written. Remove any of them to have them written again\n",
+      command, tiles, config.project.output.string());
+}
+
 /// Every tile index of the store.
 std::vector<std::size_t> all_tiles(const TileStore& store) {
   std::vector<std::size_t> tiles(store.tiles.size());
@@ -422,12 +431,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   release_freed_memory();
   seconds["tiles"] = clock.restart();
   if (nothing_to_write(config, digests, options.pictures, tiles.count > 0, cluster)) {
-    if (!cluster.root()) return;
-    std::cout << fmt::format(
-        "run: {} tiles (all reused); the outputs in {} are the last run's and nothing they are made from has "
-        "changed: nothing written ({:.2f} s). Remove any of them to have them written again\n",
-        store.tiles.size(), config.project.output.string(),
-        clock.seconds() + seconds["tiling"].get<double>() + seconds["tiles"].get<double>());
+    if (cluster.root()) std::cout << nothing_written("run", store.tiles.size(), config);
     return;
   }
   // The seam pass and the outputs need every tile: the root writes them, the other ranks
@@ -472,6 +476,10 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     (config.project.work / "results").string(), missing.size(), store->tiles.size(),
                     fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
                     shown < missing.size() ? ", ..." : ""));
+  }
+  if (outputs_up_to_date(config, final_pass_digest(config, digests, pictures))) {
+    std::cout << nothing_written("merge", store->tiles.size(), config);
+    return;
   }
   const TileStageReport none{std::vector<std::uint8_t>(store->tiles.size(), 0), 0, 0};
   write_run_outputs(config, *store, digests, none, pictures, nlohmann::json::object(), nullptr);

@@ -164,6 +164,14 @@ TEST_F(ClusterRun, SubsetsThenMergeGiveTheBytesOfOneProcess) {
   const auto merged = test::run_citymesh("merge " + run);
   ASSERT_EQ(merged.exit_code, 0) << merged.err;
   EXPECT_TRUE(test::result_bytes(output("sub")) == *reference_) << "subsets + merge differ from one process";
+  // Merged again, or run, with nothing new: the outputs are left as the merge wrote them.
+  const std::string report = test::read_text(output("sub") / "run.json");
+  for (const std::string command : {"merge ", "run "}) {
+    const auto again = test::run_citymesh(command + run);
+    ASSERT_EQ(again.exit_code, 0) << again.err;
+    EXPECT_NE(again.out.find("nothing written"), std::string::npos) << command << again.out;
+  }
+  EXPECT_EQ(test::read_text(output("sub") / "run.json"), report);
 }
 
 TEST_F(ClusterRun, AnAppendedPassUnderMpiKeepsWhatOneProcessKeepsToTheSameBytes) {
