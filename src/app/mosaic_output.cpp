@@ -1,12 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "mosaic_output.h"
 
-#include <fmt/format.h>
-
 #include <array>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
+#include "citymesh/core/log.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/render/render.h"
 #include "leaf_outputs.h"
@@ -123,17 +122,11 @@ void write_summary(const Config& config, const LoadedAcquisitions& input, const 
   write_file_atomically(params.dir / "summary.json", summary.dump(1) + "\n");
 }
 
-/// Removes an earlier run's mosaic.ply from `dir` when this run writes none ([output]
-/// mosaic_ply = false), so that no stale mosaic lies beside this run's summary. Returns whether
-/// this run writes it.
-bool drop_mosaic_ply_unless_written(const Config& config, const std::filesystem::path& dir) {
-  if (config.output.mosaic_ply) return true;
-  std::error_code ec;
-  std::filesystem::remove(dir / kMosaicFile, ec);
-  if (ec)
-    throw OutputError(
-        fmt::format("{}: cannot remove an earlier run's mosaic: {}", (dir / kMosaicFile).string(), ec.message()));
-  return false;
+/// Whether this run writes mosaic.ply in `dir`; when it does not ([output] mosaic_ply =
+/// false), an earlier run's is removed.
+bool writes_mosaic_ply(const Config& config, const std::filesystem::path& dir) {
+  if (!config.output.mosaic_ply) remove_earlier_output(dir / kMosaicFile, "[output] mosaic_ply = false");
+  return config.output.mosaic_ply;
 }
 
 /// The picture of the output's tiles, drawn one at a time.
@@ -159,12 +152,19 @@ void write_leaves_picture(const std::filesystem::path& path, const OutputLeaves&
 
 }  // namespace
 
+void remove_earlier_output(const std::filesystem::path& path, const char* why) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) return;
+  std::filesystem::remove_all(path, ec);
+  log::info("{}: an earlier run's output removed ({})", path.string(), why);
+}
+
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const MergedMesh& merged,
                           const MosaicStats& stats, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
   const std::vector<std::int32_t> faces = source_faces(merged);
   const std::vector<std::int32_t> sources = as_listed(merged.source_acq, config.listed_indices());
-  if (drop_mosaic_ply_unless_written(config, params.dir)) {
+  if (writes_mosaic_ply(config, params.dir)) {
     write_mesh_ply(params.dir / kMosaicFile, merged.mesh,
                    {{kSourceAcqProperty, std::span<const std::int32_t>(sources)},
                     {"source_face", std::span<const std::int32_t>(faces)}});
@@ -177,7 +177,7 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
                           const MosaicStats& stats, const MosaicOutputParams& params) {
   std::filesystem::create_directories(params.dir);
   const std::vector<std::int32_t> listed = config.listed_indices();
-  if (drop_mosaic_ply_unless_written(config, params.dir)) write_leaves_ply(params.dir / kMosaicFile, leaves, listed);
+  if (writes_mosaic_ply(config, params.dir)) write_leaves_ply(params.dir / kMosaicFile, leaves, listed);
   if (params.pictures) write_leaves_picture(params.dir / "mosaic.png", leaves, listed, params.pixel_size);
   OutputCounts counts{leaves.per_source(), leaves.stitched(), 0};
   counts.per_source.resize(input.acquisitions.size(), 0);

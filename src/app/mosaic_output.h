@@ -43,6 +43,12 @@ void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input,
 void write_mosaic_outputs(const Config& config, const LoadedAcquisitions& input, const OutputLeaves& leaves,
                           const MosaicStats& stats, const MosaicOutputParams& params);
 
+/// Removes `path` (a file or a folder of citymesh's outputs) when an earlier run wrote it and
+/// this one writes nothing there (`why`: the key turned off, or no triangle left), so that no
+/// other run's output lies beside this one's. Best effort: several MPI ranks may remove it at
+/// once.
+void remove_earlier_output(const std::filesystem::path& path, const char* why);
+
 /// Per triangle of the merged mesh: its face index in its source acquisition's file
 /// (kNoSource for stitch triangles).
 std::vector<std::int32_t> source_faces(const MergedMesh& merged);

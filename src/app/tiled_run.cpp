@@ -349,9 +349,9 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
 /// Whether no tile was processed and the outputs are the last run's, made from what this run's
 /// final pass would make them from (outputs.json): it would write the same again. Collective:
 /// under MPI each rank looks (they share the folders) and true only when every rank found so.
-bool nothing_to_write(const Config& config, const TileDigests& digests, const PictureOptions& pictures,
-                      bool tiles_processed, Cluster& cluster) {
-  const bool here = !tiles_processed && outputs_up_to_date(config, final_pass_digest(config, digests.result, pictures));
+bool nothing_to_write(const Config& config, std::span<const std::uint64_t> result_digests,
+                      const PictureOptions& pictures, bool tiles_processed, Cluster& cluster) {
+  const bool here = !tiles_processed && outputs_up_to_date(config, final_pass_digest(config, result_digests, pictures));
   return cluster.same_everywhere(here ? 1 : 0) && here;
 }
 
@@ -422,7 +422,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   if (options.plan) {
     RunPlan plan = plan_run(config, store, digests);
     plan.outputs_up_to_date =
-        nothing_to_write(config, digests, options.pictures, plan.to_process + plan.may_be_kept > 0, cluster);
+        nothing_to_write(config, digests.result, options.pictures, plan.to_process + plan.may_be_kept > 0, cluster);
     std::cout << describe_plan(plan, available_threads());
     return;
   }
@@ -430,7 +430,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   const TileStageReport tiles = process_tiles(config, store, digests, cluster, all_tiles(store));
   release_freed_memory();
   seconds["tiles"] = clock.restart();
-  if (nothing_to_write(config, digests, options.pictures, tiles.count > 0, cluster)) {
+  if (nothing_to_write(config, digests.result, options.pictures, tiles.count > 0, cluster)) {
     if (cluster.root()) std::cout << nothing_written("run", store.tiles.size(), config);
     return;
   }
@@ -477,7 +477,7 @@ void merge_tiled(const Config& config, const PictureOptions& pictures) {
                     fmt::join(missing.begin(), missing.begin() + static_cast<std::ptrdiff_t>(shown), ", "),
                     shown < missing.size() ? ", ..." : ""));
   }
-  if (outputs_up_to_date(config, final_pass_digest(config, digests, pictures))) {
+  if (nothing_to_write(config, digests, pictures, false, *single_process())) {
     std::cout << nothing_written("merge", store->tiles.size(), config);
     return;
   }

@@ -154,23 +154,15 @@ nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves)
   return {{"files", leaves.leaves().size()}, {"seconds", clock.seconds()}};
 }
 
-/// Removes `<output>/<folder>` when an earlier run wrote it and this one writes nothing there
-/// (the key turned off, or no triangle left): it showed another run's output. The folder is
-/// citymesh's own (the tileset or the per-tile PLYs, each replaced whole when written).
-void remove_earlier_output(const Config& config, const char* folder, const char* why) {
-  const std::filesystem::path dir = config.project.output / folder;
-  std::error_code ec;
-  if (!std::filesystem::exists(dir, ec)) return;
-  std::filesystem::remove_all(dir, ec);  // several MPI ranks may remove it at once
-  log::info("{}: an earlier run's output removed ({})", dir.string(), why);
-}
-
-/// Removes what this run does not write of the tileset outputs (remove_earlier_output).
+/// Removes what this run does not write of the tileset outputs (remove_earlier_output): the
+/// folders are citymesh's own (the tileset or the per-tile PLYs, each replaced whole when
+/// written).
 void remove_unwritten_outputs(const Config& config, bool empty) {
+  const std::filesystem::path& out = config.project.output;
   if (empty || !config.output.tiles_3d)
-    remove_earlier_output(config, "tiles", empty ? "the output has no triangles" : "[output] tiles_3d = false");
+    remove_earlier_output(out / "tiles", empty ? "the output has no triangles" : "[output] tiles_3d = false");
   if (empty || !config.output.ply)
-    remove_earlier_output(config, "ply", empty ? "the output has no triangles" : "[output] ply = false");
+    remove_earlier_output(out / "ply", empty ? "the output has no triangles" : "[output] ply = false");
 }
 
 }  // namespace
