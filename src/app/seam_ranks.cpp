@@ -154,6 +154,9 @@ void remove_seam_plan(const Config& config) {
 void help_seam_pass(const Config& config, Cluster& cluster) {
   std::atomic<std::size_t> stitched = 0, reused = 0, measured = 0;
   SeamPartCache cache = seam_part_cache(config);
+  // Outlives every measurer, which keeps a reference to it: a temporary made the other ranks
+  // measure with a grid already gone (their lengths, and the run's open boundary, were wrong).
+  const BlockStitchParams blocks = tile_grid_blocks(config);
   // The root's steps: the boundary measured, the levels stitched, the boundary measured again.
   for (int step = 0; step < kBlockStitchLevels + 2; ++step) {
     // The root writes the plan before it shares the step, and sharing starts with a barrier.
@@ -170,7 +173,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     // Each part's result is written before the root hears that the part is done (the
     // worker's next request says so).
     if (measuring) {
-      const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, tile_grid_blocks(config));
+      const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, blocks);
       run_part_workers(*channel, [&](std::size_t p) {
         write_file_atomically(files.beside(p, kLengthSuffix), length_json(measurer.measure(p)).dump());
         ++measured;
@@ -178,7 +181,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
       continue;
     }
     const PartStitchRun run{.params = stitch_params(config),
-                            .blocks = tile_grid_blocks(config),
+                            .blocks = blocks,
                             .source_sizes = plan.source_sizes,
                             .frame = std::nullopt,
                             .run_level = {},
