@@ -195,9 +195,9 @@ KeyedPiece keyed_piece(const TilePiece& piece) {
   return out;
 }
 
-SeamPartFiles::SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks)
-    : dir_(std::move(dir)), blocks_(blocks) {
-  make_empty_folder(dir_, "the seam pass");
+SeamPartFiles::SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks, Folder folder)
+    : dir_(std::move(dir)), blocks_(blocks), owned_(folder == Folder::own) {
+  if (owned_) make_empty_folder(dir_, "the seam pass");
 }
 
 SeamPartFiles::SeamPartFiles(std::filesystem::path dir, std::vector<BlockPartKey> keys)
@@ -259,19 +259,31 @@ void SeamPartFiles::add_filed(const FiledTile& tile) {
   add_counts(source_sizes_, tile.source_sizes);
 }
 
-std::vector<BlockPart> SeamPartFiles::finish() {
+std::vector<BlockPart> SeamPartFiles::finish(const PartMerging& merging) {
   std::vector<BlockPart> parts;
   for (const auto& [key, box] : boxes_) parts.push_back({key, box, {}});
   keys_.clear();
-  for (const BlockPart& p : parts) keys_.push_back(p.key);
-  parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const KeyedPiece merged = merge_and_remove(fragments_.at(keys_[i]));
-      write_scratch_file(part_file(keys_[i], false), encode_keyed_piece(in_input_order(merged)));
-    }
-  });
+  std::vector<std::vector<std::filesystem::path>> fragments;
+  for (const BlockPart& p : parts) {
+    keys_.push_back(p.key);
+    fragments.push_back(std::move(fragments_.at(p.key)));
+  }
   fragments_.clear();
+  const std::function<void(std::size_t)> here = [&](std::size_t i) { merge_fragments(keys_[i], fragments[i]); };
+  if (merging) {
+    merging(keys_, fragments, here);
+  } else {
+    parallel_for_blocks(parts.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) here(i);
+    });
+  }
   return parts;
+}
+
+void SeamPartFiles::merge_fragments(const BlockPartKey& key, std::span<const std::filesystem::path> fragments) const {
+  throw_if_interrupted("the seam pass");
+  const KeyedPiece merged = merge_and_remove(fragments);
+  write_scratch_file(part_file(key, false), encode_keyed_piece(in_input_order(merged)));
 }
 
 std::shared_ptr<const KeyedPiece> SeamPartFiles::load(std::size_t part, bool stitched) const {

@@ -40,8 +40,11 @@ KeyedPiece keyed_piece(const TilePiece& piece);
 /// The parts of a seam pass, in files under one folder (created empty, removed with this).
 class SeamPartFiles final : public PartStore {
  public:
+  /// Whose folder the parts are filed in: this object's (made empty, removed with it), or
+  /// another process's (an MPI rank filing tiles for the root: never made nor removed here).
+  enum class Folder { own, others };
   /// `blocks`: the grid, in the project CRS.
-  SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks);
+  SeamPartFiles(std::filesystem::path dir, const BlockStitchParams& blocks, Folder folder = Folder::own);
   /// The parts `keys` (in part order) of another process's folder `dir` (an MPI rank helping
   /// the root's seam pass): loads and saves them there, never creates nor removes the folder.
   SeamPartFiles(std::filesystem::path dir, std::vector<BlockPartKey> keys);
@@ -63,9 +66,17 @@ class SeamPartFiles final : public PartStore {
   void add_filed(const FiledTile& tile);
   /// Both at once.
   void add_tile(TileKey key, const std::vector<TilePiece>& selected) { add_filed(file_tile(key, selected)); }
+  /// How finish() merges every part's fragments (merge_fragments): given the parts, their
+  /// fragments and `here` (one part merged in this process). Empty: here, on the pool's threads.
+  using PartMerging = std::function<void(std::span<const BlockPartKey> parts,
+                                         std::span<const std::vector<std::filesystem::path>> fragments,
+                                         const std::function<void(std::size_t)>& here)>;
   /// Puts each part's tiles together, its triangles in input order (acquisition, then
   /// triangle); the parts in key order with their boxes. Called once, after the last tile.
-  [[nodiscard]] std::vector<BlockPart> finish();
+  [[nodiscard]] std::vector<BlockPart> finish(const PartMerging& merging = {});
+  /// Writes part `key`'s input file from its tiles' `fragments` (in tile order), which are
+  /// removed; safe from several threads (or processes) for different parts.
+  void merge_fragments(const BlockPartKey& key, std::span<const std::filesystem::path> fragments) const;
   /// Per source acquisition: its triangles in the output (clipping's precedence).
   [[nodiscard]] const std::vector<std::uint64_t>& source_sizes() const { return source_sizes_; }
 

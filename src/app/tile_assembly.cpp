@@ -16,6 +16,14 @@ namespace {
 
 constexpr std::uint8_t kKeptBit = 1u << 2, kSustainableBit = 1u << 3, kRefutesBit = 1u << 4, kStateMask = 3u;
 
+/// Throws ProcessingError naming the tile unless triangle t of acquisition a is in the store.
+void check_in(const TileStore& store, const TileResult& result, std::uint32_t a, std::uint32_t t) {
+  if (a >= store.triangles.size() || t >= store.triangles[a]) {
+    throw ProcessingError(
+        fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store", result.key.name(), t, a));
+  }
+}
+
 }  // namespace
 
 TileAssembly::TileAssembly(const TileStore& store, std::optional<std::filesystem::path> pairs_dir) : store_(store) {
@@ -39,18 +47,53 @@ std::uint16_t TileAssembly::date_index(std::int64_t ms) {
 }
 
 void TileAssembly::check_in_store(const TileResult& result, std::uint32_t a, std::uint32_t t) const {
-  if (a >= store_.triangles.size() || t >= store_.triangles[a]) {
-    throw ProcessingError(
-        fmt::format("tile {}: triangle {} of acquisition {} is not in the tile store", result.key.name(), t, a));
+  check_in(store_, result, a, t);
+}
+
+TileTally tally_of(const TileResult& result, const TileStore& store) {
+  TileTally t;
+  for (const OwnedLabel& l : result.labels) {
+    check_in(store, result, l.acquisition, l.index);
+    ++t.owned;
+    t.candidates += l.kept;
+    t.seen_through += (l.notes & kNoteSeenThrough) != 0 ? 1 : 0;
+    t.filled += (l.notes & kNoteFilled) != 0 ? 1 : 0;
+    t.fill_left_out += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
   }
+  t.change = result.change;
+  t.seconds_read = result.seconds_read;
+  t.seconds_detect = result.seconds_detect;
+  t.seconds_mosaic = result.seconds_mosaic;
+  return t;
+}
+
+void TileAssembly::add_tally(const TileTally& tally) {
+  if (labels_) throw ProcessingError("tile assembly: a tile's labels are needed, not only its tally");
+  count(tally);
+}
+
+void TileAssembly::count(const TileTally& tally) {
+  change_.add(tally.change);
+  owned_ += tally.owned;
+  candidates_ += tally.candidates;
+  seen_through_ += tally.seen_through;
+  filled_ += tally.filled;
+  fill_left_out_ += tally.fill_left_out;
 }
 
 void TileAssembly::add(TileResult result) {
+  count(tally_of(result, store_));  // checks every label against the store
+  if (labels_) spill_labels(result);
+  for (TilePiece& p : result.selected) {
+    if (p.triangle_count() > 0) pieces_.push_back(std::move(p));
+  }
+}
+
+void TileAssembly::spill_labels(const TileResult& result) {
   const auto global = [&](std::uint32_t a, std::uint32_t t) -> std::uint32_t {
     check_in_store(result, a, t);
     return static_cast<std::uint32_t>(index_.offsets[a] + t);
   };
-  change_.add(result.change);
   // The labels wait on disk, per acquisition (a city's are several times the final pass's
   // memory): the tile hands them over grouped by acquisition.
   std::vector<LabelSpill::Label> spilled;
@@ -60,13 +103,6 @@ void TileAssembly::add(TileResult result) {
   };
   for (std::size_t i = 0; i < result.labels.size(); ++i) {
     const OwnedLabel& l = result.labels[i];
-    (void)global(l.acquisition, l.index);  // checked against the store
-    ++owned_;
-    candidates_ += l.kept;
-    seen_through_ += (l.notes & kNoteSeenThrough) != 0 ? 1 : 0;
-    filled_ += (l.notes & kNoteFilled) != 0 ? 1 : 0;
-    fill_left_out_ += (l.notes & kNoteFillLeftOut) != 0 ? 1 : 0;
-    if (!labels_) continue;
     if (i > 0 && result.labels[i - 1].acquisition != l.acquisition) spill(result.labels[i - 1].acquisition);
     spilled.push_back(
         {l.index,
@@ -74,22 +110,17 @@ void TileAssembly::add(TileResult result) {
                                    (l.sustainable != 0 ? kSustainableBit : 0) | (l.refutes != 0 ? kRefutesBit : 0)),
          date_index(l.first_ms), date_index(l.last_ms)});
   }
-  if (labels_ && !result.labels.empty()) spill(result.labels.back().acquisition);
-  if (labels_) spill_refuted(result);
-  if (labels_) {
-    // Spilled a bounded run at a time: a spinning scanner's tile holds 56 M pairs, 0.45 GB
-    // as global pairs.
-    constexpr std::size_t kPairsAtOnce = std::size_t{1} << 20;
-    std::vector<TrianglePair> pairs;
-    for (const LabelPair& p : result.pairs) {
-      pairs.emplace_back(global(p.a_acquisition, p.a_index), global(p.b_acquisition, p.b_index));
-      if (pairs.size() == kPairsAtOnce) pairs_->add(std::exchange(pairs, {}));
-    }
-    if (!pairs.empty()) pairs_->add(std::move(pairs));
+  if (!result.labels.empty()) spill(result.labels.back().acquisition);
+  spill_refuted(result);
+  // Spilled a bounded run at a time: a spinning scanner's tile holds 56 M pairs, 0.45 GB
+  // as global pairs.
+  constexpr std::size_t kPairsAtOnce = std::size_t{1} << 20;
+  std::vector<TrianglePair> pairs;
+  for (const LabelPair& p : result.pairs) {
+    pairs.emplace_back(global(p.a_acquisition, p.a_index), global(p.b_acquisition, p.b_index));
+    if (pairs.size() == kPairsAtOnce) pairs_->add(std::exchange(pairs, {}));
   }
-  for (TilePiece& p : result.selected) {
-    if (p.triangle_count() > 0) pieces_.push_back(std::move(p));
-  }
+  if (!pairs.empty()) pairs_->add(std::move(pairs));
 }
 
 void TileAssembly::spill_refuted(const TileResult& result) {

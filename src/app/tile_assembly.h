@@ -15,6 +15,18 @@
 
 namespace citymesh::app {
 
+/// What the assembly counts of one tile's result, without its labels, pairs or pieces: all a
+/// rank that did not read the result needs of it (an MPI rank reads and files it).
+struct TileTally {
+  std::uint64_t owned = 0, candidates = 0, seen_through = 0, filled = 0, fill_left_out = 0;
+  ChangeStats change{};
+  double seconds_read = 0, seconds_detect = 0, seconds_mosaic = 0;
+};
+
+/// The tally of `result`. Throws ProcessingError naming the tile when one of its labels is of
+/// a triangle the store does not hold.
+TileTally tally_of(const TileResult& result, const TileStore& store);
+
 class TileAssembly {
  public:
   /// With a `pairs_dir`, also gathers every input triangle's labels and the consistent pairs,
@@ -24,6 +36,9 @@ class TileAssembly {
 
   /// Takes one tile's result (any order: the output does not depend on it).
   void add(TileResult result);
+  /// Counts a tile whose result was read elsewhere (tally_of): only without labels, which
+  /// need the result itself. Tiles are added once each, by add() or by this.
+  void add_tally(const TileTally& tally);
 
   /// The selected triangles sorted by (acquisition, triangle index), with their global ids;
   /// vertices shared within an acquisition across tiles. Hands over the tiles' pieces: they
@@ -60,6 +75,10 @@ class TileAssembly {
   void check_labelled() const;
   /// Throws ProcessingError naming the tile unless triangle t of acquisition a is in the store.
   void check_in_store(const TileResult& result, std::uint32_t a, std::uint32_t t) const;
+  /// Adds a tile's tally to the run's figures.
+  void count(const TileTally& tally);
+  /// Spills a tile's labels, refuted copies and pairs (only with labels).
+  void spill_labels(const TileResult& result);
   /// Spills the copies a tile found refuting, for labels() to raise their `refutes`.
   void spill_refuted(const TileResult& result);
 

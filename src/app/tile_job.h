@@ -143,6 +143,8 @@ struct TileResultSections {
   /// The consistent pairs: only the labelled PLYs need them, and on a city they are tens of
   /// millions of pairs to decode and hold.
   bool pairs = true;
+  /// The selected triangles: not when another MPI rank files them under the seam parts.
+  bool selected = true;
 };
 
 /// The result in `file` when it is complete and was made under `digest`; nothing otherwise

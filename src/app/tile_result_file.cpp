@@ -414,7 +414,7 @@ std::optional<TileResult> read_tile_result(const std::filesystem::path& file, st
   for (std::uint32_t a = 0; a < pieces.size() && a < store.triangles.size(); ++a) {  // withdrawn since: empty
     TilePiece piece;
     piece.mesh.origin = origin;
-    if (!pieces[a].empty()) piece = decode_tile_blocks(pieces[a], origin, a, file.string());
+    if (sections.selected && !pieces[a].empty()) piece = decode_tile_blocks(pieces[a], origin, a, file.string());
     r.selected.push_back(std::move(piece));
   }
   while (r.selected.size() < store.triangles.size()) {

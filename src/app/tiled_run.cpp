@@ -10,6 +10,7 @@
 #include <optional>
 #include <string_view>
 
+#include "assembly_ranks.h"
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/checksum.h"
 #include "citymesh/core/error.h"
@@ -70,6 +71,18 @@ void write_labels(const Config& config, const TileAssembly& assembly, const Pict
                         .at_once = labels_at_once(config, described, pictures.pictures)});
 }
 
+/// A tile's entry in the run report: its counts, and its seconds when it was processed now.
+nlohmann::json tile_entry(const TileContents& tile, bool processed, const TileTally& tally) {
+  nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
+  if (processed) {
+    entry["seconds"] = {
+        {"read", tally.seconds_read}, {"detect", tally.seconds_detect}, {"mosaic", tally.seconds_mosaic}};
+  } else {
+    entry["reused"] = true;
+  }
+  return entry;
+}
+
 /// Adds one tile's result to the assembly and its entry to the run report.
 void add_tile_result(const Config& config, const TileContents& tile, bool processed, std::optional<TileResult> r,
                      TileAssembly& assembly, std::vector<nlohmann::json>& per_tile) {
@@ -80,13 +93,11 @@ void add_tile_result(const Config& config, const TileContents& tile, bool proces
         fmt::format("{}: the tile result cannot be read any more; remove it and run again to process the tile anew",
                     result_path(config, tile.key).string()));
   }
-  nlohmann::json entry{{"tile", tile.key.name()}, {"owned", tile.owned()}, {"triangles", tile.total()}};
-  if (processed) {
-    entry["seconds"] = {{"read", r->seconds_read}, {"detect", r->seconds_detect}, {"mosaic", r->seconds_mosaic}};
-  } else {
-    entry["reused"] = true;
-  }
-  per_tile.push_back(std::move(entry));
+  TileTally seconds;
+  seconds.seconds_read = r->seconds_read;
+  seconds.seconds_detect = r->seconds_detect;
+  seconds.seconds_mosaic = r->seconds_mosaic;
+  per_tile.push_back(tile_entry(tile, processed, seconds));
   assembly.add(std::move(*r));
 }
 
@@ -110,6 +121,16 @@ class FinalOutput {
   /// Writes a tile's selected triangles under their parts and takes them out of its result
   /// before it goes to the assembly (by blocks; whole, the assembly keeps them). Safe from
   /// several threads for different tiles; add_filed() then adds them, in tile order.
+  /// Whether the ranks of an MPI job read and file the tile results together (by blocks).
+  [[nodiscard]] bool shares_assembly() const { return seams_ && shared(); }
+  /// Every tile's result read and filed by the ranks (shares_assembly()), in tile order; the
+  /// parts are then merged by the ranks too (assemble()).
+  std::vector<FiledResult> file_tiles_shared(const TileStore& store, std::span<const std::uint64_t> digests) {
+    assembly_work_ = share_assembly(config_, *cluster_, *seams_, store);
+    return assembly_work_->file_tiles(
+        [&](std::size_t k) { return file_tile_result(config_, store, k, digests[k], *seams_); });
+  }
+
   std::optional<SeamPartFiles::FiledTile> file_tile(TileKey key, TileResult& result) const {
     if (!seams_) return std::nullopt;
     SeamPartFiles::FiledTile filed = seams_->file_tile(key, result.selected);
@@ -124,7 +145,8 @@ class FinalOutput {
   std::uint64_t assemble(TileAssembly& assembly) {
     std::uint64_t selected = 0;
     if (seams_) {
-      parts_ = seams_->finish();
+      parts_ = seams_->finish(assembly_work_ ? assembly_work_->merge_parts : SeamPartFiles::PartMerging{});
+      if (assembly_work_) remove_assembly_plan(config_);
       for (const std::uint64_t n : seams_->source_sizes()) selected += n;
     } else {
       merged_ = assembly.take_merged();
@@ -137,7 +159,7 @@ class FinalOutput {
   /// tiles are joined like seams inside a tile. Returns the figures for the summary.
   nlohmann::json stitch() {
     if (seams_) {
-      const bool shared = cluster_ != nullptr && cluster_->size() > 1;
+      const bool shared = this->shared();
       // The stitched parts stay in the work folder: the next run (an acquisition appended)
       // restitches only those whose inputs changed.
       SeamPartCache cache = seam_part_cache(config_);
@@ -173,7 +195,7 @@ class FinalOutput {
     if (!leaves_) return write_tileset_outputs(config_, merged_);
     // The other ranks, done with the seam pass and the filing by grid tile, map leaves and
     // build cells of the tree until the root ends (help_outputs).
-    const bool shared = cluster_ != nullptr && cluster_->size() > 1;
+    const bool shared = this->shared();
     ExportWork work = shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{};
     work.progress = "final pass: 3D Tiles";
     const nlohmann::json exported = write_tileset_outputs(config_, *leaves_, work);
@@ -191,53 +213,41 @@ class FinalOutput {
   }
 
  private:
+  /// Whether other MPI ranks share the pass.
+  [[nodiscard]] bool shared() const { return cluster_ != nullptr && cluster_->size() > 1; }
+
   const Config& config_;
   Cluster* cluster_;
+  std::optional<AssemblyWork> assembly_work_;  ///< while the ranks share the assembly
   MergedMesh merged_;
   std::optional<SeamPartFiles> seams_;
   std::vector<BlockPart> parts_;
   std::optional<OutputLeaves> leaves_;
 };
 
-/// What reading a tile's result holds at most, per byte of its file: the file, its decoded
-/// sections (the pairs stay as the file holds them), and a million pairs at a time as the
-/// assembly files them (a spinning street's largest result, a 291 MB file, took the final
-/// pass from 0.05 to 0.69 GB read alone: 2.2 bytes a byte; 5.5 while the pairs were decoded).
-constexpr std::uint64_t kResultReadBytesPerFileByte = 3;
-
-/// Per tile, what reading its result is estimated to hold (0 when the file is missing: the
-/// read then reports it).
-std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileStore& store) {
-  std::vector<std::uint64_t> bytes;
-  for (const TileContents& tile : store.tiles) {
-    std::error_code ec;
-    const std::uintmax_t size = std::filesystem::file_size(result_path(config, tile.key), ec);
-    bytes.push_back(ec ? 0 : std::uint64_t{size} * kResultReadBytesPerFileByte);
-  }
-  return bytes;
-}
-
 /// Reads every tile's result (checked) into the assembly and the final output, a few at a
 /// time in parallel (each filed under the seam pass's parts there too), then added in tile
 /// order: a read result is several times the piece the assembly keeps of it, so not all at
 /// once, and no more at once than the memory budget holds (a spinning street's two largest
 /// results are 0.29 and 0.19 GB files: read together they took its final pass to 2.3 GB).
+/// `file_selected` false: only the labels, pairs and figures (the ranks filed the rest).
 void read_tile_results(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
                        const TileStageReport& tiles, TileAssembly& assembly, FinalOutput& output,
-                       std::vector<nlohmann::json>& per_tile) {
+                       std::vector<nlohmann::json>& per_tile, bool file_selected = true) {
   constexpr std::size_t kBatch = 4;
   std::vector<std::optional<TileResult>> batch(kBatch);
   std::vector<std::optional<SeamPartFiles::FiledTile>> filed(kBatch);
   const std::vector<std::uint64_t> read_bytes = result_read_bytes(config, store);
-  StageProgress progress({.stage = "final pass: tile results read", .total = store.tiles.size()});
+  StageProgress progress({.stage = file_selected ? "final pass: tile results read" : "final pass: tile labels read",
+                          .total = store.tiles.size()});
   for (std::size_t first = 0, count = 0; first < store.tiles.size(); first += count) {
     count = batch_within(read_bytes, first, kBatch, memory_left(config.run.memory));
     parallel_for_blocks(count, 1, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         const TileKey key = store.tiles[first + i].key;
-        batch[i] =
-            read_tile_result(result_path(config, key), digests[first + i], store, {.pairs = config.output.labels});
-        filed[i] = batch[i] ? output.file_tile(key, *batch[i]) : std::nullopt;
+        batch[i] = read_tile_result(result_path(config, key), digests[first + i], store,
+                                    {.pairs = config.output.labels, .selected = file_selected});
+        filed[i] = batch[i] && file_selected ? output.file_tile(key, *batch[i]) : std::nullopt;
       }
     });
     for (std::size_t i = 0; i < count; ++i) {
@@ -246,6 +256,24 @@ void read_tile_results(const Config& config, const TileStore& store, std::span<c
                       per_tile);
     }
     progress.advance(count);
+  }
+}
+
+/// Under MPI (by blocks): every rank reads and files tile results (share_assembly); the root
+/// adds what they report in tile order, and reads the labels itself when it writes labelled
+/// outputs.
+void gather_filed_results(const Config& config, const TileStore& store, std::span<const std::uint64_t> digests,
+                          const TileStageReport& tiles, TileAssembly& assembly, FinalOutput& output,
+                          std::vector<nlohmann::json>& per_tile) {
+  const std::vector<FiledResult> filed = output.file_tiles_shared(store, digests);
+  for (const FiledResult& r : filed) output.add_filed(r.filed);
+  if (config.output.labels) {
+    read_tile_results(config, store, digests, tiles, assembly, output, per_tile, false);
+    return;
+  }
+  for (std::size_t k = 0; k < filed.size(); ++k) {
+    assembly.add_tally(filed[k].tally);
+    per_tile.push_back(tile_entry(store.tiles[k], tiles.processed[k] != 0, filed[k].tally));
   }
 }
 
@@ -271,7 +299,11 @@ void write_run_outputs(const Config& config, const TileStore& store, std::span<c
                         config.output.labels ? std::optional(pair_spill_folder(config.project.work)) : std::nullopt);
   FinalOutput output(config, cluster);
   std::vector<nlohmann::json> per_tile;
-  read_tile_results(config, store, digests, tiles, assembly, output, per_tile);
+  if (output.shares_assembly()) {
+    gather_filed_results(config, store, digests, tiles, assembly, output, per_tile);
+  } else {
+    read_tile_results(config, store, digests, tiles, assembly, output, per_tile);
+  }
   const std::uint64_t selected = output.assemble(assembly);
   stage_done("assembly");
   if (config.output.labels) {
@@ -439,6 +471,7 @@ void run_tiled(const Config& config, const TiledRunOptions& options, Cluster& cl
   if (cluster.root()) {
     write_run_outputs(config, store, digests.result, tiles, options.pictures, seconds, &cluster);
   } else if (seam_pass_in_blocks(config)) {
+    help_assembly(config, cluster, store, digests.result);
     help_seam_pass(config, cluster);
     help_outputs(config, cluster);
   }

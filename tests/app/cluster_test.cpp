@@ -121,13 +121,15 @@ TEST_F(ClusterRun, ThreeMpiRanksShareTheFinalPassAndGiveTheBytesOfOneProcess) {
   // The figures too: the open boundary measured by the other ranks once came out longer
   // (they measured with a grid gone out of scope).
   EXPECT_EQ(summary_figures(output("blocks-mpi")), summary_figures(output("blocks-one")));
-  // Ranks 1 and 2 each say how many parts they stitched: some of them did.
+  // Ranks 1 and 2 each say how many tile results they read and filed, and how many parts
+  // they stitched: some of each.
   const std::string log = test::read_text(*dir_ / "blocks.log");
-  for (const std::string_view said : {"stitched "}) {
+  for (const std::string_view said : {"read and filed ", "stitched "}) {
     const auto [items, ranks] = done_by_other_ranks(log, said);
     EXPECT_EQ(ranks, 2u) << said << log;
     EXPECT_GT(items, 0u) << said << log;
   }
+  EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "assembly-step.json")) << "the plan was left behind";
   EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "seam-level.json")) << "the plan was left behind";
   // They then file the output by grid tile, map leaves and build cells of the 3D Tiles tree
   // (the tiles are among the bytes compared above) until rank 0 ends; how many each gets
@@ -136,6 +138,37 @@ TEST_F(ClusterRun, ThreeMpiRanksShareTheFinalPassAndGiveTheBytesOfOneProcess) {
     EXPECT_NE(log.find(fmt::format("rank {}: filed ", rank)), std::string::npos) << log;
   }
   EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "output-step.json")) << "the plan was left behind";
+}
+
+TEST_F(ClusterRun, WithoutLabelsTheRanksAssembleTheTilesAndTheRootAddsUpWhatOneProcessCounts) {
+  if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
+  // Without labelled outputs rank 0 reads no tile result at all: it adds up the counts the
+  // ranks that read them report (run.json, summary.json) and files what they filed.
+  const std::string blocks =
+      " --set tiling.tile_size=20 --set run.seam_pass=blocks --set output.labels=false --threads 1";
+  const auto one = test::run_citymesh("run " + args(sim_, "tally-one") + blocks);
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  const std::string cmd =
+      fmt::format("{} run {}{} > {} 2>&1", mpirun(3), args(sim_, "tally-mpi"), blocks, (*dir_ / "tally.log").string());
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << test::read_text(*dir_ / "tally.log");
+  const auto bytes = test::result_bytes(output("tally-mpi"));
+  EXPECT_TRUE(bytes == test::result_bytes(output("tally-one"))) << "3 ranks differ from one process";
+  EXPECT_TRUE(bytes.contains("mosaic/mosaic.ply"));
+  EXPECT_EQ(summary_figures(output("tally-mpi")), summary_figures(output("tally-one")));
+  const nlohmann::json run_one = read_json(output("tally-one") / "run.json"),
+                       run_mpi = read_json(output("tally-mpi") / "run.json");
+  for (const char* key : {"input_triangles", "output_triangles", "tiles"}) EXPECT_EQ(run_mpi[key], run_one[key]) << key;
+  ASSERT_EQ(run_mpi["per_tile"].size(), run_one["per_tile"].size());
+  for (std::size_t k = 0; k < run_one["per_tile"].size(); ++k) {
+    for (const char* key : {"tile", "owned", "triangles"}) {
+      EXPECT_EQ(run_mpi["per_tile"][k][key], run_one["per_tile"][k][key]) << k << key;
+    }
+    EXPECT_TRUE(run_mpi["per_tile"][k]["seconds"].contains("mosaic")) << "a processed tile's seconds came back";
+  }
+  const auto [items, ranks] = done_by_other_ranks(test::read_text(*dir_ / "tally.log"), "read and filed ");
+  EXPECT_EQ(ranks, 2u);
+  EXPECT_GT(items, 0u);
+  EXPECT_FALSE(std::filesystem::exists(output("work-tally-mpi") / "assembly-step.json")) << "the plan was left behind";
 }
 
 TEST_F(ClusterRun, AKilledRankLosesOnlyItsWorkInFlight) {

@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: MIT
+#include "assembly_ranks.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <atomic>
+#include <nlohmann/json.hpp>
+#include <optional>
+
+#include "citymesh/core/atomic_file.h"
+#include "citymesh/core/error.h"
+#include "citymesh/core/interrupt.h"
+#include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
+#include "citymesh/core/process_memory.h"
+#include "citymesh/core/progress.h"
+#include "json_bits.h"
+#include "mosaic_step.h"
+#include "run_stages.h"
+#include "work_schedule.h"
+
+namespace citymesh::app {
+
+namespace {
+
+/// What reading a tile's result holds at most, per byte of its file: the file, its decoded
+/// sections (the pairs stay as the file holds them), and a million pairs at a time as the
+/// assembly files them (a spinning street's largest result, a 291 MB file, took the final
+/// pass from 0.05 to 0.69 GB read alone: 2.2 bytes a byte; 5.5 while the pairs were decoded).
+constexpr std::uint64_t kResultReadBytesPerFileByte = 3;
+
+/// The plan of the step being shared, written by the root before it shares the step.
+std::filesystem::path plan_path(const Config& config) { return config.project.work / "assembly-step.json"; }
+
+/// What another rank needs for one step: the root's folder of parts, and for "merge" every
+/// part with its fragments (for "file" the tiles are the store's, which every rank holds).
+struct StepPlan {
+  std::string step;  ///< "file" or "merge"
+  std::filesystem::path dir;
+  std::vector<BlockPartKey> parts;
+  std::vector<std::vector<std::filesystem::path>> fragments;
+};
+
+void write_plan(const Config& config, const StepPlan& plan) {
+  nlohmann::json parts = nlohmann::json::array(), fragments = nlohmann::json::array();
+  for (const BlockPartKey& k : plan.parts) parts.push_back({k.level, k.x, k.y});
+  for (const auto& of_part : plan.fragments) {
+    nlohmann::json files = nlohmann::json::array();
+    for (const std::filesystem::path& f : of_part) files.push_back(std::filesystem::absolute(f).string());
+    fragments.push_back(std::move(files));
+  }
+  const nlohmann::json j{{"step", plan.step},
+                         {"dir", std::filesystem::absolute(plan.dir).string()},
+                         {"parts", parts},
+                         {"fragments", fragments}};
+  write_file_atomically(plan_path(config), j.dump() + "\n");
+}
+
+StepPlan read_plan(const Config& config) {
+  return decode_json_file(plan_path(config), "rank 0's plan of the assembly", [](const nlohmann::json& j) {
+    StepPlan plan;
+    plan.step = j.at("step").get<std::string>();
+    plan.dir = j.at("dir").get<std::string>();
+    for (const auto& k : j.at("parts")) {
+      plan.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
+    }
+    for (const auto& of_part : j.at("fragments")) {
+      plan.fragments.emplace_back();
+      for (const auto& f : of_part) plan.fragments.back().emplace_back(f.get<std::string>());
+    }
+    if (plan.fragments.size() != plan.parts.size()) throw ProcessingError("the plan's fragments are not its parts'");
+    return plan;
+  });
+}
+
+/// Where a tile's filing is reported for the root: beside the parts.
+std::filesystem::path filed_file(const std::filesystem::path& dir, TileKey key) {
+  return dir / fmt::format("{}.filed.json", key.name());
+}
+
+nlohmann::json tally_json(const TileTally& t) {
+  nlohmann::json change_counts = nlohmann::json::array(), change_seconds = nlohmann::json::array();
+  for (const auto field : kChangeCounts) change_counts.push_back(t.change.*field);
+  for (const auto field : kChangeSeconds) change_seconds.push_back(double_bits(t.change.*field));
+  return {{"counts", {t.owned, t.candidates, t.seen_through, t.filled, t.fill_left_out}},
+          {"change_counts", change_counts},
+          {"change_seconds", change_seconds},
+          {"seconds", {double_bits(t.seconds_read), double_bits(t.seconds_detect), double_bits(t.seconds_mosaic)}}};
+}
+
+TileTally tally_from(const nlohmann::json& j) {
+  TileTally t;
+  const auto& counts = j.at("counts");
+  std::size_t i = 0;
+  for (std::uint64_t TileTally::*field : {&TileTally::owned, &TileTally::candidates, &TileTally::seen_through,
+                                          &TileTally::filled, &TileTally::fill_left_out}) {
+    t.*field = counts.at(i++).get<std::uint64_t>();
+  }
+  i = 0;
+  for (const auto field : kChangeCounts) t.change.*field = j.at("change_counts").at(i++).get<std::uint64_t>();
+  i = 0;
+  for (const auto field : kChangeSeconds) t.change.*field = double_from_bits(j.at("change_seconds").at(i++));
+  const auto& seconds = j.at("seconds");
+  t.seconds_read = double_from_bits(seconds.at(0));
+  t.seconds_detect = double_from_bits(seconds.at(1));
+  t.seconds_mosaic = double_from_bits(seconds.at(2));
+  return t;
+}
+
+nlohmann::json filed_json(const FiledResult& r) {
+  nlohmann::json parts = nlohmann::json::array(), files = nlohmann::json::array(), boxes = nlohmann::json::array();
+  for (const BlockPartKey& k : r.filed.parts) parts.push_back({k.level, k.x, k.y});
+  for (const std::filesystem::path& f : r.filed.files) files.push_back(f.string());
+  for (const Box3d& b : r.filed.boxes) boxes.push_back(box_bits(b));
+  return {{"parts", parts},
+          {"files", files},
+          {"boxes", boxes},
+          {"source_sizes", r.filed.source_sizes},
+          {"tally", tally_json(r.tally)}};
+}
+
+FiledResult filed_from(const nlohmann::json& j) {
+  FiledResult r;
+  for (const auto& k : j.at("parts")) {
+    r.filed.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
+  }
+  for (const auto& f : j.at("files")) r.filed.files.emplace_back(f.get<std::string>());
+  for (const auto& b : j.at("boxes")) r.filed.boxes.push_back(box_from_bits(b));
+  if (r.filed.files.size() != r.filed.parts.size() || r.filed.boxes.size() != r.filed.parts.size()) {
+    throw ProcessingError("a filed tile's parts, files and boxes differ in number");
+  }
+  r.filed.source_sizes = j.at("source_sizes").get<std::vector<std::uint64_t>>();
+  r.tally = tally_from(j.at("tally"));
+  return r;
+}
+
+/// Shares one step's items (one per cost, largest first) with the worker threads of every
+/// rank, `workers` on each; `here(i)` does item i in this process. Progress lines count the
+/// items done by every rank as `stage`.
+void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, unsigned workers, std::string stage,
+                 const std::function<void(std::size_t)>& here) {
+  const std::size_t n = costs.size();
+  StageProgress progress({.stage = std::move(stage), .total = n});
+  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
+  auto channel = cluster.share(&schedule, [&progress](std::size_t) { progress.advance(); });
+  run_workers(*channel, workers, [&](std::size_t i) {
+    throw_if_interrupted("the assembly");
+    here(i);
+  });
+}
+
+}  // namespace
+
+std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileStore& store) {
+  std::vector<std::uint64_t> bytes;
+  for (const TileContents& tile : store.tiles) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(result_path(config, tile.key), ec);
+    bytes.push_back(ec ? 0 : std::uint64_t{size} * kResultReadBytesPerFileByte);
+  }
+  return bytes;
+}
+
+unsigned results_at_once(const Config& config, const TileStore& store) {
+  const std::vector<std::uint64_t> bytes = result_read_bytes(config, store);
+  const std::uint64_t largest = bytes.empty() ? 0 : *std::max_element(bytes.begin(), bytes.end());
+  const std::uint64_t fit = largest == 0 ? available_threads() : memory_left(config.run.memory) / largest;
+  return static_cast<unsigned>(std::clamp<std::uint64_t>(fit, 1, available_threads()));
+}
+
+FiledResult file_tile_result(const Config& config, const TileStore& store, std::size_t k, std::uint64_t digest,
+                             const SeamPartFiles& files) {
+  const TileKey key = store.tiles.at(k).key;
+  const std::filesystem::path path = result_path(config, key);
+  const std::optional<TileResult> r = read_tile_result(path, digest, store, {.pairs = false});
+  if (!r) {
+    // Checked whole before the pass began: gone since, or whole but not decodable (a warning
+    // above says why; only a fault of citymesh writes such a file).
+    throw ProcessingError(
+        fmt::format("{}: the tile result cannot be read any more; remove it and run again to process the tile anew",
+                    path.string()));
+  }
+  return {files.file_tile(key, r->selected), tally_of(*r, store)};
+}
+
+AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPartFiles& files,
+                            const TileStore& store) {
+  AssemblyWork work;
+  work.file_tiles = [&config, &cluster, &files, &store](const std::function<FiledResult(std::size_t)>& here) {
+    write_plan(config, {.step = "file", .dir = files.dir(), .parts = {}, .fragments = {}});
+    std::vector<std::optional<FiledResult>> mine(store.tiles.size());
+    share_items(cluster, result_read_bytes(config, store), results_at_once(config, store),
+                "final pass: tile results read", [&](std::size_t k) { mine[k] = here(k); });
+    std::vector<FiledResult> out(mine.size());
+    std::size_t elsewhere = 0;
+    for (std::size_t k = 0; k < out.size(); ++k) {
+      if (mine[k]) {
+        out[k] = std::move(*mine[k]);
+        continue;
+      }
+      out[k] = take_json_file(filed_file(files.dir(), store.tiles[k].key), "a tile another rank filed", filed_from);
+      ++elsewhere;
+    }
+    log::debug("final pass: {} of {} tile results read and filed by other ranks", elsewhere, out.size());
+    return out;
+  };
+  work.merge_parts = [&config, &cluster, &files](std::span<const BlockPartKey> parts,
+                                                 std::span<const std::vector<std::filesystem::path>> fragments,
+                                                 const std::function<void(std::size_t)>& here) {
+    write_plan(config, {.step = "merge",
+                        .dir = files.dir(),
+                        .parts = {parts.begin(), parts.end()},
+                        .fragments = {fragments.begin(), fragments.end()}});
+    std::vector<std::uint64_t> costs;  // fragments to read: the most first
+    for (const auto& of_part : fragments) costs.push_back(of_part.size());
+    share_items(cluster, std::move(costs), available_threads(), "final pass: seam parts assembled", here);
+  };
+  return work;
+}
+
+void remove_assembly_plan(const Config& config) {
+  std::error_code ec;
+  std::filesystem::remove(plan_path(config), ec);
+}
+
+void help_assembly(const Config& config, Cluster& cluster, const TileStore& store,
+                   std::span<const std::uint64_t> digests) {
+  std::atomic<std::size_t> filed = 0, merged = 0;
+  for (const std::string_view expected : {"file", "merge"}) {
+    // The root writes the plan before it shares the step, and sharing starts with a barrier.
+    auto channel = cluster.share(nullptr, {});
+    const StepPlan plan = read_plan(config);
+    if (plan.step != expected) {
+      throw ProcessingError(fmt::format("{}: step '{}' where step '{}' of the assembly was expected",
+                                        plan_path(config).string(), plan.step, expected));
+    }
+    const SeamPartFiles files(plan.dir, tile_grid_blocks(config), SeamPartFiles::Folder::others);
+    // Each item's outcome is written before the root hears that it is done (the worker's
+    // next request says so).
+    if (plan.step == "file") {
+      run_workers(*channel, results_at_once(config, store), [&](std::size_t k) {
+        throw_if_interrupted("the assembly");
+        const FiledResult r = file_tile_result(config, store, k, digests[k], files);
+        write_file_atomically(filed_file(plan.dir, store.tiles.at(k).key), filed_json(r).dump());
+        ++filed;
+      });
+      continue;
+    }
+    run_workers(*channel, available_threads(), [&](std::size_t p) {
+      throw_if_interrupted("the assembly");
+      files.merge_fragments(plan.parts.at(p), plan.fragments.at(p));
+      ++merged;
+    });
+  }
+  log::info("rank {}: read and filed {} tile results and merged {} seam parts of the assembly", cluster.rank(),
+            filed.load(), merged.load());
+}
+
+}  // namespace citymesh::app
