@@ -35,6 +35,7 @@ std::filesystem::path plan_path(const Config& config) { return config.project.wo
 /// - "merge": write each leaf file `leaf_files[l]` from its shares `shares[l]`;
 /// - "boxes": map the output's tiles (`leaves`, in `dir`) to the frame at `frame.origin`;
 /// - "cells": build the export's cells in `frame`, from the same tiles;
+/// - "plys": write each tile's (`leaves`, in `dir`) provenance PLY to `leaf_files`;
 /// - "end": nothing more.
 struct StepPlan {
   std::string step;
@@ -403,6 +404,19 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
   return work;
 }
 
+LeafPlyWork share_leaf_plys(const Config& config, Cluster& cluster, const OutputLeaves& leaves) {
+  return [&config, &cluster, &leaves](std::span<const std::filesystem::path> files,
+                                      const std::function<void(std::size_t)>& here) {
+    StepPlan plan = plan_of("plys", leaves.dir());
+    for (const OutputLeaf& leaf : leaves.leaves()) plan.leaves.push_back(leaf.key);
+    plan.leaf_files.assign(files.begin(), files.end());
+    write_plan(config, plan);
+    std::vector<std::uint64_t> costs;  // largest tile first
+    for (const OutputLeaf& leaf : leaves.leaves()) costs.push_back(leaf.triangles);
+    share_items(cluster, std::move(costs), here);
+  };
+}
+
 void end_shared_outputs(const Config& config, Cluster& cluster) {
   write_plan(config, plan_of("end"));
   share_items(cluster, {}, [](std::size_t) {});
@@ -411,7 +425,8 @@ void end_shared_outputs(const Config& config, Cluster& cluster) {
 }
 
 void help_outputs(const Config& config, Cluster& cluster) {
-  std::atomic<std::size_t> filed = 0, merged = 0, mapped = 0, built = 0;
+  std::atomic<std::size_t> filed = 0, merged = 0, mapped = 0, built = 0, plys = 0;
+  const std::vector<std::int32_t> listed = config.listed_indices();
   const Crs crs = config.crs();
   ExportCaches cache(config.project.work);
   TilesetExportParams params = tileset_export_params(config);
@@ -462,14 +477,20 @@ void help_outputs(const Config& config, Cluster& cluster) {
         write_cell(plan.dir, c, export_cell(*view, crs, plan.frame, params, c));
         ++built;
       });
+    } else if (plan.step == "plys") {
+      work([&](std::size_t l) {
+        write_leaf_ply(attached, l, plan.leaf_files.at(l), listed);
+        ++plys;
+      });
     } else {
       throw ProcessingError(
           fmt::format("{}: unknown step '{}' of the final pass", plan_path(config).string(), plan.step));
     }
   }
   log::info(
-      "rank {}: filed {} parts and {} tiles of the output; mapped {} leaves and built {} cells of the 3D Tiles export",
-      cluster.rank(), filed.load(), merged.load(), mapped.load(), built.load());
+      "rank {}: filed {} parts and {} tiles of the output; mapped {} leaves and built {} cells of the 3D Tiles export; "
+      "wrote {} per-tile PLYs",
+      cluster.rank(), filed.load(), merged.load(), mapped.load(), built.load(), plys.load());
 }
 
 }  // namespace citymesh::app

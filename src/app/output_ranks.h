@@ -15,6 +15,7 @@
 #include "citymesh/tiles3d/export.h"
 #include "cluster.h"
 #include "seam_parts.h"
+#include "tileset_output.h"
 
 namespace citymesh::app {
 
@@ -28,12 +29,17 @@ LeafFilingWork share_leaf_filing(const Config& config, Cluster& cluster, const s
 /// (collective when called). `config`, `cluster` and `leaves` must outlive it.
 ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeaves& leaves);
 
+/// On the root: the per-tile PLYs of `leaves` ([output] ply) handed out to every rank
+/// (collective when called). `config`, `cluster` and `leaves` must outlive it.
+LeafPlyWork share_leaf_plys(const Config& config, Cluster& cluster, const OutputLeaves& leaves);
+
 /// On the root, once the outputs are written (or when there are none): lets the other ranks
 /// out of help_outputs() and removes the plan. Collective.
 void end_shared_outputs(const Config& config, Cluster& cluster);
 
-/// On every other rank, after help_seam_pass(): files parts, maps leaves and builds cells as
-/// the root hands them out, until the root ends. Collective with the three above.
+/// On every other rank, after help_seam_pass(): files parts, maps leaves, builds cells and
+/// writes per-tile PLYs as the root hands them out, until the root ends. Collective with the
+/// four above.
 void help_outputs(const Config& config, Cluster& cluster);
 
 }  // namespace citymesh::app

@@ -198,7 +198,8 @@ class FinalOutput {
     const bool shared = this->shared();
     ExportWork work = shared ? share_export(config_, *cluster_, *leaves_) : ExportWork{};
     work.progress = "final pass: 3D Tiles";
-    const nlohmann::json exported = write_tileset_outputs(config_, *leaves_, work);
+    const nlohmann::json exported = write_tileset_outputs(
+        config_, *leaves_, work, shared ? share_leaf_plys(config_, *cluster_, *leaves_) : LeafPlyWork{});
     if (shared) end_shared_outputs(config_, *cluster_);
     leaves_.reset();
     seams_.reset();

@@ -11,6 +11,7 @@
 #include "citymesh/core/error.h"
 #include "citymesh/core/interrupt.h"
 #include "citymesh/core/log.h"
+#include "citymesh/core/parallel.h"
 #include "citymesh/core/stopwatch.h"
 #include "citymesh/io/ply_writer.h"
 #include "citymesh/tiles3d/export.h"
@@ -134,20 +135,24 @@ nlohmann::json write_tile_plys(const Config& config, const MergedMesh& merged) {
   return {{"files", tiles.size()}, {"seconds", clock.seconds()}};
 }
 
-/// One provenance PLY per tile from the output's tiles in files.
-nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves) {
+/// One provenance PLY per tile from the output's tiles in files, each tile's written where
+/// `plys` says (empty: on this process's threads).
+nlohmann::json write_tile_plys(const Config& config, const OutputLeaves& leaves, const LeafPlyWork& plys) {
   Stopwatch clock;
   const std::filesystem::path dir = config.project.output / "ply";
   const std::filesystem::path staged = staging_directory(dir);
   std::filesystem::remove_all(staged);
   std::filesystem::create_directories(staged);
   const std::vector<std::int32_t> listed = config.listed_indices();
-  for (std::size_t l = 0; l < leaves.leaves().size(); ++l) {
-    const KeyedPiece piece = leaves.load(l);
-    const MeshVertexRows rows = piece_rows(piece);
-    const Provenance provenance(piece, listed);
-    write_ply(staged / (leaves.leaves()[l].key.name() + ".ply"),
-              {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
+  std::vector<std::filesystem::path> files;
+  for (const OutputLeaf& leaf : leaves.leaves()) files.push_back(staged / (leaf.key.name() + ".ply"));
+  const std::function<void(std::size_t)> here = [&](std::size_t l) { write_leaf_ply(leaves, l, files[l], listed); };
+  if (plys) {
+    plys(files, here);
+  } else {
+    parallel_for_blocks(files.size(), 1, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t l = begin; l < end; ++l) here(l);
+    });
   }
   replace_directory_atomically(staged, dir);
   std::cout << fmt::format("provenance PLY: {} tiles -> {}\n", leaves.leaves().size(), dir.string());
@@ -175,7 +180,17 @@ std::filesystem::path find_tileset(const std::filesystem::path& given) {
       fmt::format("{}: no tileset.json there nor in its tiles/ folder (run citymesh run first)", given.string()));
 }
 
-nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work) {
+void write_leaf_ply(const OutputLeaves& leaves, std::size_t l, const std::filesystem::path& file,
+                    std::span<const std::int32_t> listed) {
+  throw_if_interrupted("the per-tile PLYs");
+  const KeyedPiece piece = leaves.load(l);
+  const MeshVertexRows rows = piece_rows(piece);
+  const Provenance provenance(piece, listed);
+  write_ply(file, {rows.positions, piece.triangles, rows.columns(), provenance.columns(), {std::string(kPlyComment)}});
+}
+
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work,
+                                     const LeafPlyWork& plys) {
   nlohmann::json report = nlohmann::json::object();
   remove_unwritten_outputs(config, leaves.leaves().empty());
   if (leaves.leaves().empty()) {
@@ -194,7 +209,7 @@ nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& l
     report["tiles_3d"] = report_3d_tiles(export_tileset(LeavesToExport(leaves), config.crs(), params, work), params);
     cache.prune(started);
   }
-  if (config.output.ply) report["ply"] = write_tile_plys(config, leaves);
+  if (config.output.ply) report["ply"] = write_tile_plys(config, leaves, plys);
   return report;
 }
 

@@ -5,8 +5,10 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <span>
 
 #include "citymesh/config/config.h"
 #include "citymesh/mosaic/merged_mesh.h"
@@ -21,10 +23,19 @@ std::filesystem::path find_tileset(const std::filesystem::path& given);
 
 /// Writes what [output] asks for; returns figures for the run report ({} when nothing).
 nlohmann::json write_tileset_outputs(const Config& config, const MergedMesh& merged);
+/// How the per-tile PLYs are written: given each leaf's file and `here(l)` (leaf l's written
+/// in this process). Empty: here, on the pool's threads.
+using LeafPlyWork =
+    std::function<void(std::span<const std::filesystem::path> files, const std::function<void(std::size_t)>& here)>;
 /// The same from the output's tiles in files (a tiled run's seam pass block by block), the
-/// 3D Tiles export's leaves mapped and cells built as `work` says (default: here; an MPI
-/// job's ranks share them).
-nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work = {});
+/// 3D Tiles export's leaves mapped and cells built as `work` says, and the per-tile PLYs
+/// written as `plys` says (default: here; an MPI job's ranks share them).
+nlohmann::json write_tileset_outputs(const Config& config, const OutputLeaves& leaves, const ExportWork& work = {},
+                                     const LeafPlyWork& plys = {});
+/// Leaf `l`'s provenance PLY (as [output] ply writes it) in `file`: safe from several threads
+/// (or processes) for different leaves. `listed`: Config::listed_indices().
+void write_leaf_ply(const OutputLeaves& leaves, std::size_t l, const std::filesystem::path& file,
+                    std::span<const std::int32_t> listed);
 
 /// The 3D Tiles export's settings from the config.
 TilesetExportParams tileset_export_params(const Config& config);

@@ -140,12 +140,14 @@ TEST_F(ClusterRun, ThreeMpiRanksShareTheFinalPassAndGiveTheBytesOfOneProcess) {
   EXPECT_FALSE(std::filesystem::exists(output("work-blocks-mpi") / "output-step.json")) << "the plan was left behind";
 }
 
-TEST_F(ClusterRun, WithoutLabelsTheRanksAssembleTheTilesAndTheRootAddsUpWhatOneProcessCounts) {
+TEST_F(ClusterRun, WithoutLabelsTheRanksAssembleTheTilesAndWriteTheTilePlysAndTheRootAddsUpWhatOneProcessCounts) {
   if (!have_mpi()) GTEST_SKIP() << "built without MPI or mpirun missing (tools/setup installs OpenMPI)";
   // Without labelled outputs rank 0 reads no tile result at all: it adds up the counts the
   // ranks that read them report (run.json, summary.json) and files what they filed.
+  // The per-tile PLYs that go with it at city scale are written by every rank too.
   const std::string blocks =
-      " --set tiling.tile_size=20 --set run.seam_pass=blocks --set output.labels=false --threads 1";
+      " --set tiling.tile_size=20 --set run.seam_pass=blocks --set output.labels=false --set output.ply=true "
+      "--threads 1";
   const auto one = test::run_citymesh("run " + args(sim_, "tally-one") + blocks);
   ASSERT_EQ(one.exit_code, 0) << one.err;
   const std::string cmd =
@@ -154,6 +156,9 @@ TEST_F(ClusterRun, WithoutLabelsTheRanksAssembleTheTilesAndTheRootAddsUpWhatOneP
   const auto bytes = test::result_bytes(output("tally-mpi"));
   EXPECT_TRUE(bytes == test::result_bytes(output("tally-one"))) << "3 ranks differ from one process";
   EXPECT_TRUE(bytes.contains("mosaic/mosaic.ply"));
+  std::size_t tile_plys = 0;
+  for (const auto& [name, content] : bytes) tile_plys += name.starts_with("ply/") ? 1 : 0;
+  EXPECT_GE(tile_plys, 4u);
   EXPECT_EQ(summary_figures(output("tally-mpi")), summary_figures(output("tally-one")));
   const nlohmann::json run_one = read_json(output("tally-one") / "run.json"),
                        run_mpi = read_json(output("tally-mpi") / "run.json");
@@ -165,9 +170,18 @@ TEST_F(ClusterRun, WithoutLabelsTheRanksAssembleTheTilesAndTheRootAddsUpWhatOneP
     }
     EXPECT_TRUE(run_mpi["per_tile"][k]["seconds"].contains("mosaic")) << "a processed tile's seconds came back";
   }
-  const auto [items, ranks] = done_by_other_ranks(test::read_text(*dir_ / "tally.log"), "read and filed ");
-  EXPECT_EQ(ranks, 2u);
-  EXPECT_GT(items, 0u);
+  const std::string log = test::read_text(*dir_ / "tally.log");
+  const auto [items, ranks] = done_by_other_ranks(log, "read and filed ");
+  EXPECT_EQ(ranks, 2u) << log;
+  EXPECT_GT(items, 0u) << log;
+  std::size_t plys_elsewhere = 0;
+  for (const int rank : {1, 2}) {
+    const auto line = log.find(fmt::format("rank {}: filed ", rank));
+    const auto wrote = log.find("; wrote ", line);
+    ASSERT_NE(wrote, std::string::npos) << log;
+    plys_elsewhere += std::stoul(log.substr(wrote + 8));
+  }
+  EXPECT_GT(plys_elsewhere, 0u) << "no other rank wrote a per-tile PLY\n" << log;
   EXPECT_FALSE(std::filesystem::exists(output("work-tally-mpi") / "assembly-step.json")) << "the plan was left behind";
 }
 
