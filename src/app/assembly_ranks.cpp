@@ -4,9 +4,11 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <type_traits>
 
 #include "citymesh/core/atomic_file.h"
 #include "citymesh/core/error.h"
@@ -79,36 +81,59 @@ std::filesystem::path filed_file(const std::filesystem::path& dir, TileKey key) 
   return dir / fmt::format("{}.filed.json", key.name());
 }
 
+/// A tally's counts and seconds, in the order its JSON lists them.
+constexpr std::array kTallyCounts{&TileTally::owned, &TileTally::candidates, &TileTally::seen_through,
+                                  &TileTally::filled, &TileTally::fill_left_out};
+constexpr std::array kTallySeconds{&TileTally::seconds_read, &TileTally::seconds_detect, &TileTally::seconds_mosaic};
+
+/// The fields `fields` of `object` as a JSON list, doubles as their bits (a sum over ranks
+/// must equal one process's).
+template <class Object, class Fields>
+nlohmann::json fields_json(const Object& object, const Fields& fields) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto field : fields) {
+    if constexpr (std::is_same_v<std::remove_cvref_t<decltype(object.*field)>, double>) {
+      out.push_back(double_bits(object.*field));
+    } else {
+      out.push_back(object.*field);
+    }
+  }
+  return out;
+}
+
+/// The inverse of fields_json; throws nlohmann's errors when the list is short.
+template <class Object, class Fields>
+void fields_from(const nlohmann::json& list, const Fields& fields, Object& object) {
+  std::size_t i = 0;
+  for (const auto field : fields) {
+    using Value = std::remove_cvref_t<decltype(object.*field)>;
+    if constexpr (std::is_same_v<Value, double>) {
+      object.*field = double_from_bits(list.at(i++));
+    } else {
+      object.*field = list.at(i++).template get<Value>();
+    }
+  }
+}
+
 nlohmann::json tally_json(const TileTally& t) {
-  nlohmann::json change_counts = nlohmann::json::array(), change_seconds = nlohmann::json::array();
-  for (const auto field : kChangeCounts) change_counts.push_back(t.change.*field);
-  for (const auto field : kChangeSeconds) change_seconds.push_back(double_bits(t.change.*field));
-  return {{"counts", {t.owned, t.candidates, t.seen_through, t.filled, t.fill_left_out}},
-          {"change_counts", change_counts},
-          {"change_seconds", change_seconds},
-          {"seconds", {double_bits(t.seconds_read), double_bits(t.seconds_detect), double_bits(t.seconds_mosaic)}}};
+  return {{"counts", fields_json(t, kTallyCounts)},
+          {"change_counts", fields_json(t.change, kChangeCounts)},
+          {"change_seconds", fields_json(t.change, kChangeSeconds)},
+          {"seconds", fields_json(t, kTallySeconds)}};
 }
 
 TileTally tally_from(const nlohmann::json& j) {
   TileTally t;
-  const auto& counts = j.at("counts");
-  std::size_t i = 0;
-  for (std::uint64_t TileTally::*field : {&TileTally::owned, &TileTally::candidates, &TileTally::seen_through,
-                                          &TileTally::filled, &TileTally::fill_left_out}) {
-    t.*field = counts.at(i++).get<std::uint64_t>();
-  }
-  i = 0;
-  for (const auto field : kChangeCounts) t.change.*field = j.at("change_counts").at(i++).get<std::uint64_t>();
-  i = 0;
-  for (const auto field : kChangeSeconds) t.change.*field = double_from_bits(j.at("change_seconds").at(i++));
-  const auto& seconds = j.at("seconds");
-  t.seconds_read = double_from_bits(seconds.at(0));
-  t.seconds_detect = double_from_bits(seconds.at(1));
-  t.seconds_mosaic = double_from_bits(seconds.at(2));
+  fields_from(j.at("counts"), kTallyCounts, t);
+  fields_from(j.at("change_counts"), kChangeCounts, t.change);
+  fields_from(j.at("change_seconds"), kChangeSeconds, t.change);
+  fields_from(j.at("seconds"), kTallySeconds, t);
   return t;
 }
 
-nlohmann::json filed_json(const FiledResult& r) {
+}  // namespace
+
+nlohmann::json filed_result_json(const FiledResult& r) {
   nlohmann::json parts = nlohmann::json::array(), files = nlohmann::json::array(), boxes = nlohmann::json::array();
   for (const BlockPartKey& k : r.filed.parts) parts.push_back({k.level, k.x, k.y});
   for (const std::filesystem::path& f : r.filed.files) files.push_back(f.string());
@@ -120,7 +145,7 @@ nlohmann::json filed_json(const FiledResult& r) {
           {"tally", tally_json(r.tally)}};
 }
 
-FiledResult filed_from(const nlohmann::json& j) {
+FiledResult filed_result_from(const nlohmann::json& j) {
   FiledResult r;
   for (const auto& k : j.at("parts")) {
     r.filed.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
@@ -134,6 +159,8 @@ FiledResult filed_from(const nlohmann::json& j) {
   r.tally = tally_from(j.at("tally"));
   return r;
 }
+
+namespace {
 
 /// Shares one step's items (one per cost, largest first) with the worker threads of every
 /// rank, `workers` on each; `here(i)` does item i in this process. Progress lines count the
@@ -199,7 +226,8 @@ AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPa
         out[k] = std::move(*mine[k]);
         continue;
       }
-      out[k] = take_json_file(filed_file(files.dir(), store.tiles[k].key), "a tile another rank filed", filed_from);
+      out[k] =
+          take_json_file(filed_file(files.dir(), store.tiles[k].key), "a tile another rank filed", filed_result_from);
       ++elsewhere;
     }
     log::debug("final pass: {} of {} tile results read and filed by other ranks", elsewhere, out.size());
@@ -242,7 +270,7 @@ void help_assembly(const Config& config, Cluster& cluster, const TileStore& stor
       run_workers(*channel, results_at_once(config, store), [&](std::size_t k) {
         throw_if_interrupted("the assembly");
         const FiledResult r = file_tile_result(config, store, k, digests[k], files);
-        write_file_atomically(filed_file(plan.dir, store.tiles.at(k).key), filed_json(r).dump());
+        write_file_atomically(filed_file(plan.dir, store.tiles.at(k).key), filed_result_json(r).dump());
         ++filed;
       });
       continue;

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <span>
 #include <vector>
 
@@ -22,6 +23,12 @@ struct FiledResult {
   SeamPartFiles::FiledTile filed;
   TileTally tally;
 };
+
+/// What a rank leaves beside the parts for the root: a tile's filing and tally as JSON
+/// (doubles and boxes as their bits, so that the root's sums are one process's), and back
+/// (throws nlohmann::json::exception or ProcessingError when a field is missing).
+nlohmann::json filed_result_json(const FiledResult& r);
+FiledResult filed_result_from(const nlohmann::json& j);
 
 /// Reads the result of tile `k` of `store` (made under `digest`) without its pairs and files
 /// its selected triangles under their parts in `files`' folder. Throws ProcessingError naming

@@ -93,11 +93,9 @@ void add_tile_result(const Config& config, const TileContents& tile, bool proces
         fmt::format("{}: the tile result cannot be read any more; remove it and run again to process the tile anew",
                     result_path(config, tile.key).string()));
   }
-  TileTally seconds;
-  seconds.seconds_read = r->seconds_read;
-  seconds.seconds_detect = r->seconds_detect;
-  seconds.seconds_mosaic = r->seconds_mosaic;
-  per_tile.push_back(tile_entry(tile, processed, seconds));
+  per_tile.push_back(tile_entry(
+      tile, processed,
+      {.seconds_read = r->seconds_read, .seconds_detect = r->seconds_detect, .seconds_mosaic = r->seconds_mosaic}));
   assembly.add(std::move(*r));
 }
 
@@ -118,9 +116,6 @@ class FinalOutput {
     }
   }
 
-  /// Writes a tile's selected triangles under their parts and takes them out of its result
-  /// before it goes to the assembly (by blocks; whole, the assembly keeps them). Safe from
-  /// several threads for different tiles; add_filed() then adds them, in tile order.
   /// Whether the ranks of an MPI job read and file the tile results together (by blocks).
   [[nodiscard]] bool shares_assembly() const { return seams_ && shared(); }
   /// Every tile's result read and filed by the ranks (shares_assembly()), in tile order; the
@@ -131,6 +126,9 @@ class FinalOutput {
         [&](std::size_t k) { return file_tile_result(config_, store, k, digests[k], *seams_); });
   }
 
+  /// Writes a tile's selected triangles under their parts and takes them out of its result
+  /// before it goes to the assembly (by blocks; whole, the assembly keeps them). Safe from
+  /// several threads for different tiles; add_filed() then adds them, in tile order.
   std::optional<SeamPartFiles::FiledTile> file_tile(TileKey key, TileResult& result) const {
     if (!seams_) return std::nullopt;
     SeamPartFiles::FiledTile filed = seams_->file_tile(key, result.selected);
