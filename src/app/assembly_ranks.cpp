@@ -16,10 +16,10 @@
 #include "citymesh/core/log.h"
 #include "citymesh/core/parallel.h"
 #include "citymesh/core/process_memory.h"
-#include "citymesh/core/progress.h"
 #include "json_bits.h"
 #include "mosaic_step.h"
 #include "run_stages.h"
+#include "shared_steps.h"
 #include "work_schedule.h"
 
 namespace citymesh::app {
@@ -45,8 +45,7 @@ struct StepPlan {
 };
 
 void write_plan(const Config& config, const StepPlan& plan) {
-  nlohmann::json parts = nlohmann::json::array(), fragments = nlohmann::json::array();
-  for (const BlockPartKey& k : plan.parts) parts.push_back({k.level, k.x, k.y});
+  nlohmann::json fragments = nlohmann::json::array();
   for (const auto& of_part : plan.fragments) {
     nlohmann::json files = nlohmann::json::array();
     for (const std::filesystem::path& f : of_part) files.push_back(std::filesystem::absolute(f).string());
@@ -54,7 +53,7 @@ void write_plan(const Config& config, const StepPlan& plan) {
   }
   const nlohmann::json j{{"step", plan.step},
                          {"dir", std::filesystem::absolute(plan.dir).string()},
-                         {"parts", parts},
+                         {"parts", block_part_keys_json(plan.parts)},
                          {"fragments", fragments}};
   write_file_atomically(plan_path(config), j.dump() + "\n");
 }
@@ -64,9 +63,7 @@ StepPlan read_plan(const Config& config) {
     StepPlan plan;
     plan.step = j.at("step").get<std::string>();
     plan.dir = j.at("dir").get<std::string>();
-    for (const auto& k : j.at("parts")) {
-      plan.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
-    }
+    plan.parts = block_part_keys_from(j.at("parts"));
     for (const auto& of_part : j.at("fragments")) {
       plan.fragments.emplace_back();
       for (const auto& f : of_part) plan.fragments.back().emplace_back(f.get<std::string>());
@@ -134,11 +131,10 @@ TileTally tally_from(const nlohmann::json& j) {
 }  // namespace
 
 nlohmann::json filed_result_json(const FiledResult& r) {
-  nlohmann::json parts = nlohmann::json::array(), files = nlohmann::json::array(), boxes = nlohmann::json::array();
-  for (const BlockPartKey& k : r.filed.parts) parts.push_back({k.level, k.x, k.y});
+  nlohmann::json files = nlohmann::json::array(), boxes = nlohmann::json::array();
   for (const std::filesystem::path& f : r.filed.files) files.push_back(f.string());
   for (const Box3d& b : r.filed.boxes) boxes.push_back(box_bits(b));
-  return {{"parts", parts},
+  return {{"parts", block_part_keys_json(r.filed.parts)},
           {"files", files},
           {"boxes", boxes},
           {"source_sizes", r.filed.source_sizes},
@@ -147,9 +143,7 @@ nlohmann::json filed_result_json(const FiledResult& r) {
 
 FiledResult filed_result_from(const nlohmann::json& j) {
   FiledResult r;
-  for (const auto& k : j.at("parts")) {
-    r.filed.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
-  }
+  r.filed.parts = block_part_keys_from(j.at("parts"));
   for (const auto& f : j.at("files")) r.filed.files.emplace_back(f.get<std::string>());
   for (const auto& b : j.at("boxes")) r.filed.boxes.push_back(box_from_bits(b));
   if (r.filed.files.size() != r.filed.parts.size() || r.filed.boxes.size() != r.filed.parts.size()) {
@@ -159,25 +153,6 @@ FiledResult filed_result_from(const nlohmann::json& j) {
   r.tally = tally_from(j.at("tally"));
   return r;
 }
-
-namespace {
-
-/// Shares one step's items (one per cost, largest first) with the worker threads of every
-/// rank, `workers` on each; `here(i)` does item i in this process. Progress lines count the
-/// items done by every rank as `stage`.
-void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, unsigned workers, std::string stage,
-                 const std::function<void(std::size_t)>& here) {
-  const std::size_t n = costs.size();
-  StageProgress progress({.stage = std::move(stage), .total = n});
-  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
-  auto channel = cluster.share(&schedule, [&progress](std::size_t) { progress.advance(); });
-  run_workers(*channel, workers, [&](std::size_t i) {
-    throw_if_interrupted("the assembly");
-    here(i);
-  });
-}
-
-}  // namespace
 
 std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileStore& store) {
   std::vector<std::uint64_t> bytes;
@@ -189,8 +164,7 @@ std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileSto
   return bytes;
 }
 
-unsigned results_at_once(const Config& config, const TileStore& store) {
-  const std::vector<std::uint64_t> bytes = result_read_bytes(config, store);
+unsigned results_at_once(const Config& config, std::span<const std::uint64_t> bytes) {
   const std::uint64_t largest = bytes.empty() ? 0 : *std::max_element(bytes.begin(), bytes.end());
   const std::uint64_t fit = largest == 0 ? available_threads() : memory_left(config.run.memory) / largest;
   return static_cast<unsigned>(std::clamp<std::uint64_t>(fit, 1, available_threads()));
@@ -216,22 +190,14 @@ AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPa
   AssemblyWork work;
   work.file_tiles = [&config, &cluster, &files, &store](const std::function<FiledResult(std::size_t)>& here) {
     write_plan(config, {.step = "file", .dir = files.dir(), .parts = {}, .fragments = {}});
-    std::vector<std::optional<FiledResult>> mine(store.tiles.size());
-    share_items(cluster, result_read_bytes(config, store), results_at_once(config, store),
-                "final pass: tile results read", [&](std::size_t k) { mine[k] = here(k); });
-    std::vector<FiledResult> out(mine.size());
-    std::size_t elsewhere = 0;
-    for (std::size_t k = 0; k < out.size(); ++k) {
-      if (mine[k]) {
-        out[k] = std::move(*mine[k]);
-        continue;
-      }
-      out[k] =
-          take_json_file(filed_file(files.dir(), store.tiles[k].key), "a tile another rank filed", filed_result_from);
-      ++elsewhere;
-    }
-    log::debug("final pass: {} of {} tile results read and filed by other ranks", elsewhere, out.size());
-    return out;
+    std::vector<std::uint64_t> bytes = result_read_bytes(config, store);
+    const SharedStep step{
+        .workers = results_at_once(config, bytes), .what = "the assembly", .progress = "final pass: tile results read"};
+    return share_and_gather<FiledResult>(cluster, std::move(bytes), step, "tile results read and filed", here,
+                                         [&](std::size_t k) {
+                                           return take_json_file(filed_file(files.dir(), store.tiles[k].key),
+                                                                 "a tile another rank filed", filed_result_from);
+                                         });
   };
   work.merge_parts = [&config, &cluster, &files](std::span<const BlockPartKey> parts,
                                                  std::span<const std::vector<std::filesystem::path>> fragments,
@@ -242,7 +208,9 @@ AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPa
                         .fragments = {fragments.begin(), fragments.end()}});
     std::vector<std::uint64_t> costs;  // fragments to read: the most first
     for (const auto& of_part : fragments) costs.push_back(of_part.size());
-    share_items(cluster, std::move(costs), available_threads(), "final pass: seam parts assembled", here);
+    share_items(
+        cluster, std::move(costs),
+        {.workers = available_threads(), .what = "the assembly", .progress = "final pass: seam parts assembled"}, here);
   };
   return work;
 }
@@ -267,7 +235,7 @@ void help_assembly(const Config& config, Cluster& cluster, const TileStore& stor
     // Each item's outcome is written before the root hears that it is done (the worker's
     // next request says so).
     if (plan.step == "file") {
-      run_workers(*channel, results_at_once(config, store), [&](std::size_t k) {
+      run_workers(*channel, results_at_once(config, result_read_bytes(config, store)), [&](std::size_t k) {
         throw_if_interrupted("the assembly");
         const FiledResult r = file_tile_result(config, store, k, digests[k], files);
         write_file_atomically(filed_file(plan.dir, store.tiles.at(k).key), filed_result_json(r).dump());

@@ -40,9 +40,10 @@ FiledResult file_tile_result(const Config& config, const TileStore& store, std::
 /// read then reports it).
 std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileStore& store);
 
-/// How many results each process reads at once: its threads, fewer when the budget left does
-/// not hold that many of the largest (a spinning street's results reach 0.3 GB each).
-unsigned results_at_once(const Config& config, const TileStore& store);
+/// How many results each process reads at once, given result_read_bytes(): its threads, fewer
+/// when the budget left does not hold that many of the largest (a spinning street's results
+/// reach 0.3 GB each).
+unsigned results_at_once(const Config& config, std::span<const std::uint64_t> bytes);
 
 /// On the root: the assembly's two steps shared with every rank (collective: the other ranks
 /// are in help_assembly()). `files` and `cluster` must outlive it.

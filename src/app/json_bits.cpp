@@ -29,6 +29,25 @@ float float_from_bits(const nlohmann::json& j) { return std::bit_cast<float>(j.g
 
 nlohmann::json tile_key_json(const TileKey& k) { return {k.i, k.j}; }
 
+nlohmann::json block_part_key_json(const BlockPartKey& k) { return {k.level, k.x, k.y}; }
+
+BlockPartKey block_part_key_from(const nlohmann::json& j) {
+  if (!j.is_array() || j.size() != 3) throw ProcessingError("a seam part's key is not [level, x, y]");
+  return {j.at(0).get<int>(), j.at(1).get<std::int64_t>(), j.at(2).get<std::int64_t>()};
+}
+
+nlohmann::json block_part_keys_json(std::span<const BlockPartKey> keys) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const BlockPartKey& k : keys) rows.push_back(block_part_key_json(k));
+  return rows;
+}
+
+std::vector<BlockPartKey> block_part_keys_from(const nlohmann::json& rows) {
+  std::vector<BlockPartKey> keys;
+  for (const auto& r : rows) keys.push_back(block_part_key_from(r));
+  return keys;
+}
+
 TileKey tile_key_from(const nlohmann::json& j) { return {j.at(0).get<std::int32_t>(), j.at(1).get<std::int32_t>()}; }
 
 }  // namespace citymesh::app

@@ -10,12 +10,15 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "citymesh/core/error.h"
 #include "citymesh/core/read_file.h"
 #include "citymesh/core/vec.h"
+#include "citymesh/mosaic/stitch_blocks.h"
 #include "citymesh/tiler/tile_grid.h"
 
 namespace citymesh::app {
@@ -30,6 +33,12 @@ Box3d box_from_bits(const nlohmann::json& j);
 
 nlohmann::json tile_key_json(const TileKey& k);
 TileKey tile_key_from(const nlohmann::json& j);
+/// A seam part's key as [level, x, y], and back (ProcessingError when it is not three numbers).
+nlohmann::json block_part_key_json(const BlockPartKey& k);
+BlockPartKey block_part_key_from(const nlohmann::json& j);
+/// A list of them.
+nlohmann::json block_part_keys_json(std::span<const BlockPartKey> keys);
+std::vector<BlockPartKey> block_part_keys_from(const nlohmann::json& rows);
 
 /// `decode(the JSON in file)`; throws ProcessingError naming the file when it is missing
 /// ("missing (`what`)") or holds something `decode` does not expect ("malformed").

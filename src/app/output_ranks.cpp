@@ -20,6 +20,7 @@
 #include "citymesh/core/read_file.h"
 #include "json_bits.h"
 #include "kept_files.h"
+#include "shared_steps.h"
 #include "tileset_output.h"
 #include "work_schedule.h"
 
@@ -69,8 +70,6 @@ void write_plan(const Config& config, const StepPlan& plan) {
     for (const float v : f.lattice.lattice->origin) lattice.push_back(float_bits(v));
     lattice.push_back(float_bits(f.lattice.lattice->range));
   }
-  nlohmann::json parts = nlohmann::json::array();
-  for (const BlockPartKey& k : plan.parts) parts.push_back({k.level, k.x, k.y});
   nlohmann::json leaf_files = nlohmann::json::array(), shares = nlohmann::json::array();
   for (const std::filesystem::path& file : plan.leaf_files) leaf_files.push_back(absolute_or_empty(file));
   for (const auto& of_leaf : plan.shares) {
@@ -82,7 +81,7 @@ void write_plan(const Config& config, const StepPlan& plan) {
       {"step", plan.step},
       {"dir", absolute_or_empty(plan.dir)},
       {"parts_dir", absolute_or_empty(plan.parts_dir)},
-      {"parts", parts},
+      {"parts", block_part_keys_json(plan.parts)},
       {"leaf_files", leaf_files},
       {"shares", shares},
       {"leaves", leaves},
@@ -99,9 +98,7 @@ StepPlan read_plan(const Config& config) {
     plan.step = j.at("step").get<std::string>();
     plan.dir = j.at("dir").get<std::string>();
     plan.parts_dir = j.at("parts_dir").get<std::string>();
-    for (const auto& k : j.at("parts")) {
-      plan.parts.push_back({k.at(0).get<int>(), k.at(1).get<std::int64_t>(), k.at(2).get<std::int64_t>()});
-    }
+    plan.parts = block_part_keys_from(j.at("parts"));
     for (const auto& f : j.at("leaf_files")) plan.leaf_files.emplace_back(f.get<std::string>());
     for (const auto& of_leaf : j.at("shares")) {
       plan.shares.emplace_back();
@@ -299,38 +296,12 @@ Box3d take_box(const std::filesystem::path& dir, const TileKey& key) {
   return take_json_file(box_file(dir, key), "a leaf another rank mapped", box_from_bits);
 }
 
-/// Shares one step with every rank: one item per cost (none for "end"), `here(i)` done by
-/// this rank's workers, largest cost first. Returns once every rank's workers are done.
-void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const std::function<void(std::size_t)>& here) {
-  const std::size_t n = costs.size();
-  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(n), std::vector<std::uint8_t>(n, 0));
-  auto channel = cluster.share(&schedule, [](std::size_t) {});
-  run_workers(*channel, available_threads(), [&](std::size_t i) {
-    throw_if_interrupted("the final pass");
-    here(i);
-  });
-}
+/// A step of the outputs on every rank, with this rank's threads.
+SharedStep output_step() { return {.workers = available_threads(), .what = "the final pass", .progress = {}}; }
 
-/// share_items() for items with a result: each item's, from `here(i)` where this rank did
-/// it, else from `theirs(i)` (what another rank left for it). Logs how many others did.
-template <class Result>
-std::vector<Result> share_and_gather(Cluster& cluster, std::vector<std::uint64_t> costs, std::string_view what,
-                                     const std::function<Result(std::size_t)>& here,
-                                     const std::function<Result(std::size_t)>& theirs) {
-  std::vector<std::optional<Result>> mine(costs.size());
-  share_items(cluster, std::move(costs), [&](std::size_t i) { mine[i] = here(i); });
-  std::vector<Result> out(mine.size());
-  std::size_t elsewhere = 0;
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (mine[i]) {
-      out[i] = std::move(*mine[i]);
-    } else {
-      out[i] = theirs(i);
-      ++elsewhere;
-    }
-  }
-  log::debug("final pass: {} of {} {} by other ranks", elsewhere, out.size(), what);
-  return out;
+/// Shares one step with every rank: one item per cost (none for "end"), largest first.
+void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const std::function<void(std::size_t)>& here) {
+  app::share_items(cluster, std::move(costs), output_step(), here);
 }
 
 }  // namespace
@@ -346,7 +317,7 @@ LeafFilingWork share_leaf_filing(const Config& config, Cluster& cluster, const s
     plan.parts_dir = parts_dir;
     plan.parts = parts;
     write_plan(config, plan);
-    return share_and_gather<std::vector<OutputShare>>(cluster, std::vector<std::uint64_t>(count, 1),
+    return share_and_gather<std::vector<OutputShare>>(cluster, std::vector<std::uint64_t>(count, 1), output_step(),
                                                       "parts filed by grid tile", here,
                                                       [&](std::size_t p) { return take_shares(dir, p); });
   };
@@ -384,7 +355,7 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
     write_plan(config, plan);
     std::vector<std::uint64_t> costs;
     for (const TileKey& k : keys) costs.push_back(triangles->at(k));
-    return share_and_gather<Box3d>(cluster, std::move(costs), "leaves mapped", here,
+    return share_and_gather<Box3d>(cluster, std::move(costs), output_step(), "leaves mapped", here,
                                    [&](std::size_t k) { return take_box(leaves.dir(), keys[k]); });
   };
   work.cells = [&config, &cluster, &leaves, triangles, keys](const TilesetFrame& frame, const TileTreeBuild& tree,
@@ -398,7 +369,7 @@ ExportWork share_export(const Config& config, Cluster& cluster, const OutputLeav
     for (std::size_t c = 0; c < costs.size(); ++c) {
       for (const TileKey& k : tree.cell_leaves(c)) costs[c] += triangles->at(k);
     }
-    return share_and_gather<ExportedCell>(cluster, std::move(costs), "3D Tiles cells built", here,
+    return share_and_gather<ExportedCell>(cluster, std::move(costs), output_step(), "3D Tiles cells built", here,
                                           [&](std::size_t c) { return take_cell(leaves.dir(), c); });
   };
   return work;

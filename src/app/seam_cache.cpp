@@ -20,22 +20,6 @@ namespace {
 constexpr std::string_view kCacheMagic = "CMSTCH03";
 constexpr std::string_view kCacheSuffix = ".part";
 
-/// Part keys as [level, x, y] rows.
-nlohmann::json key_parts_json(std::span<const BlockPartKey> keys) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const BlockPartKey& k : keys) rows.push_back({k.level, k.x, k.y});
-  return rows;
-}
-
-std::vector<BlockPartKey> key_parts_from(const nlohmann::json& rows) {
-  std::vector<BlockPartKey> keys;
-  for (const auto& r : rows) {
-    if (r.size() != 3) throw ProcessingError("a seam part's outcome: a part key is not [level, x, y]");
-    keys.push_back({r.at(0).get<int>(), r.at(1).get<std::int64_t>(), r.at(2).get<std::int64_t>()});
-  }
-  return keys;
-}
-
 }  // namespace
 
 std::filesystem::path seam_cache_folder(const std::filesystem::path& work) { return work / "seam-cache"; }
@@ -44,7 +28,7 @@ nlohmann::json outcome_json(const PartOutcome& o) {
   std::vector<std::uint64_t> counts;
   for (const auto count : kStitchCounts) counts.push_back(o.stats.*count);
   return {{"counts", counts},   {"box", box_bits(o.box)}, {"cut_triangles", o.cut_triangles},
-          {"digest", o.digest}, {"reused", o.reused},     {"key_parts", key_parts_json(o.key_parts)}};
+          {"digest", o.digest}, {"reused", o.reused},     {"key_parts", block_part_keys_json(o.key_parts)}};
 }
 
 PartOutcome outcome_from(const nlohmann::json& j) {
@@ -56,7 +40,7 @@ PartOutcome outcome_from(const nlohmann::json& j) {
   o.cut_triangles = j.at("cut_triangles").get<std::size_t>();
   o.digest = j.at("digest").get<std::uint64_t>();
   o.reused = j.at("reused").get<bool>();
-  o.key_parts = key_parts_from(j.at("key_parts"));
+  o.key_parts = block_part_keys_from(j.at("key_parts"));
   return o;
 }
 

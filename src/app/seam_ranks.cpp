@@ -17,6 +17,7 @@
 #include "json_bits.h"
 #include "mosaic_step.h"
 #include "seam_cache.h"
+#include "shared_steps.h"
 #include "work_schedule.h"
 
 namespace citymesh::app {
@@ -43,9 +44,8 @@ struct StepPlan {
 void write_plan(const Config& config, const StepPlan& plan) {
   nlohmann::json parts = nlohmann::json::array();
   for (const BlockPart& p : plan.parts) {
-    parts.push_back({{"key", {p.key.level, p.key.x, p.key.y}},
-                     {"box", box_bits(p.box)},
-                     {"stitched_box", box_bits(p.stitched_box)}});
+    parts.push_back(
+        {{"key", block_part_key_json(p.key)}, {"box", box_bits(p.box)}, {"stitched_box", box_bits(p.stitched_box)}});
   }
   const nlohmann::json j{{"dir", std::filesystem::absolute(plan.dir).string()},
                          {"step", plan.step},
@@ -65,9 +65,7 @@ StepPlan read_plan(const Config& config) {
     plan.stitched = j.at("stitched").get<bool>();
     for (const auto& p : j.at("parts")) {
       const auto& key = p.at("key");
-      plan.parts.push_back({{key.at(0).get<int>(), key.at(1).get<std::int64_t>(), key.at(2).get<std::int64_t>()},
-                            box_from_bits(p.at("box")),
-                            box_from_bits(p.at("stitched_box"))});
+      plan.parts.push_back({block_part_key_from(key), box_from_bits(p.at("box")), box_from_bits(p.at("stitched_box"))});
     }
     plan.source_sizes = j.at("source_sizes").get<std::vector<std::uint64_t>>();
     return plan;
@@ -96,10 +94,9 @@ void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const s
                  const std::function<void(std::size_t)>& here) {
   std::vector<std::uint64_t> costs;  // largest first, as tiles: none is left to end a step alone
   for (const std::size_t p : index) costs.push_back(files.input_bytes(p));
-  WorkSchedule schedule(std::move(costs), std::vector<std::vector<std::size_t>>(index.size()),
-                        std::vector<std::uint8_t>(index.size(), 0));
-  auto channel = cluster.share(&schedule, [](std::size_t) {});
-  run_part_workers(*channel, here);
+  app::share_items(
+      cluster, std::move(costs),
+      {.workers = std::min(available_threads(), kMaxSeamPartsInFlight), .what = "the seam pass", .progress = {}}, here);
 }
 
 }  // namespace
