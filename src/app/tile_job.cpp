@@ -129,19 +129,22 @@ std::optional<bool> SettledSelection::selected(std::uint32_t acquisition, std::u
 namespace {
 
 /// The consistent pairs and the pairs of layers of one pass with an owned end, as result
-/// pairs; the change step's lists are let go. `owned(g)` and `id(g)` tell a global triangle's
-/// role and (acquisition, index). A tile keeps each acquisition's triangles in input order, so
-/// each list comes out sorted as it was. Its bytes are counted before they are written: a
-/// spinning scanner's tile holds 56 M pairs (0.3 GB as the result holds them), and a list
-/// grown by doubling holds up to twice that while it moves.
-template <class Owned, class Id>
-LabelPairList owned_pairs(ChangeResult& change, const Owned& owned, const Id& id) {
+/// pairs; the change step's lists are let go. A tile keeps each acquisition's triangles in
+/// input order, so each list comes out sorted as it was. Its bytes are counted before they
+/// are written: a spinning scanner's tile holds 56 M pairs (0.3 GB as the result holds them),
+/// and a list grown by doubling holds up to twice that while it moves.
+LabelPairList owned_pairs(ChangeResult& change, std::span<const TilePiece> pieces) {
+  const GlobalTriangles& index = change.index;
   const auto each_owned = [&](const auto& visit) {
     LabelPair previous{};
     for (const PackedPairs* pairs : {&change.consistent_pairs, &change.layer_pairs}) {
+      std::uint32_t ag = 0;  // g's acquisition, found by walking: each list comes sorted by g
       for (const auto& [g, h] : *pairs) {
-        if (!owned(g) && !owned(h)) continue;
-        auto x = id(g), y = id(h);
+        while (g >= index.offsets[ag + 1]) ++ag;
+        const std::uint32_t ah = index.acquisition_of(h);
+        const std::size_t tg = g - index.offsets[ag], th = h - index.offsets[ah];
+        if (pieces[ag].roles[tg] != TileRole::owned && pieces[ah].roles[th] != TileRole::owned) continue;
+        auto x = std::pair{ag, pieces[ag].triangle_index[tg]}, y = std::pair{ah, pieces[ah].triangle_index[th]};
         if (y < x) std::swap(x, y);
         const LabelPair p{x.first, x.second, y.first, y.second};
         visit(previous, p);
@@ -207,14 +210,6 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
       (change.consistent_pairs.size() + change.layer_pairs.size()) * LabelPairList::kBytesPerPair;
   if (resident_bytes() + pair_bytes > config.run.memory) release_freed_memory();
 
-  const auto owned = [&](std::uint32_t g) {
-    const std::uint32_t a = change.index.acquisition_of(g);
-    return pieces[a].roles[g - change.index.offsets[a]] == TileRole::owned;
-  };
-  const auto id = [&](std::uint32_t g) {
-    const std::uint32_t a = change.index.acquisition_of(g);
-    return std::pair{a, pieces[a].triangle_index[g - change.index.offsets[a]]};
-  };
   std::size_t owned_count = 0;
   for (const TilePiece& p : pieces)
     owned_count += static_cast<std::size_t>(std::count(p.roles.begin(), p.roles.end(), TileRole::owned));
@@ -249,7 +244,7 @@ TileResult process_tile(const TileStore& store, TileKey key, const Config& confi
   // already (sorting them was 1 % of a run).
   sort_unless_sorted(r.labels.begin(), r.labels.end(), by_triangle);
   sort_unless_sorted(r.refuted.begin(), r.refuted.end());
-  r.pairs = owned_pairs(change, owned, id);
+  r.pairs = owned_pairs(change, pieces);
   return r;
 }
 

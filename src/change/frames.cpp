@@ -37,11 +37,6 @@ std::string_view triangle_state_name(TriangleState s) {
   }
 }
 
-std::uint32_t GlobalTriangles::acquisition_of(std::size_t g) const {
-  const auto it = std::upper_bound(offsets.begin(), offsets.end(), g);
-  return static_cast<std::uint32_t>(it - offsets.begin() - 1);
-}
-
 namespace change_detail {
 
 namespace {
@@ -180,8 +175,10 @@ PartnerBits partner_bits(const TriangleFrames& frames, const PackedPairs& pairs)
   PartnerBits p;
   p.words = (frames.acquisitions() + 63) / 64;
   p.bits.assign(frames.size() * p.words, 0);
+  std::size_t ja = 0;  // a's acquisition, found by walking: the pairs come sorted by a
   for (const auto& [a, b] : pairs) {
-    const std::size_t ja = frames.index.acquisition_of(a), jb = frames.index.acquisition_of(b);
+    while (a >= frames.index.offsets[ja + 1]) ++ja;
+    const std::size_t jb = frames.index.acquisition_of(b);
     p.bits[a * p.words + jb / 64] |= std::uint64_t{1} << (jb % 64);
     p.bits[b * p.words + ja / 64] |= std::uint64_t{1} << (ja % 64);
   }

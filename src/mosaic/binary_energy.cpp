@@ -13,19 +13,7 @@
 
 namespace citymesh {
 
-void PairList::push_back(const EnergyPair& p) {
-  const std::array<double, 4> w{p.e00, p.e01, p.e10, p.e11};
-  const auto bits = [](const std::array<double, 4>& v) {
-    return std::array{std::bit_cast<std::uint64_t>(v[0]), std::bit_cast<std::uint64_t>(v[1]),
-                      std::bit_cast<std::uint64_t>(v[2]), std::bit_cast<std::uint64_t>(v[3])};
-  };
-  if (ends_.size() >= UINT32_MAX) throw ProcessingError("energy: too many pair terms");
-  if (rows_.empty() || bits(rows_.back()) != bits(w)) {
-    rows_.push_back(w);
-    row_starts_.push_back(static_cast<std::uint32_t>(ends_.size()));
-  }
-  ends_.push_back({p.i, p.j});
-}
+void PairList::too_many_terms() { throw ProcessingError("energy: too many pair terms"); }
 
 std::uint32_t PairList::row(std::size_t k) const {
   // The ends first, without bisection: every begin() and end() asks for them.
