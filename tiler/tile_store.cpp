@@ -5,9 +5,11 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <new>
@@ -103,6 +105,16 @@ int open_block_file(const std::filesystem::path& file) {
   return fd >= 0 ? fd : ::open(file.c_str(), flags, 0644);
 }
 
+/// Why a write ending at byte `end` failed with `err`. The kernel trims a write that crosses
+/// the file size limit (RLIMIT_FSIZE, `ulimit -f`) to end at the limit, which an O_DIRECT write
+/// then refuses as unaligned (EINVAL): that is the limit's EFBIG, "File too large".
+int write_error(int err, std::uint64_t end) {
+  rlimit limit{};
+  const bool past_limit =
+      ::getrlimit(RLIMIT_FSIZE, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY && end > limit.rlim_cur;
+  return err == EINVAL && past_limit ? EFBIG : err;
+}
+
 /// Writes `bytes` of `data` at `offset` of `fd` (`file` names it in errors), then asks for
 /// write-back to start (without O_DIRECT, the fsync before the store is published then finds
 /// little left to wait for; only a hint).
@@ -111,7 +123,7 @@ void write_pages(int fd, const char* data, std::size_t bytes, std::uint64_t offs
   while (done < bytes) {
     const ssize_t n = ::pwrite(fd, data + done, bytes - done, static_cast<off_t>(offset + done));
     if (n <= 0) {
-      const int err = n < 0 ? errno : EIO;
+      const int err = n < 0 ? write_error(errno, offset + bytes) : EIO;
       throw OutputError(fmt::format("{}: cannot append tile blocks: {}", file.string(), std::strerror(err)));
     }
     done += static_cast<std::size_t>(n);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstring>
 #include <fstream>
 #include <numeric>
@@ -54,7 +55,10 @@ void write_scratch_file(const std::filesystem::path& path, std::string_view byte
   // fsync (hundreds of them would cost seconds); a killed run's folder is removed whole.
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-  if (!out.flush()) throw OutputError(fmt::format("{}: cannot write a part of the seam pass", path.string()));
+  if (!out.flush()) {
+    const int err = errno;  // the failed open or write's reason (a full disk, mostly)
+    throw OutputError(fmt::format("{}: cannot write a part of the seam pass: {}", path.string(), std::strerror(err)));
+  }
 }
 
 void make_empty_folder(const std::filesystem::path& dir, std::string_view what) {

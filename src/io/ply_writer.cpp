@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <functional>
@@ -227,7 +228,11 @@ class SpoolFile {
     std::filesystem::path name = output;
     name += fmt::format(".{}{}{}", part, kTemporaryInfix, process_tag());
     file_ = std::fopen(name.c_str(), "w+b");
-    if (file_ == nullptr) throw OutputError(fmt::format("{}: cannot open a scratch file beside it", output.string()));
+    if (file_ == nullptr) {
+      const int err = errno;
+      throw OutputError(
+          fmt::format("{}: cannot open a scratch file beside it: {}", output.string(), std::strerror(err)));
+    }
     std::error_code ignored;  // a name that cannot be removed only leaves an empty file behind
     std::filesystem::remove(name, ignored);
   }
@@ -237,7 +242,8 @@ class SpoolFile {
 
   void write(const char* data, std::size_t size) {
     if (size > 0 && std::fwrite(data, 1, size, file_) != size) {
-      throw OutputError(fmt::format("{}: cannot write its scratch file (disk full?)", output_.string()));
+      const int err = errno;
+      throw OutputError(fmt::format("{}: cannot write its scratch file: {}", output_.string(), std::strerror(err)));
     }
   }
   /// Everything written so far, appended to `out`.

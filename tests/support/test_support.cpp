@@ -45,11 +45,15 @@ void write_text(const std::filesystem::path& path, const std::string& text) {
 CommandResult run_citymesh(const std::string& args) { return run_program(CITYMESH_BINARY, args); }
 
 CommandResult run_program(const std::filesystem::path& program, const std::string& args) {
+  return run_shell(program.string() + " " + args);
+}
+
+CommandResult run_shell(const std::string& command) {
   TempDir dir;
   const auto err_file = dir / "stderr.txt";
-  const std::string command = program.string() + " " + args + " 2>" + err_file.string();
+  const std::string redirected = "{ " + command + "; } 2>" + err_file.string();
   CommandResult result;
-  FILE* pipe = ::popen(command.c_str(), "r");
+  FILE* pipe = ::popen(redirected.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("popen failed");
   std::array<char, 4096> buffer{};
   std::size_t n = 0;

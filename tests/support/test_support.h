@@ -32,6 +32,8 @@ struct CommandResult {
 CommandResult run_citymesh(const std::string& args);
 /// The same with another executable (a copy of citymesh, say).
 CommandResult run_program(const std::filesystem::path& program, const std::string& args);
+/// A shell command (/bin/sh), its stderr captured.
+CommandResult run_shell(const std::string& command);
 /// A copy of the citymesh binary in `dir` with one byte appended: the same program, but
 /// another build to citymesh (its executable_identity differs).
 std::filesystem::path copy_as_another_build(const std::filesystem::path& dir);
