@@ -154,6 +154,20 @@ FiledResult filed_result_from(const nlohmann::json& j) {
   return r;
 }
 
+namespace {
+
+/// The assembly's steps on every rank: filing the tile results, as many at once as the budget
+/// holds (`bytes`: each result's read size), then merging the parts' fragments.
+SharedStep filing_step(const Config& config, std::span<const std::uint64_t> bytes) {
+  return {
+      .workers = results_at_once(config, bytes), .what = "the assembly", .progress = "final pass: tile results read"};
+}
+SharedStep merging_step() {
+  return {.workers = available_threads(), .what = "the assembly", .progress = "final pass: seam parts assembled"};
+}
+
+}  // namespace
+
 std::vector<std::uint64_t> result_read_bytes(const Config& config, const TileStore& store) {
   std::vector<std::uint64_t> bytes;
   for (const TileContents& tile : store.tiles) {
@@ -191,8 +205,7 @@ AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPa
   work.file_tiles = [&config, &cluster, &files, &store](const std::function<FiledResult(std::size_t)>& here) {
     write_plan(config, {.step = "file", .dir = files.dir(), .parts = {}, .fragments = {}});
     std::vector<std::uint64_t> bytes = result_read_bytes(config, store);
-    const SharedStep step{
-        .workers = results_at_once(config, bytes), .what = "the assembly", .progress = "final pass: tile results read"};
+    const SharedStep step = filing_step(config, bytes);
     return share_and_gather<FiledResult>(cluster, std::move(bytes), step, "tile results read and filed", here,
                                          [&](std::size_t k) {
                                            return take_json_file(filed_file(files.dir(), store.tiles[k].key),
@@ -208,9 +221,7 @@ AssemblyWork share_assembly(const Config& config, Cluster& cluster, const SeamPa
                         .fragments = {fragments.begin(), fragments.end()}});
     std::vector<std::uint64_t> costs;  // fragments to read: the most first
     for (const auto& of_part : fragments) costs.push_back(of_part.size());
-    share_items(
-        cluster, std::move(costs),
-        {.workers = available_threads(), .what = "the assembly", .progress = "final pass: seam parts assembled"}, here);
+    share_items(cluster, std::move(costs), merging_step(), here);
   };
   return work;
 }
@@ -235,16 +246,14 @@ void help_assembly(const Config& config, Cluster& cluster, const TileStore& stor
     // Each item's outcome is written before the root hears that it is done (the worker's
     // next request says so).
     if (plan.step == "file") {
-      run_workers(*channel, results_at_once(config, result_read_bytes(config, store)), [&](std::size_t k) {
-        throw_if_interrupted("the assembly");
+      work_on_shared_items(*channel, filing_step(config, result_read_bytes(config, store)), [&](std::size_t k) {
         const FiledResult r = file_tile_result(config, store, k, digests[k], files);
         write_file_atomically(filed_file(plan.dir, store.tiles.at(k).key), filed_result_json(r).dump());
         ++filed;
       });
       continue;
     }
-    run_workers(*channel, available_threads(), [&](std::size_t p) {
-      throw_if_interrupted("the assembly");
+    work_on_shared_items(*channel, merging_step(), [&](std::size_t p) {
       files.merge_fragments(plan.parts.at(p), plan.fragments.at(p));
       ++merged;
     });

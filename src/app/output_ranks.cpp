@@ -412,10 +412,7 @@ void help_outputs(const Config& config, Cluster& cluster) {
     // Each result is written before the root hears that the item is done (the worker's next
     // request says so).
     const auto work = [&](const std::function<void(std::size_t)>& body) {
-      run_workers(*channel, available_threads(), [&](std::size_t i) {
-        throw_if_interrupted("the final pass");
-        body(i);
-      });
+      work_on_shared_items(*channel, output_step(), body);
     };
     if (plan.step == "split") {
       const SeamPartFiles parts(plan.parts_dir, plan.parts);

@@ -78,13 +78,9 @@ double length_from(const nlohmann::json& j) { return double_from_bits(j.at("bits
 
 constexpr std::string_view kLengthSuffix = "length.json";
 
-/// This rank's workers on a step's channel: each item (a part) done by `body`, at most
-/// kMaxSeamPartsInFlight at a time, stopping between parts when interrupted.
-void run_part_workers(WorkChannel& channel, const std::function<void(std::size_t)>& body) {
-  run_workers(channel, std::min(available_threads(), kMaxSeamPartsInFlight), [&](std::size_t i) {
-    throw_if_interrupted("the seam pass");
-    body(i);
-  });
+/// A step of the seam pass on every rank: at most kMaxSeamPartsInFlight parts at a time.
+SharedStep seam_step() {
+  return {.workers = std::min(available_threads(), kMaxSeamPartsInFlight), .what = "the seam pass", .progress = {}};
 }
 
 /// Hands out one item per entry of `index` (item i: part index[i]) to every rank's workers,
@@ -94,9 +90,7 @@ void share_items(Cluster& cluster, const SeamPartFiles& files, std::span<const s
                  const std::function<void(std::size_t)>& here) {
   std::vector<std::uint64_t> costs;  // largest first, as tiles: none is left to end a step alone
   for (const std::size_t p : index) costs.push_back(files.input_bytes(p));
-  app::share_items(
-      cluster, std::move(costs),
-      {.workers = std::min(available_threads(), kMaxSeamPartsInFlight), .what = "the seam pass", .progress = {}}, here);
+  app::share_items(cluster, std::move(costs), seam_step(), here);
 }
 
 }  // namespace
@@ -171,7 +165,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
     // worker's next request says so).
     if (measuring) {
       const BoundaryMeasurer measurer(plan.parts, files, plan.stitched, blocks);
-      run_part_workers(*channel, [&](std::size_t p) {
+      work_on_shared_items(*channel, seam_step(), [&](std::size_t p) {
         write_file_atomically(files.beside(p, kLengthSuffix), length_json(measurer.measure(p)).dump());
         ++measured;
       });
@@ -184,7 +178,7 @@ void help_seam_pass(const Config& config, Cluster& cluster) {
                             .run_level = {},
                             .cache = &cache};
     const LevelStitcher stitcher(plan.parts, plan.level, files, run);
-    run_part_workers(*channel, [&](std::size_t i) {
+    work_on_shared_items(*channel, seam_step(), [&](std::size_t i) {
       const PartOutcome outcome = stitcher.stitch(i);
       write_file_atomically(files.beside(stitcher.parts_of_level()[i], kOutcomeSuffix), outcome_json(outcome).dump());
       ++(outcome.reused ? reused : stitched);

@@ -19,10 +19,14 @@ void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const Share
   auto channel = cluster.share(&schedule, [&progress](std::size_t) {
     if (progress) progress->advance();
   });
+  work_on_shared_items(*channel, step, here);
+}
+
+void work_on_shared_items(WorkChannel& channel, const SharedStep& step, const std::function<void(std::size_t)>& body) {
   const std::string what(step.what);
-  run_workers(*channel, step.workers, [&](std::size_t i) {
+  run_workers(channel, step.workers, [&](std::size_t i) {
     throw_if_interrupted(what);
-    here(i);
+    body(i);
   });
 }
 

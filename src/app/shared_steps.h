@@ -29,6 +29,12 @@ struct SharedStep {
 void share_items(Cluster& cluster, std::vector<std::uint64_t> costs, const SharedStep& step,
                  const std::function<void(std::size_t)>& here);
 
+/// A helping rank's side of share_items(): this rank's `step.workers` threads take items from
+/// `channel` (shared by the root with the same step) and do `body(i)` for each, stopping
+/// between items when interrupted. Root and helpers derive their workers and the step's name
+/// from one SharedStep.
+void work_on_shared_items(WorkChannel& channel, const SharedStep& step, const std::function<void(std::size_t)>& body);
+
 /// share_items() for items with a result: each item's, from `here(i)` where this rank did it,
 /// else from `theirs(i)` (what another rank left for it). Logs how many others did, as `done`
 /// ("leaves mapped").
